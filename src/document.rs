@@ -1,0 +1,165 @@
+//! A document: one mesh with its mesh colors, opened from glTF or a packed file.
+//!
+//! Opening chooses the loader by content (the packed magic), not by extension. A glTF
+//! mesh is welded, given a uniform resolution, and coloured: without a texture it gets
+//! a deterministic colour from position so the result is visibly non-uniform. A packed
+//! file is unpacked into the editable store.
+
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+use crate::color::{ColorFormat, Rgba};
+use crate::import::{ImportError, import_gltf};
+use crate::layout::Resolution;
+use crate::packed::PackedMesh;
+use crate::packed_file::{self, PackedFileError};
+use crate::packer::{self, PackError};
+use crate::store::ColorStore;
+use crate::topology::{Topology, TopologyError};
+use crate::weld::weld_scene;
+
+/// Errors of opening or saving a document; each names the file.
+#[derive(Debug, Error)]
+pub enum DocumentError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The glTF importer refused the file.
+    #[error(transparent)]
+    Import(#[from] ImportError),
+    /// The packed-file reader or writer refused the file.
+    #[error(transparent)]
+    PackedFile(#[from] PackedFileError),
+    /// The mesh has no valid topology.
+    #[error("{path}: {source}")]
+    Topology {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: TopologyError,
+    },
+    /// Packing or unpacking failed.
+    #[error("{path}: {source}")]
+    Pack {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: PackError,
+    },
+}
+
+/// Where a document came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SourceKind {
+    /// A .glb / .gltf file.
+    Gltf,
+    /// A packed file, in this colour format.
+    Packed(ColorFormat),
+}
+
+/// An open mesh with its editable colours.
+#[derive(Debug, Clone)]
+pub struct Document {
+    /// World-space vertex positions.
+    pub positions: Vec<[f32; 3]>,
+    /// Topology and colours.
+    pub store: ColorStore,
+    /// Triangles dropped by welding (0 for packed files).
+    pub degenerate_triangles_dropped: u64,
+    /// Where it came from.
+    pub source: SourceKind,
+    /// Importer notes (skipped primitives, ignored features).
+    pub warnings: Vec<String>,
+}
+
+/// A smooth, deterministic colour field over the bounding box, so texture-less meshes
+/// show visible variation: three sine waves of different frequency per channel.
+pub fn position_color(position: [f32; 3], bounds_min: [f32; 3], bounds_size: [f32; 3]) -> Rgba {
+    let t: [f32; 3] = std::array::from_fn(|a| {
+        let size = if bounds_size[a] > 0.0 { bounds_size[a] } else { 1.0 };
+        (position[a] - bounds_min[a]) / size
+    });
+    let wave = |x: f32, phase: f32| 0.5 + 0.5 * (std::f32::consts::TAU * x + phase).sin();
+    [wave(1.5 * t[0] + 0.5 * t[1], 0.0), wave(2.0 * t[1] + 0.7 * t[2], 2.0), wave(1.0 * t[2] + 1.3 * t[0], 4.0), 1.0]
+}
+
+/// Axis-aligned bounds `(min, size)` of `positions` (zeros when empty).
+pub fn bounds(positions: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
+    let mut min = [f32::INFINITY; 3];
+    let mut max = [f32::NEG_INFINITY; 3];
+    for p in positions {
+        for a in 0..3 {
+            min[a] = min[a].min(p[a]);
+            max[a] = max[a].max(p[a]);
+        }
+    }
+    if positions.is_empty() {
+        return ([0.0; 3], [0.0; 3]);
+    }
+    (min, std::array::from_fn(|a| max[a] - min[a]))
+}
+
+impl Document {
+    /// Opens `path`: a packed file (by magic) or glTF at uniform `gltf_resolution`.
+    pub fn open(path: &Path, gltf_resolution: Resolution) -> Result<Self, DocumentError> {
+        let mut head = [0u8; 8];
+        let is_packed = {
+            use std::io::Read;
+            let mut file =
+                std::fs::File::open(path).map_err(|source| DocumentError::Io { path: path.to_owned(), source })?;
+            let read = file.read(&mut head).unwrap_or(0);
+            packed_file::looks_like_packed(&head[..read])
+        };
+        if is_packed {
+            let packed = packed_file::read_file(path)?;
+            return Self::from_packed(&packed).map_err(|source| DocumentError::Pack { path: path.to_owned(), source });
+        }
+        let scene = import_gltf(path)?;
+        let welded = weld_scene(&scene);
+        let topology = Topology::build(welded.positions_world.len() as u32, &welded.triangles)
+            .map_err(|source| DocumentError::Topology { path: path.to_owned(), source })?;
+        let mut store = ColorStore::uniform(topology, gltf_resolution, [1.0; 4]);
+        let (min, size) = bounds(&welded.positions_world);
+        let corners = store.topology().face_vertices.clone();
+        let positions = welded.positions_world;
+        store.fill_with(|site| {
+            let face = corners[site.face as usize];
+            let p: [f32; 3] = std::array::from_fn(|a| {
+                site.barycentric[0] * positions[face[0] as usize][a]
+                    + site.barycentric[1] * positions[face[1] as usize][a]
+                    + site.barycentric[2] * positions[face[2] as usize][a]
+            });
+            position_color(p, min, size)
+        });
+        store.take_dirty();
+        Ok(Document {
+            positions,
+            store,
+            degenerate_triangles_dropped: welded.degenerate_triangles_dropped,
+            source: SourceKind::Gltf,
+            warnings: scene.warnings,
+        })
+    }
+
+    /// A document from packed buffers (level 0 becomes the store).
+    pub fn from_packed(packed: &PackedMesh) -> Result<Self, PackError> {
+        Ok(Document {
+            positions: packed.positions.clone(),
+            store: packer::unpack(packed)?,
+            degenerate_triangles_dropped: 0,
+            source: SourceKind::Packed(packed.format),
+            warnings: Vec::new(),
+        })
+    }
+
+    /// Packs the document into linear buffers in `format`.
+    pub fn pack(&self, format: ColorFormat) -> Result<PackedMesh, PackError> {
+        packer::pack(&self.store, &self.positions, format)
+    }
+}

@@ -1,0 +1,860 @@
+//! The packed file: one self-contained little-endian binary file holding a [`PackedMesh`].
+//!
+//! This is both the "export packed buffers" output and the project's save format. The
+//! byte-by-byte specification is `docs/FORMAT.md`; in short:
+//!
+//! ```text
+//! offset 0     header (128 bytes, zero-padded to 256)
+//! offset 256·k positions     vertex_count × [f32; 3]
+//! offset 256·k indices       face_count × [u32; 3]
+//! offset 256·k face records  face_count × 4 u32 (see crate::packed)
+//! offset 256·k colours       sample_count × bytes_per_sample(format)
+//! ```
+//!
+//! Every section starts at a multiple of [`SECTION_ALIGN`] (256) bytes, so each can be
+//! uploaded to the GPU with one write at an offset that satisfies wgpu's copy (4) and
+//! storage-buffer offset (≤ 256) alignments. Gaps are zero. One CRC-32 (IEEE, as
+//! `crc32fast` computes it) covers every byte of the file except the 4-byte checksum
+//! field itself (header bytes 124..128).
+//!
+//! # Reading hostile files
+//!
+//! [`from_bytes`] checks every count, offset and index before using it: it never panics
+//! and never allocates more than the file's own size justifies (every section length is
+//! checked against `bytes.len()` before its vector is built). The checks run in this
+//! order, so that the error says the most useful thing:
+//!
+//! 1. magic, header length, version, header size;
+//! 2. the section table: aligned, in order, non-overlapping, inside the file, and the
+//!    file ending exactly at the end of the colour section (truncation is reported as
+//!    such, before the checksum);
+//! 3. the checksum;
+//! 4. flags, reserved fields, colour format, counts against limits and section lengths;
+//! 5. the content: finite positions, indices in range, no repeated corners, and every
+//!    face record within the limits and its chains inside the colour buffer (the bounds
+//!    that make any GPU read derived from the records safe).
+//!
+//! Deeper layout consistency (e.g. two faces agreeing on a shared edge's chain base) is
+//! the unpacker's job ([`crate::packer`]), not this module's.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::color::ColorFormat;
+use crate::layout::{MAX_LOG2_RESOLUTION, Resolution, edge_chain_len, interior_chain_len};
+use crate::packed::{FaceRecord, MAX_SAMPLES, PackedMesh, unpack_word};
+
+/// The first 8 bytes of every packed file.
+pub const MAGIC: [u8; 8] = *b"MESHPAK\0";
+/// The format version this module writes and reads.
+pub const VERSION: u32 = 1;
+/// Size of the version-1 header in bytes (the header is zero-padded to [`SECTION_ALIGN`]).
+pub const HEADER_SIZE: usize = 128;
+/// Alignment of every section's offset in bytes.
+pub const SECTION_ALIGN: u64 = 256;
+/// Flag bits defined by this version (none); any set bit is refused.
+pub const KNOWN_FLAGS: u32 = 0;
+
+/// Byte offset of the CRC-32 field in the header.
+const CHECKSUM_OFFSET: usize = 124;
+/// Bytes of one position (`[f32; 3]`).
+const POSITION_SIZE: u64 = 12;
+/// Bytes of one triangle's indices (`[u32; 3]`).
+const TRIANGLE_SIZE: u64 = 12;
+/// Bytes of one face record.
+const RECORD_SIZE: u64 = 16;
+/// Number of entries in the section table.
+const SECTION_COUNT: usize = 4;
+/// Section names, in table and file order.
+const SECTION_NAMES: [&str; SECTION_COUNT] = ["positions", "indices", "face records", "colors"];
+
+/// Everything that can go wrong writing or reading a packed file.
+#[derive(Debug, thiserror::Error)]
+pub enum PackedFileError {
+    /// An I/O operation on `path` failed.
+    #[error("{}: cannot {action}: {source}", path.display())]
+    Io {
+        /// The file (or temporary file) concerned.
+        path: PathBuf,
+        /// What was being done, e.g. "read the file".
+        action: &'static str,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The content of the file at `path` is refused.
+    #[error("{}: {source}", path.display())]
+    File {
+        /// The file that was read or written.
+        path: PathBuf,
+        /// What is wrong.
+        source: Box<PackedFileError>,
+    },
+    /// The file does not start with [`MAGIC`].
+    #[error("not a meshpaint packed file: starts with {found:02x?}, expected {MAGIC:02x?} (\"MESHPAK\\0\")")]
+    NotPacked {
+        /// The first (up to 8) bytes of the file.
+        found: Vec<u8>,
+    },
+    /// The file ends before something the header (or the format) says is there.
+    #[error("truncated: {what} at byte {end} but the file has {len} bytes")]
+    Truncated {
+        /// What ends past the end of file, e.g. "header says colors end".
+        what: String,
+        /// Where it ends.
+        end: u64,
+        /// The file's actual length.
+        len: u64,
+    },
+    /// The file has bytes after its end (as the header's file size or last section say).
+    #[error("{extra} unexpected bytes after the end of the {what} at byte {end}")]
+    TrailingBytes {
+        /// What ends there ("file" by the header's size field, or "last section").
+        what: &'static str,
+        /// Where the file should end.
+        end: u64,
+        /// How many bytes follow.
+        extra: u64,
+    },
+    /// The file's version is not [`VERSION`].
+    #[error("unsupported packed file version {0} (this build reads version {VERSION})")]
+    UnsupportedVersion(u32),
+    /// The header size field is not [`HEADER_SIZE`].
+    #[error("header size is {0} bytes, version {VERSION} headers are {HEADER_SIZE} bytes")]
+    HeaderSize(u32),
+    /// The stored CRC-32 does not match the file content.
+    #[error("checksum mismatch: stored CRC-32 {stored:#010x}, content has {computed:#010x} (file corrupt)")]
+    ChecksumMismatch {
+        /// The CRC-32 in the header.
+        stored: u32,
+        /// The CRC-32 of the content.
+        computed: u32,
+    },
+    /// Flag bits this version does not define are set.
+    #[error("unknown flag bits {0:#010x} (version {VERSION} defines none)")]
+    UnknownFlags(u32),
+    /// A reserved header field is not zero.
+    #[error("reserved header field at byte {offset} is {value:#x}, must be 0")]
+    ReservedNotZero {
+        /// Byte offset of the field in the header.
+        offset: usize,
+        /// Its value.
+        value: u32,
+    },
+    /// The colour format code is unknown.
+    #[error("unknown colour format code {0} (known: 0 = rgba8, 1 = rgba16f, 2 = rgba32f)")]
+    UnknownColorFormat(u32),
+    /// A section offset is not a multiple of [`SECTION_ALIGN`].
+    #[error("{section} section offset {offset} is not a multiple of {SECTION_ALIGN}")]
+    SectionMisaligned {
+        /// The section.
+        section: &'static str,
+        /// Its offset.
+        offset: u64,
+    },
+    /// A section starts before the previous section (or the header) ends.
+    #[error("{section} section starts at byte {offset}, before the end of the {previous} at byte {previous_end}")]
+    SectionOverlap {
+        /// The section.
+        section: &'static str,
+        /// Its offset.
+        offset: u64,
+        /// What precedes it ("header" or a section name).
+        previous: &'static str,
+        /// Where that ends.
+        previous_end: u64,
+    },
+    /// A section's offset plus length does not fit in 64 bits.
+    #[error("{section} section: offset {offset} + length {length} overflows")]
+    SectionOverflow {
+        /// The section.
+        section: &'static str,
+        /// Its offset.
+        offset: u64,
+        /// Its length.
+        length: u64,
+    },
+    /// A section's length disagrees with the header counts.
+    #[error("{section} section is {length} bytes but {count} {unit} need {expected} bytes")]
+    SectionLength {
+        /// The section.
+        section: &'static str,
+        /// Its length in the table.
+        length: u64,
+        /// The header count.
+        count: u64,
+        /// What is counted ("vertices", "faces", "samples").
+        unit: &'static str,
+        /// `count × element size`, or `None` when that overflows 64 bits.
+        expected: Expected,
+    },
+    /// More samples than face-record bases can address.
+    #[error("sample count {0} exceeds the limit of {MAX_SAMPLES} (2^28) samples")]
+    TooManySamples(u64),
+    /// More vertices or faces than a 32-bit count holds (writer only).
+    #[error("{count} {what} exceed the format's 32-bit count")]
+    TooMany {
+        /// What ("vertices", "faces").
+        what: &'static str,
+        /// How many.
+        count: u64,
+    },
+    /// The mesh's buffers disagree about the face count (writer only).
+    #[error("{indices} triangles in the index buffer but {records} face records")]
+    FaceCountMismatch {
+        /// Triangles.
+        indices: u64,
+        /// Face records.
+        records: u64,
+    },
+    /// The colour buffer is not a whole number of samples (writer only).
+    #[error("colour buffer of {len} bytes is not a whole number of {bytes_per_sample}-byte samples")]
+    PartialSample {
+        /// Bytes in the colour buffer.
+        len: u64,
+        /// Bytes per sample of the format.
+        bytes_per_sample: usize,
+    },
+    /// `vertex_levels` exceeds `1 + MAX_LOG2_RESOLUTION`.
+    #[error("vertex_levels is {0}, the most is {max} (1 + log2 of the largest resolution)", max = MAX_LOG2_RESOLUTION + 1)]
+    TooManyVertexLevels(u32),
+    /// The vertex section does not fit in the colour buffer.
+    #[error("{vertices} vertices × {levels} levels need {needed} samples but there are {samples}")]
+    VertexSamples {
+        /// Vertex count.
+        vertices: u64,
+        /// `vertex_levels`.
+        levels: u32,
+        /// Their product.
+        needed: u64,
+        /// The colour buffer's sample count.
+        samples: u64,
+    },
+    /// A position coordinate is NaN or infinite.
+    #[error("position of vertex {vertex} is not finite: {position:?}")]
+    NonFinitePosition {
+        /// The vertex.
+        vertex: u64,
+        /// Its position.
+        position: [f32; 3],
+    },
+    /// A triangle refers to a vertex that does not exist.
+    #[error("index {corner} of triangle {triangle} is {index} but there are {vertex_count} vertices")]
+    IndexOutOfRange {
+        /// The triangle.
+        triangle: u64,
+        /// The corner (0, 1, 2).
+        corner: usize,
+        /// The index stored.
+        index: u32,
+        /// The number of vertices.
+        vertex_count: u64,
+    },
+    /// A triangle uses the same vertex twice.
+    #[error("triangle {triangle} repeats a corner: {corners:?}")]
+    RepeatedCorner {
+        /// The triangle.
+        triangle: u64,
+        /// Its corners.
+        corners: [u32; 3],
+    },
+    /// A face record's `log2 R_f` exceeds [`MAX_LOG2_RESOLUTION`].
+    #[error("face record {face}: log2 R = {log2} exceeds {MAX_LOG2_RESOLUTION} (R ≤ 4096)")]
+    FaceResolution {
+        /// The face.
+        face: u64,
+        /// Its stored `log2 R_f`.
+        log2: u32,
+    },
+    /// A face record's edge resolution is below the face's or above the limit.
+    #[error(
+        "face record {face}, edge {edge}: log2 R_e = {log2} must be in {face_log2}..={MAX_LOG2_RESOLUTION} (at least the face's log2 R)"
+    )]
+    EdgeResolution {
+        /// The face.
+        face: u64,
+        /// The face edge (0, 1, 2).
+        edge: usize,
+        /// Its stored `log2 R_e`.
+        log2: u32,
+        /// The face's `log2 R_f`.
+        face_log2: u32,
+    },
+    /// `vertex_levels` is too small for a face's resolution.
+    #[error("face record {face}: log2 R = {log2} needs vertex_levels >= {needed} but it is {vertex_levels}")]
+    VertexLevelsTooFew {
+        /// The face.
+        face: u64,
+        /// Its `log2 R_f`.
+        log2: u32,
+        /// `1 + log2`.
+        needed: u32,
+        /// The mesh's `vertex_levels`.
+        vertex_levels: u32,
+    },
+    /// A face record's MIP chain runs past the end of the colour buffer.
+    #[error(
+        "face record {face}: {chain} chain (R = {resolution}) at samples {base}..{end} runs past the {samples} samples of the colour buffer"
+    )]
+    ChainOutOfRange {
+        /// The face.
+        face: u64,
+        /// "interior" or "edge 0/1/2".
+        chain: &'static str,
+        /// The chain's resolution.
+        resolution: u32,
+        /// Its first sample.
+        base: u32,
+        /// One past its last sample.
+        end: u64,
+        /// The colour buffer's sample count.
+        samples: u64,
+    },
+}
+
+/// An expected byte count that may have overflowed 64 bits (for error messages).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Expected(pub Option<u64>);
+
+impl std::fmt::Display for Expected {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some(bytes) => write!(f, "{bytes}"),
+            None => write!(f, "more than 2^64"),
+        }
+    }
+}
+
+/// One entry of the section table.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct Section {
+    offset: u64,
+    length: u64,
+}
+
+/// The decoded version-1 header.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct Header {
+    version: u32,
+    header_size: u32,
+    file_size: u64,
+    flags: u32,
+    format_code: u32,
+    vertex_count: u32,
+    face_count: u32,
+    vertex_levels: u32,
+    reserved_44: u32,
+    sample_count: u64,
+    sections: [Section; SECTION_COUNT],
+    reserved_120: u32,
+    checksum: u32,
+}
+
+/// A panic-free little-endian field reader over the fixed-size header.
+struct Fields<'a>(&'a [u8]);
+
+impl Fields<'_> {
+    fn u32(&mut self) -> u32 {
+        match self.0.split_first_chunk::<4>() {
+            Some((head, rest)) => {
+                self.0 = rest;
+                u32::from_le_bytes(*head)
+            }
+            None => 0,
+        }
+    }
+
+    fn u64(&mut self) -> u64 {
+        match self.0.split_first_chunk::<8>() {
+            Some((head, rest)) => {
+                self.0 = rest;
+                u64::from_le_bytes(*head)
+            }
+            None => 0,
+        }
+    }
+}
+
+impl Header {
+    /// Decodes the header fields (after the magic) from the first [`HEADER_SIZE`] bytes.
+    fn parse(bytes: &[u8; HEADER_SIZE]) -> Header {
+        let mut fields = Fields(bytes.get(MAGIC.len()..).unwrap_or_default());
+        let version = fields.u32();
+        let header_size = fields.u32();
+        let file_size = fields.u64();
+        let flags = fields.u32();
+        let format_code = fields.u32();
+        let vertex_count = fields.u32();
+        let face_count = fields.u32();
+        let vertex_levels = fields.u32();
+        let reserved_44 = fields.u32();
+        let sample_count = fields.u64();
+        let mut sections = [Section::default(); SECTION_COUNT];
+        for section in &mut sections {
+            section.offset = fields.u64();
+            section.length = fields.u64();
+        }
+        let reserved_120 = fields.u32();
+        let checksum = fields.u32();
+        Header {
+            version,
+            header_size,
+            file_size,
+            flags,
+            format_code,
+            vertex_count,
+            face_count,
+            vertex_levels,
+            reserved_44,
+            sample_count,
+            sections,
+            reserved_120,
+            checksum,
+        }
+    }
+
+    /// Appends the encoded header (exactly [`HEADER_SIZE`] bytes) to `out`.
+    fn write(&self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&MAGIC);
+        out.extend_from_slice(&self.version.to_le_bytes());
+        out.extend_from_slice(&self.header_size.to_le_bytes());
+        out.extend_from_slice(&self.file_size.to_le_bytes());
+        out.extend_from_slice(&self.flags.to_le_bytes());
+        out.extend_from_slice(&self.format_code.to_le_bytes());
+        out.extend_from_slice(&self.vertex_count.to_le_bytes());
+        out.extend_from_slice(&self.face_count.to_le_bytes());
+        out.extend_from_slice(&self.vertex_levels.to_le_bytes());
+        out.extend_from_slice(&self.reserved_44.to_le_bytes());
+        out.extend_from_slice(&self.sample_count.to_le_bytes());
+        for section in &self.sections {
+            out.extend_from_slice(&section.offset.to_le_bytes());
+            out.extend_from_slice(&section.length.to_le_bytes());
+        }
+        out.extend_from_slice(&self.reserved_120.to_le_bytes());
+        out.extend_from_slice(&self.checksum.to_le_bytes());
+    }
+}
+
+/// The CRC-32 of every byte of `bytes` except the checksum field (header bytes 124..128).
+fn checksum(bytes: &[u8]) -> u32 {
+    let mut hasher = crc32fast::Hasher::new();
+    hasher.update(bytes.get(..CHECKSUM_OFFSET).unwrap_or(bytes));
+    hasher.update(bytes.get(CHECKSUM_OFFSET + 4..).unwrap_or_default());
+    hasher.finalize()
+}
+
+/// Whether `bytes` starts with the packed-file [`MAGIC`] (to choose a loader by content).
+pub fn looks_like_packed(bytes: &[u8]) -> bool {
+    bytes.starts_with(&MAGIC)
+}
+
+/// `value` rounded up to a multiple of [`SECTION_ALIGN`], or `None` on overflow.
+fn align_up(value: u64) -> Option<u64> {
+    value.checked_add(SECTION_ALIGN - 1).map(|v| v / SECTION_ALIGN * SECTION_ALIGN)
+}
+
+/// Checks the content of a mesh whose buffers have consistent sizes: the limits of the
+/// format and the bounds that make GPU reads derived from the face records safe.
+fn check_content(mesh: &PackedMesh, sample_count: u64) -> Result<(), PackedFileError> {
+    if sample_count > MAX_SAMPLES {
+        return Err(PackedFileError::TooManySamples(sample_count));
+    }
+    if mesh.vertex_levels > MAX_LOG2_RESOLUTION + 1 {
+        return Err(PackedFileError::TooManyVertexLevels(mesh.vertex_levels));
+    }
+    let vertex_count = mesh.positions.len() as u64;
+    let vertex_samples = vertex_count.checked_mul(u64::from(mesh.vertex_levels));
+    if vertex_samples.is_none_or(|needed| needed > sample_count) {
+        return Err(PackedFileError::VertexSamples {
+            vertices: vertex_count,
+            levels: mesh.vertex_levels,
+            needed: vertex_samples.unwrap_or(u64::MAX),
+            samples: sample_count,
+        });
+    }
+    for (vertex, position) in (0u64..).zip(&mesh.positions) {
+        if !position.iter().all(|c| c.is_finite()) {
+            return Err(PackedFileError::NonFinitePosition { vertex, position: *position });
+        }
+    }
+    for (triangle, corners) in (0u64..).zip(&mesh.indices) {
+        for (corner, &index) in corners.iter().enumerate() {
+            if u64::from(index) >= vertex_count {
+                return Err(PackedFileError::IndexOutOfRange { triangle, corner, index, vertex_count });
+            }
+        }
+        let [a, b, c] = *corners;
+        if a == b || b == c || c == a {
+            return Err(PackedFileError::RepeatedCorner { triangle, corners: *corners });
+        }
+    }
+    for (face, record) in (0u64..).zip(&mesh.face_records) {
+        check_record(face, record, mesh.vertex_levels, sample_count)?;
+    }
+    Ok(())
+}
+
+/// Checks one face record: resolutions within limits and chains inside the colour buffer.
+fn check_record(face: u64, record: &FaceRecord, vertex_levels: u32, sample_count: u64) -> Result<(), PackedFileError> {
+    const EDGE_NAMES: [&str; 3] = ["edge 0", "edge 1", "edge 2"];
+    let (interior_base, face_log2) = unpack_word(record.interior);
+    let Ok(face_r) = Resolution::from_log2(face_log2) else {
+        return Err(PackedFileError::FaceResolution { face, log2: face_log2 });
+    };
+    let needed = face_log2 + 1;
+    if vertex_levels < needed {
+        return Err(PackedFileError::VertexLevelsTooFew { face, log2: face_log2, needed, vertex_levels });
+    }
+    let chain_in_range = |chain: &'static str, base: u32, r: Resolution, len: u32| {
+        let end = u64::from(base) + u64::from(len);
+        if end > sample_count {
+            return Err(PackedFileError::ChainOutOfRange {
+                face,
+                chain,
+                resolution: r.get(),
+                base,
+                end,
+                samples: sample_count,
+            });
+        }
+        Ok(())
+    };
+    if face_r.get() >= 4 {
+        chain_in_range("interior", interior_base, face_r, interior_chain_len(face_r))?;
+    }
+    for ((edge, &word), name) in record.edges.iter().enumerate().zip(EDGE_NAMES) {
+        let (base, log2) = unpack_word(word);
+        let edge_r = match Resolution::from_log2(log2) {
+            Ok(r) if log2 >= face_log2 => r,
+            _ => {
+                return Err(PackedFileError::EdgeResolution { face, edge, log2, face_log2 });
+            }
+        };
+        if edge_r.get() >= 2 {
+            chain_in_range(name, base, edge_r, edge_chain_len(edge_r))?;
+        }
+    }
+    Ok(())
+}
+
+/// Encodes `mesh` as a packed file.
+///
+/// Deterministic: the same mesh always gives the same bytes. Refuses meshes the reader
+/// would refuse (inconsistent buffer sizes, limits exceeded, non-finite positions,
+/// indices out of range, face records out of bounds), so every written file reads back.
+pub fn to_bytes(mesh: &PackedMesh) -> Result<Vec<u8>, PackedFileError> {
+    let vertex_count = u32::try_from(mesh.positions.len())
+        .map_err(|_| PackedFileError::TooMany { what: "vertices", count: mesh.positions.len() as u64 })?;
+    let face_count = u32::try_from(mesh.indices.len())
+        .map_err(|_| PackedFileError::TooMany { what: "faces", count: mesh.indices.len() as u64 })?;
+    if mesh.indices.len() != mesh.face_records.len() {
+        return Err(PackedFileError::FaceCountMismatch {
+            indices: mesh.indices.len() as u64,
+            records: mesh.face_records.len() as u64,
+        });
+    }
+    let bytes_per_sample = mesh.format.bytes_per_sample();
+    if !mesh.colors.len().is_multiple_of(bytes_per_sample) {
+        return Err(PackedFileError::PartialSample { len: mesh.colors.len() as u64, bytes_per_sample });
+    }
+    let sample_count = (mesh.colors.len() / bytes_per_sample) as u64;
+    check_content(mesh, sample_count)?;
+
+    // Section layout: each section at the next multiple of SECTION_ALIGN.
+    let lengths = [
+        u64::from(vertex_count) * POSITION_SIZE,
+        u64::from(face_count) * TRIANGLE_SIZE,
+        u64::from(face_count) * RECORD_SIZE,
+        mesh.colors.len() as u64,
+    ];
+    let mut sections = [Section::default(); SECTION_COUNT];
+    let mut cursor = HEADER_SIZE as u64;
+    for (section, length) in sections.iter_mut().zip(lengths) {
+        // Sizes here are bounded by the in-memory mesh, far below 2^64.
+        section.offset = align_up(cursor).unwrap_or(u64::MAX);
+        section.length = length;
+        cursor = section.offset.saturating_add(length);
+    }
+    let header = Header {
+        version: VERSION,
+        header_size: HEADER_SIZE as u32,
+        file_size: cursor,
+        flags: 0,
+        format_code: mesh.format.code(),
+        vertex_count,
+        face_count,
+        vertex_levels: mesh.vertex_levels,
+        reserved_44: 0,
+        sample_count,
+        sections,
+        reserved_120: 0,
+        checksum: 0,
+    };
+
+    let capacity = usize::try_from(cursor).unwrap_or(0);
+    let mut out = Vec::with_capacity(capacity);
+    header.write(&mut out);
+    let pad_to = |out: &mut Vec<u8>, offset: u64| {
+        out.resize(usize::try_from(offset).unwrap_or(out.len()), 0);
+    };
+    pad_to(&mut out, sections[0].offset);
+    for position in &mesh.positions {
+        for coordinate in position {
+            out.extend_from_slice(&coordinate.to_le_bytes());
+        }
+    }
+    pad_to(&mut out, sections[1].offset);
+    for triangle in &mesh.indices {
+        for index in triangle {
+            out.extend_from_slice(&index.to_le_bytes());
+        }
+    }
+    pad_to(&mut out, sections[2].offset);
+    for record in &mesh.face_records {
+        out.extend_from_slice(&record.interior.to_le_bytes());
+        for word in &record.edges {
+            out.extend_from_slice(&word.to_le_bytes());
+        }
+    }
+    pad_to(&mut out, sections[3].offset);
+    out.extend_from_slice(&mesh.colors);
+
+    let crc = checksum(&out);
+    if let Some(slot) = out.get_mut(CHECKSUM_OFFSET..CHECKSUM_OFFSET + 4) {
+        for (dst, src) in slot.iter_mut().zip(crc.to_le_bytes()) {
+            *dst = src;
+        }
+    }
+    Ok(out)
+}
+
+/// Checks the section table against the file length (before the checksum, so that a
+/// truncated file is reported as truncated).
+fn check_sections(header: &Header, len: u64) -> Result<(), PackedFileError> {
+    let mut previous = "header";
+    let mut previous_end = HEADER_SIZE as u64;
+    for (section, name) in header.sections.iter().zip(SECTION_NAMES) {
+        if !section.offset.is_multiple_of(SECTION_ALIGN) {
+            return Err(PackedFileError::SectionMisaligned { section: name, offset: section.offset });
+        }
+        if section.offset < previous_end {
+            return Err(PackedFileError::SectionOverlap {
+                section: name,
+                offset: section.offset,
+                previous,
+                previous_end,
+            });
+        }
+        let Some(end) = section.offset.checked_add(section.length) else {
+            return Err(PackedFileError::SectionOverflow {
+                section: name,
+                offset: section.offset,
+                length: section.length,
+            });
+        };
+        if end > len {
+            return Err(PackedFileError::Truncated { what: format!("header says {name} end"), end, len });
+        }
+        previous = name;
+        previous_end = end;
+    }
+    if header.file_size > len {
+        return Err(PackedFileError::Truncated {
+            what: "header says the file ends".to_owned(),
+            end: header.file_size,
+            len,
+        });
+    }
+    for (what, end) in [("file", header.file_size), ("last section", previous_end)] {
+        if end < len {
+            return Err(PackedFileError::TrailingBytes { what, end, extra: len - end });
+        }
+    }
+    Ok(())
+}
+
+/// Checks that a section's length is `count × element_size`.
+fn check_length(
+    section: Section,
+    index: usize,
+    count: u64,
+    element_size: u64,
+    unit: &'static str,
+) -> Result<(), PackedFileError> {
+    let expected = count.checked_mul(element_size);
+    if expected != Some(section.length) {
+        return Err(PackedFileError::SectionLength {
+            section: SECTION_NAMES.get(index).copied().unwrap_or("?"),
+            length: section.length,
+            count,
+            unit,
+            expected: Expected(expected),
+        });
+    }
+    Ok(())
+}
+
+/// The bytes of a section already checked to lie inside `bytes`.
+fn section_bytes(bytes: &[u8], section: Section) -> &[u8] {
+    let start = usize::try_from(section.offset).unwrap_or(usize::MAX);
+    let end = usize::try_from(section.offset.saturating_add(section.length)).unwrap_or(usize::MAX);
+    bytes.get(start..end).unwrap_or_default()
+}
+
+/// Splits `bytes` into groups of `N` little-endian `u32` words (a partial group at the
+/// end is ignored; callers pass whole sections).
+fn le_words<const N: usize>(bytes: &[u8]) -> Vec<[u32; N]> {
+    bytes
+        .chunks_exact(4 * N)
+        .map(|chunk| {
+            let mut words = [0u32; N];
+            for (word, le) in words.iter_mut().zip(chunk.chunks_exact(4)) {
+                *word = u32::from_le_bytes(le.first_chunk::<4>().copied().unwrap_or_default());
+            }
+            words
+        })
+        .collect()
+}
+
+/// Decodes a packed file, refusing anything truncated, corrupt or hostile.
+///
+/// Never panics, and allocates at most about the size of `bytes`. See the module
+/// documentation for the checks and their order.
+pub fn from_bytes(bytes: &[u8]) -> Result<PackedMesh, PackedFileError> {
+    let len = bytes.len() as u64;
+    if !looks_like_packed(bytes) {
+        let found = bytes.get(..MAGIC.len()).unwrap_or(bytes);
+        if MAGIC.starts_with(found) {
+            return Err(PackedFileError::Truncated {
+                what: "the header ends".to_owned(),
+                end: HEADER_SIZE as u64,
+                len,
+            });
+        }
+        return Err(PackedFileError::NotPacked { found: found.to_vec() });
+    }
+    let Some(header_bytes) = bytes.first_chunk::<HEADER_SIZE>() else {
+        return Err(PackedFileError::Truncated { what: "the header ends".to_owned(), end: HEADER_SIZE as u64, len });
+    };
+    let header = Header::parse(header_bytes);
+    if header.version != VERSION {
+        return Err(PackedFileError::UnsupportedVersion(header.version));
+    }
+    if header.header_size as usize != HEADER_SIZE {
+        return Err(PackedFileError::HeaderSize(header.header_size));
+    }
+    check_sections(&header, len)?;
+    let computed = checksum(bytes);
+    if computed != header.checksum {
+        return Err(PackedFileError::ChecksumMismatch { stored: header.checksum, computed });
+    }
+    if header.flags & !KNOWN_FLAGS != 0 {
+        return Err(PackedFileError::UnknownFlags(header.flags & !KNOWN_FLAGS));
+    }
+    for (offset, value) in [(44, header.reserved_44), (120, header.reserved_120)] {
+        if value != 0 {
+            return Err(PackedFileError::ReservedNotZero { offset, value });
+        }
+    }
+    let format =
+        ColorFormat::from_code(header.format_code).ok_or(PackedFileError::UnknownColorFormat(header.format_code))?;
+    if header.sample_count > MAX_SAMPLES {
+        return Err(PackedFileError::TooManySamples(header.sample_count));
+    }
+    if header.vertex_levels > MAX_LOG2_RESOLUTION + 1 {
+        return Err(PackedFileError::TooManyVertexLevels(header.vertex_levels));
+    }
+    let vertex_count = u64::from(header.vertex_count);
+    let face_count = u64::from(header.face_count);
+    let [positions, indices, records, colors] = header.sections;
+    check_length(positions, 0, vertex_count, POSITION_SIZE, "vertices")?;
+    check_length(indices, 1, face_count, TRIANGLE_SIZE, "faces")?;
+    check_length(records, 2, face_count, RECORD_SIZE, "faces")?;
+    check_length(colors, 3, header.sample_count, format.bytes_per_sample() as u64, "samples")?;
+
+    // Every section now lies inside `bytes` with the length its count implies, so the
+    // vectors below are no larger than the file.
+    let positions: Vec<[f32; 3]> =
+        le_words::<3>(section_bytes(bytes, positions)).into_iter().map(|words| words.map(f32::from_bits)).collect();
+    let indices = le_words::<3>(section_bytes(bytes, indices));
+    let face_records = le_words::<4>(section_bytes(bytes, records))
+        .into_iter()
+        .map(|[interior, e0, e1, e2]| FaceRecord { interior, edges: [e0, e1, e2] })
+        .collect();
+    let mesh = PackedMesh {
+        positions,
+        indices,
+        vertex_levels: header.vertex_levels,
+        face_records,
+        format,
+        colors: section_bytes(bytes, colors).to_vec(),
+    };
+    check_content(&mesh, header.sample_count)?;
+    Ok(mesh)
+}
+
+/// Writes `mesh` to `path` atomically: the bytes go to a temporary file in the same
+/// directory, which is flushed to disk and then renamed over `path`. Errors name the path.
+pub fn write_file(path: &Path, mesh: &PackedMesh) -> Result<(), PackedFileError> {
+    let bytes = to_bytes(mesh)
+        .map_err(|source| PackedFileError::File { path: path.to_path_buf(), source: Box::new(source) })?;
+    let Some(file_name) = path.file_name() else {
+        return Err(PackedFileError::Io {
+            path: path.to_path_buf(),
+            action: "write a file at a path without a file name",
+            source: std::io::ErrorKind::InvalidInput.into(),
+        });
+    };
+    let dir = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let mut temp_name = std::ffi::OsString::from(".");
+    temp_name.push(file_name);
+    temp_name.push(format!(".{}-{}.tmp", std::process::id(), temp_counter()));
+    let temp = dir.join(temp_name);
+
+    if let Err(error) = write_temp_and_rename(&temp, path, &bytes) {
+        // Best effort: the temporary file may not exist (any more).
+        let _ = std::fs::remove_file(&temp);
+        return Err(error);
+    }
+    // Make the rename itself durable where directories can be synced (best effort).
+    if let Ok(dir_handle) = std::fs::File::open(dir) {
+        let _ = dir_handle.sync_all();
+    }
+    Ok(())
+}
+
+/// Writes `bytes` to the new file `temp`, syncs it and renames it to `path`.
+fn write_temp_and_rename(temp: &Path, path: &Path, bytes: &[u8]) -> Result<(), PackedFileError> {
+    let io_error = |path: &Path, action: &'static str| {
+        let path = path.to_path_buf();
+        move |source: std::io::Error| PackedFileError::Io { path, action, source }
+    };
+    let mut file = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(temp)
+        .map_err(io_error(temp, "create the temporary file"))?;
+    file.write_all(bytes).map_err(io_error(temp, "write the temporary file"))?;
+    file.sync_all().map_err(io_error(temp, "flush the temporary file to disk"))?;
+    drop(file);
+    std::fs::rename(temp, path).map_err(io_error(path, "rename the temporary file onto"))
+}
+
+/// A process-wide counter making temporary names unique across threads.
+fn temp_counter() -> u64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    COUNTER.fetch_add(1, Ordering::Relaxed)
+}
+
+/// Reads and decodes the packed file at `path`. Errors name the path.
+pub fn read_file(path: &Path) -> Result<PackedMesh, PackedFileError> {
+    let bytes = std::fs::read(path).map_err(|source| PackedFileError::Io {
+        path: path.to_path_buf(),
+        action: "read the file",
+        source,
+    })?;
+    from_bytes(&bytes).map_err(|source| PackedFileError::File { path: path.to_path_buf(), source: Box::new(source) })
+}

@@ -1,0 +1,454 @@
+//! The editable store: what paint mode edits.
+//!
+//! Colours are held per element, keyed by element id: one colour per vertex, one sample
+//! vector per edge (its `R_e − 1` samples in canonical direction) and one per face (its
+//! interior samples). Each element owns its own allocation (`Vec<Vec<_>>` is a dense map
+//! from id to samples), so changing one face's resolution reallocates only that face and
+//! its edges and never shifts any global array. The linear GPU layout is produced from
+//! this by the packer when paint mode ends.
+//!
+//! Rules:
+//! - a face's resolution `R_f` is a power of two in `1..=MAX_RESOLUTION`;
+//! - an edge's resolution `R_e` is the maximum over its faces; a face with `R_f < R_e`
+//!   reads the edge with stride `R_e / R_f`, so every face sees the same colour at a
+//!   shared sample position;
+//! - raising `R_f` interpolates the current signal (old samples unchanged), lowering it
+//!   filters ([`crate::resample`]), and raising then lowering restores the samples exactly;
+//! - every write and every resolution change is recorded as dirty until [`ColorStore::take_dirty`].
+
+use thiserror::Error;
+
+use crate::color::Rgba;
+use crate::layout::{self, Resolution, SampleLocation};
+use crate::resample::{Lattice, reduce_polyline, refine_polyline};
+use crate::topology::Topology;
+
+/// Errors of store operations.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum StoreError {
+    /// A face id past the face count.
+    #[error("face {face} does not exist (the mesh has {face_count} faces)")]
+    NoSuchFace {
+        /// The id asked for.
+        face: u32,
+        /// Number of faces.
+        face_count: u32,
+    },
+    /// A per-face array of the wrong length.
+    #[error("expected {expected} face resolutions, got {got}")]
+    WrongLength {
+        /// Number of faces.
+        expected: usize,
+        /// Length given.
+        got: usize,
+    },
+}
+
+/// One stored sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum SampleRef {
+    /// The colour of a vertex.
+    Vertex(u32),
+    /// Sample `offset` (canonical direction) of an edge.
+    Edge {
+        /// Edge id.
+        edge: u32,
+        /// Offset in `0..R_e − 1`.
+        offset: u32,
+    },
+    /// Interior sample `offset` of a face.
+    Interior {
+        /// Face id.
+        face: u32,
+        /// Offset in `0..(R−1)(R−2)/2` (thesis eq. 3.2 order).
+        offset: u32,
+    },
+}
+
+/// A sample together with where it lies: barycentric coordinates in one face that
+/// contains it. Shared samples are reported once, in their *owner* face: the lowest
+/// face id among those containing them (the rule texture conversion uses across seams).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampleSite {
+    /// The sample.
+    pub sample: SampleRef,
+    /// The owner face.
+    pub face: u32,
+    /// Barycentric coordinates `(w0, w1, w2)` in the owner face.
+    pub barycentric: [f32; 3],
+}
+
+/// Elements changed since the last [`ColorStore::take_dirty`], sorted and unique.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct DirtyElements {
+    /// Vertices whose colour changed.
+    pub vertices: Vec<u32>,
+    /// Edges whose samples changed (values or count).
+    pub edges: Vec<u32>,
+    /// Faces whose interior samples changed (values or count).
+    pub faces: Vec<u32>,
+    /// Faces whose resolution changed (their face records must be rewritten).
+    pub resized_faces: Vec<u32>,
+    /// Edges whose resolution changed (their storage was reallocated).
+    pub resized_edges: Vec<u32>,
+}
+
+impl DirtyElements {
+    /// Whether nothing changed.
+    pub fn is_empty(&self) -> bool {
+        self.vertices.is_empty() && self.edges.is_empty() && self.faces.is_empty()
+    }
+}
+
+/// Dirty flags with a list, so marking is O(1) and collecting is O(changed).
+#[derive(Debug, Clone, Default)]
+struct DirtySet {
+    flags: Vec<bool>,
+    list: Vec<u32>,
+}
+
+impl DirtySet {
+    fn new(len: usize) -> Self {
+        DirtySet { flags: vec![false; len], list: Vec::new() }
+    }
+
+    fn mark(&mut self, id: u32) {
+        if let Some(flag) = self.flags.get_mut(id as usize)
+            && !*flag
+        {
+            *flag = true;
+            self.list.push(id);
+        }
+    }
+
+    fn take(&mut self) -> Vec<u32> {
+        let mut list = std::mem::take(&mut self.list);
+        for &id in &list {
+            self.flags[id as usize] = false;
+        }
+        list.sort_unstable();
+        list
+    }
+}
+
+/// The editable mesh-colors store.
+#[derive(Debug, Clone)]
+pub struct ColorStore {
+    topology: Topology,
+    face_resolution: Vec<Resolution>,
+    edge_resolution: Vec<Resolution>,
+    vertex_colors: Vec<Rgba>,
+    edge_samples: Vec<Vec<Rgba>>,
+    interior_samples: Vec<Vec<Rgba>>,
+    /// For each vertex, the lowest face id that uses it (`INVALID` if none).
+    vertex_owner_face: Vec<u32>,
+    dirty_vertices: DirtySet,
+    dirty_edges: DirtySet,
+    dirty_faces: DirtySet,
+    resized_faces: DirtySet,
+    resized_edges: DirtySet,
+}
+
+impl ColorStore {
+    /// A store with every face at `resolution` and every sample `color`.
+    pub fn uniform(topology: Topology, resolution: Resolution, color: Rgba) -> Self {
+        let faces = topology.face_count() as usize;
+        Self::build(topology, vec![resolution; faces], color)
+    }
+
+    /// A store with per-face resolutions (one per face) and every sample `color`.
+    pub fn with_resolutions(
+        topology: Topology,
+        face_resolution: Vec<Resolution>,
+        color: Rgba,
+    ) -> Result<Self, StoreError> {
+        let faces = topology.face_count() as usize;
+        if face_resolution.len() != faces {
+            return Err(StoreError::WrongLength { expected: faces, got: face_resolution.len() });
+        }
+        Ok(Self::build(topology, face_resolution, color))
+    }
+
+    /// Builds the store; `face_resolution` has one entry per face.
+    fn build(topology: Topology, face_resolution: Vec<Resolution>, color: Rgba) -> Self {
+        let faces = topology.face_count() as usize;
+        let edge_resolution: Vec<Resolution> = (0..topology.edge_count())
+            .map(|edge| {
+                topology
+                    .faces_of_edge(edge)
+                    .iter()
+                    .map(|&(face, _)| face_resolution[face as usize])
+                    .max()
+                    .unwrap_or(Resolution::ONE)
+            })
+            .collect();
+        let mut vertex_owner_face = vec![crate::topology::INVALID; topology.vertex_count as usize];
+        for (face, corners) in topology.face_vertices.iter().enumerate().rev() {
+            for &v in corners {
+                vertex_owner_face[v as usize] = face as u32;
+            }
+        }
+        ColorStore {
+            vertex_colors: vec![color; topology.vertex_count as usize],
+            edge_samples: edge_resolution.iter().map(|&r| vec![color; layout::edge_sample_count(r) as usize]).collect(),
+            interior_samples: face_resolution
+                .iter()
+                .map(|&r| vec![color; layout::interior_sample_count(r) as usize])
+                .collect(),
+            dirty_vertices: DirtySet::new(topology.vertex_count as usize),
+            dirty_edges: DirtySet::new(edge_resolution.len()),
+            dirty_faces: DirtySet::new(faces),
+            resized_faces: DirtySet::new(faces),
+            resized_edges: DirtySet::new(edge_resolution.len()),
+            vertex_owner_face,
+            face_resolution,
+            edge_resolution,
+            topology,
+        }
+    }
+
+    /// The mesh connectivity.
+    pub fn topology(&self) -> &Topology {
+        &self.topology
+    }
+
+    /// Resolution of `face`.
+    pub fn face_resolution(&self, face: u32) -> Option<Resolution> {
+        self.face_resolution.get(face as usize).copied()
+    }
+
+    /// Resolutions of all faces.
+    pub fn face_resolutions(&self) -> &[Resolution] {
+        &self.face_resolution
+    }
+
+    /// Resolution of `edge` (the maximum over its faces).
+    pub fn edge_resolution(&self, edge: u32) -> Option<Resolution> {
+        self.edge_resolution.get(edge as usize).copied()
+    }
+
+    /// Colour of vertex `v`.
+    pub fn vertex_color(&self, v: u32) -> Option<Rgba> {
+        self.vertex_colors.get(v as usize).copied()
+    }
+
+    /// The samples of `edge`, canonical direction.
+    pub fn edge_samples(&self, edge: u32) -> &[Rgba] {
+        self.edge_samples.get(edge as usize).map_or(&[], Vec::as_slice)
+    }
+
+    /// The interior samples of `face`, thesis eq. 3.2 order.
+    pub fn interior_samples(&self, face: u32) -> &[Rgba] {
+        self.interior_samples.get(face as usize).map_or(&[], Vec::as_slice)
+    }
+
+    /// Number of level-0 samples stored.
+    pub fn sample_count(&self) -> u64 {
+        self.vertex_colors.len() as u64
+            + self.edge_samples.iter().map(|s| s.len() as u64).sum::<u64>()
+            + self.interior_samples.iter().map(|s| s.len() as u64).sum::<u64>()
+    }
+
+    /// Reads one sample.
+    pub fn get(&self, sample: SampleRef) -> Option<Rgba> {
+        match sample {
+            SampleRef::Vertex(v) => self.vertex_colors.get(v as usize).copied(),
+            SampleRef::Edge { edge, offset } => self.edge_samples.get(edge as usize)?.get(offset as usize).copied(),
+            SampleRef::Interior { face, offset } => {
+                self.interior_samples.get(face as usize)?.get(offset as usize).copied()
+            }
+        }
+    }
+
+    /// Writes one sample and marks its element dirty. Returns `false` (and writes
+    /// nothing) when the sample does not exist.
+    pub fn set(&mut self, sample: SampleRef, color: Rgba) -> bool {
+        let slot = match sample {
+            SampleRef::Vertex(v) => self.vertex_colors.get_mut(v as usize),
+            SampleRef::Edge { edge, offset } => {
+                self.edge_samples.get_mut(edge as usize).and_then(|s| s.get_mut(offset as usize))
+            }
+            SampleRef::Interior { face, offset } => {
+                self.interior_samples.get_mut(face as usize).and_then(|s| s.get_mut(offset as usize))
+            }
+        };
+        let Some(slot) = slot else {
+            return false;
+        };
+        *slot = color;
+        match sample {
+            SampleRef::Vertex(v) => self.dirty_vertices.mark(v),
+            SampleRef::Edge { edge, .. } => self.dirty_edges.mark(edge),
+            SampleRef::Interior { face, .. } => self.dirty_faces.mark(face),
+        }
+        true
+    }
+
+    /// The stored sample at face-local lattice point `(i, j)` of `face` at the face's
+    /// resolution (edges read with stride when the edge is finer than the face).
+    pub fn face_sample_ref(&self, face: u32, i: u32, j: u32) -> Option<SampleRef> {
+        let r = self.face_resolution(face)?;
+        let corners = self.topology.face_vertices.get(face as usize)?;
+        Some(match layout::classify_sample(r, i, j, [false; 3])? {
+            SampleLocation::Vertex { corner } => SampleRef::Vertex(corners[usize::from(corner)]),
+            SampleLocation::Edge { face_edge, offset } => {
+                let k = usize::from(face_edge);
+                let edge = self.topology.face_edges[face as usize][k];
+                let r_edge = self.edge_resolution(edge)?;
+                let position = (offset + 1) << (r_edge.log2() - r.log2());
+                SampleRef::Edge {
+                    edge,
+                    offset: layout::edge_storage_offset(r_edge, position, self.topology.is_reversed(face, k)),
+                }
+            }
+            SampleLocation::Interior { offset } => SampleRef::Interior { face, offset },
+        })
+    }
+
+    /// The colour at face-local lattice point `(i, j)` of `face`.
+    pub fn face_sample(&self, face: u32, i: u32, j: u32) -> Option<Rgba> {
+        self.get(self.face_sample_ref(face, i, j)?)
+    }
+
+    /// The face's whole lattice at its resolution (vertices, edges, interior).
+    pub fn face_lattice(&self, face: u32) -> Option<Lattice> {
+        let r = self.face_resolution(face)?.get();
+        let mut lattice = Lattice::new(r, [0.0; 4]);
+        for i in 0..=r {
+            for j in 0..=r - i {
+                lattice.set(i, j, self.face_sample(face, i, j)?);
+            }
+        }
+        Some(lattice)
+    }
+
+    /// Calls `visit` once for every stored sample with its site in its owner face.
+    pub fn for_each_site(&self, mut visit: impl FnMut(SampleSite)) {
+        let bary = |r: Resolution, (i, j): (u32, u32)| layout::sample_barycentric(r, i, j).map(|w| w as f32);
+        for (v, &face) in self.vertex_owner_face.iter().enumerate() {
+            let Some(corners) = self.topology.face_vertices.get(face as usize) else {
+                continue;
+            };
+            let corner = corners.iter().position(|&c| c == v as u32).unwrap_or(0);
+            let mut barycentric = [0.0; 3];
+            barycentric[corner] = 1.0;
+            visit(SampleSite { sample: SampleRef::Vertex(v as u32), face, barycentric });
+        }
+        for edge in 0..self.topology.edge_count() {
+            let Some(&(face, k)) = self.topology.faces_of_edge(edge).first() else {
+                continue;
+            };
+            let r_edge = self.edge_resolution[edge as usize];
+            let reversed = self.topology.is_reversed(face, usize::from(k));
+            for offset in 0..layout::edge_sample_count(r_edge) {
+                // Position along the face edge from its start corner, in the edge's lattice.
+                let position = if reversed { r_edge.get() - 1 - offset } else { offset + 1 };
+                visit(SampleSite {
+                    sample: SampleRef::Edge { edge, offset },
+                    face,
+                    barycentric: bary(r_edge, layout::edge_sample_coords(r_edge, k, position)),
+                });
+            }
+        }
+        for face in 0..self.topology.face_count() {
+            let r = self.face_resolution[face as usize];
+            for offset in 0..layout::interior_sample_count(r) {
+                let Some(ij) = layout::interior_sample_at(r, offset) else {
+                    continue;
+                };
+                visit(SampleSite { sample: SampleRef::Interior { face, offset }, face, barycentric: bary(r, ij) });
+            }
+        }
+    }
+
+    /// Sets every sample to `color_at(site)`, marking everything dirty.
+    pub fn fill_with(&mut self, mut color_at: impl FnMut(SampleSite) -> Rgba) {
+        let mut writes = Vec::new();
+        self.for_each_site(|site| writes.push((site.sample, color_at(site))));
+        for (sample, color) in writes {
+            self.set(sample, color);
+        }
+    }
+
+    /// Changes the resolution of `face`, resampling its interior and any edge whose
+    /// resolution (the maximum over its faces) changes as a result.
+    pub fn set_face_resolution(&mut self, face: u32, resolution: Resolution) -> Result<(), StoreError> {
+        let Some(&old) = self.face_resolution.get(face as usize) else {
+            return Err(StoreError::NoSuchFace { face, face_count: self.topology.face_count() });
+        };
+        if old == resolution {
+            return Ok(());
+        }
+        // The face's signal at its old resolution, resampled in 2× steps.
+        let Some(mut lattice) = self.face_lattice(face) else {
+            return Ok(());
+        };
+        while lattice.resolution() < resolution.get() {
+            lattice = lattice.refine();
+        }
+        while lattice.resolution() > resolution.get() {
+            lattice = lattice.reduce();
+        }
+        self.face_resolution[face as usize] = resolution;
+        self.resized_faces.mark(face);
+        // Edges follow the maximum of their faces.
+        for k in 0..3 {
+            let edge = self.topology.face_edges[face as usize][k];
+            let target = self
+                .topology
+                .faces_of_edge(edge)
+                .iter()
+                .map(|&(f, _)| self.face_resolution[f as usize])
+                .max()
+                .unwrap_or(Resolution::ONE);
+            self.resample_edge(edge, target);
+        }
+        let interior: Vec<Rgba> = (0..layout::interior_sample_count(resolution))
+            .filter_map(|offset| {
+                let (i, j) = layout::interior_sample_at(resolution, offset)?;
+                lattice.get(i, j)
+            })
+            .collect();
+        self.interior_samples[face as usize] = interior;
+        self.dirty_faces.mark(face);
+        Ok(())
+    }
+
+    /// Resamples `edge` to `target` as a polyline between its endpoint colours.
+    fn resample_edge(&mut self, edge: u32, target: Resolution) {
+        let current = self.edge_resolution[edge as usize];
+        if current == target {
+            return;
+        }
+        let [lower, higher] = self.topology.edge_vertices[edge as usize];
+        let mut polyline = Vec::with_capacity(self.edge_samples[edge as usize].len() + 2);
+        polyline.push(self.vertex_colors[lower as usize]);
+        polyline.extend_from_slice(&self.edge_samples[edge as usize]);
+        polyline.push(self.vertex_colors[higher as usize]);
+        let mut r = current.get();
+        while r < target.get() {
+            polyline = refine_polyline(&polyline);
+            r *= 2;
+        }
+        while r > target.get() {
+            polyline = reduce_polyline(&polyline);
+            r /= 2;
+        }
+        let inner = polyline.get(1..polyline.len().saturating_sub(1)).unwrap_or(&[]);
+        self.edge_samples[edge as usize] = inner.to_vec();
+        self.edge_resolution[edge as usize] = target;
+        self.resized_edges.mark(edge);
+        self.dirty_edges.mark(edge);
+    }
+
+    /// Takes the set of elements changed since the last call.
+    pub fn take_dirty(&mut self) -> DirtyElements {
+        DirtyElements {
+            vertices: self.dirty_vertices.take(),
+            edges: self.dirty_edges.take(),
+            faces: self.dirty_faces.take(),
+            resized_faces: self.resized_faces.take(),
+            resized_edges: self.resized_edges.take(),
+        }
+    }
+}
