@@ -13,7 +13,7 @@
 //!
 //! Every section starts at a multiple of [`SECTION_ALIGN`] (256) bytes, so each can be
 //! uploaded to the GPU with one write at an offset that satisfies wgpu's copy (4) and
-//! storage-buffer offset (≤ 256) alignments. Gaps are zero. One CRC-32 (IEEE, as
+//! storage-buffer offset (≤ 256) alignments. Gaps are zero (the reader checks). One CRC-32 (IEEE, as
 //! `crc32fast` computes it) covers every byte of the file except the 4-byte checksum
 //! field itself (header bytes 124..128).
 //!
@@ -29,7 +29,8 @@
 //!    file ending exactly at the end of the colour section (truncation is reported as
 //!    such, before the checksum);
 //! 3. the checksum;
-//! 4. flags, reserved fields, colour format, counts against limits and section lengths;
+//! 4. flags, reserved fields, zero padding, colour format, counts against limits and
+//!    section lengths;
 //! 5. the content: finite positions, indices in range, no repeated corners, and every
 //!    face record within the limits and its chains inside the colour buffer (the bounds
 //!    that make any GPU read derived from the records safe).
@@ -139,6 +140,14 @@ pub enum PackedFileError {
         offset: usize,
         /// Its value.
         value: u32,
+    },
+    /// A padding byte (between the header and a section, or between sections) is not zero.
+    #[error("padding byte at offset {offset} is {value:#04x}, must be 0")]
+    NonZeroPadding {
+        /// Offset of the first non-zero padding byte.
+        offset: u64,
+        /// Its value.
+        value: u8,
     },
     /// The colour format code is unknown.
     #[error("unknown colour format code {0} (known: 0 = rgba8, 1 = rgba16f, 2 = rgba32f)")]
@@ -500,12 +509,13 @@ fn check_record(face: u64, record: &FaceRecord, vertex_levels: u32, sample_count
     let Ok(face_r) = Resolution::from_log2(face_log2) else {
         return Err(PackedFileError::FaceResolution { face, log2: face_log2 });
     };
-    let needed = face_log2 + 1;
+    let needed = face_r.level_count();
     if vertex_levels < needed {
         return Err(PackedFileError::VertexLevelsTooFew { face, log2: face_log2, needed, vertex_levels });
     }
     let chain_in_range = |chain: &'static str, base: u32, r: Resolution, len: u32| {
-        let end = u64::from(base) + u64::from(len);
+        // Both terms are below 2^32: no overflow in u64.
+        let end = u64::from(base).saturating_add(u64::from(len));
         if end > sample_count {
             return Err(PackedFileError::ChainOutOfRange {
                 face,
@@ -574,6 +584,7 @@ pub fn to_bytes(mesh: &PackedMesh) -> Result<Vec<u8>, PackedFileError> {
         section.length = length;
         cursor = section.offset.saturating_add(length);
     }
+    let [positions_at, indices_at, records_at, colors_at] = sections.map(|section| section.offset);
     let header = Header {
         version: VERSION,
         header_size: HEADER_SIZE as u32,
@@ -596,26 +607,26 @@ pub fn to_bytes(mesh: &PackedMesh) -> Result<Vec<u8>, PackedFileError> {
     let pad_to = |out: &mut Vec<u8>, offset: u64| {
         out.resize(usize::try_from(offset).unwrap_or(out.len()), 0);
     };
-    pad_to(&mut out, sections[0].offset);
+    pad_to(&mut out, positions_at);
     for position in &mesh.positions {
         for coordinate in position {
             out.extend_from_slice(&coordinate.to_le_bytes());
         }
     }
-    pad_to(&mut out, sections[1].offset);
+    pad_to(&mut out, indices_at);
     for triangle in &mesh.indices {
         for index in triangle {
             out.extend_from_slice(&index.to_le_bytes());
         }
     }
-    pad_to(&mut out, sections[2].offset);
+    pad_to(&mut out, records_at);
     for record in &mesh.face_records {
         out.extend_from_slice(&record.interior.to_le_bytes());
         for word in &record.edges {
             out.extend_from_slice(&word.to_le_bytes());
         }
     }
-    pad_to(&mut out, sections[3].offset);
+    pad_to(&mut out, colors_at);
     out.extend_from_slice(&mesh.colors);
 
     let crc = checksum(&out);
@@ -666,8 +677,21 @@ fn check_sections(header: &Header, len: u64) -> Result<(), PackedFileError> {
     }
     for (what, end) in [("file", header.file_size), ("last section", previous_end)] {
         if end < len {
-            return Err(PackedFileError::TrailingBytes { what, end, extra: len - end });
+            return Err(PackedFileError::TrailingBytes { what, end, extra: len.saturating_sub(end) });
         }
+    }
+    Ok(())
+}
+
+/// Checks that every byte outside the header fields and the sections is zero.
+fn check_padding(bytes: &[u8], header: &Header) -> Result<(), PackedFileError> {
+    let mut gap_start = HEADER_SIZE as u64;
+    for section in &header.sections {
+        let gap = section_bytes(bytes, Section { offset: gap_start, length: section.offset.saturating_sub(gap_start) });
+        if let Some((at, &value)) = (gap_start..).zip(gap).find(|&(_, &byte)| byte != 0) {
+            return Err(PackedFileError::NonZeroPadding { offset: at, value });
+        }
+        gap_start = section.offset.saturating_add(section.length);
     }
     Ok(())
 }
@@ -755,6 +779,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<PackedMesh, PackedFileError> {
             return Err(PackedFileError::ReservedNotZero { offset, value });
         }
     }
+    check_padding(bytes, &header)?;
     let format =
         ColorFormat::from_code(header.format_code).ok_or(PackedFileError::UnknownColorFormat(header.format_code))?;
     if header.sample_count > MAX_SAMPLES {

@@ -55,7 +55,7 @@ pub fn refine_polyline(coarse: &[Rgba]) -> Vec<Rgba> {
 /// Reduces a polyline of `2R + 1` samples to `R + 1` (endpoints copied). An input of
 /// even length or shorter than 3 is returned unchanged.
 pub fn reduce_polyline(fine: &[Rgba]) -> Vec<Rgba> {
-    if fine.len() < 3 || fine.len() % 2 == 0 {
+    if fine.len() < 3 || fine.len().is_multiple_of(2) {
         return fine.to_vec();
     }
     let last = fine.len() - 1;

@@ -385,6 +385,10 @@ impl ColorStore {
         };
         while lattice.resolution() < resolution.get() {
             lattice = lattice.refine();
+            // Where an edge already holds finer samples (a finer neighbour), its true
+            // colours replace the interpolated boundary, so the next refinement and any
+            // later reduction see the same boundary (this keeps up-then-down exact).
+            self.copy_finer_edges_into(face, &mut lattice);
         }
         while lattice.resolution() > resolution.get() {
             lattice = lattice.reduce();
@@ -412,6 +416,31 @@ impl ColorStore {
         self.interior_samples[face as usize] = interior;
         self.dirty_faces.mark(face);
         Ok(())
+    }
+
+    /// Overwrites the boundary of `lattice` (a lattice of `face`) with the stored edge
+    /// samples of every edge at least as fine as the lattice.
+    fn copy_finer_edges_into(&self, face: u32, lattice: &mut Lattice) {
+        let r = lattice.resolution();
+        let Ok(r_lattice) = Resolution::new(u64::from(r)) else {
+            return;
+        };
+        for k in 0..3u8 {
+            let edge = self.topology.face_edges[face as usize][usize::from(k)];
+            let r_edge = self.edge_resolution[edge as usize];
+            if r_edge.get() < r {
+                continue;
+            }
+            let stride = r_edge.get() / r;
+            let reversed = self.topology.is_reversed(face, usize::from(k));
+            for position in 1..r {
+                let offset = layout::edge_storage_offset(r_edge, position * stride, reversed);
+                if let Some(&color) = self.edge_samples[edge as usize].get(offset as usize) {
+                    let (i, j) = layout::edge_sample_coords(r_lattice, k, position);
+                    lattice.set(i, j, color);
+                }
+            }
+        }
     }
 
     /// Resamples `edge` to `target` as a polyline between its endpoint colours.

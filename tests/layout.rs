@@ -2,6 +2,9 @@
 //! lattices, geometric sample positions, summed level sizes, and the thesis' formulas
 //! evaluated literally.
 
+// Colour channels are indexed 0..4 in parallel arrays; an index reads clearest.
+#![allow(clippy::needless_range_loop)]
+
 use std::collections::HashMap;
 
 use meshpaint::layout::*;
@@ -283,10 +286,12 @@ fn points_on_edges_and_sub_triangle_boundaries_stay_inside_the_lattice() {
                 // Weights below f32 rounding of R·b (a few R·ε) are noise, not a leak.
                 let noise = 8.0 * res * f32::EPSILON;
                 for s in samples.iter().filter(|s| s.weight > noise) {
-                    let on_edge = match bary {
-                        [_, _, z] if z == 0.0 => s.j == 0,
-                        [x, _, _] if x == 0.0 => s.i + s.j == r.get(),
-                        _ => s.i == 0,
+                    let on_edge = if bary[2] == 0.0 {
+                        s.j == 0
+                    } else if bary[0] == 0.0 {
+                        s.i + s.j == r.get()
+                    } else {
+                        s.i == 0
                     };
                     assert!(on_edge, "R = {res}, {bary:?} leaves the edge via ({}, {})", s.i, s.j);
                 }

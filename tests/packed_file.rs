@@ -179,6 +179,17 @@ fn round_trip_is_exact_and_deterministic_for_every_format() {
 }
 
 #[test]
+fn documented_example_layout() {
+    // docs/FORMAT.md: the tetrahedron with 85 RGBA8 samples.
+    let mesh = tetrahedron(ColorFormat::Rgba8Srgb);
+    assert_eq!(mesh.sample_count(), 85);
+    let bytes = to_bytes(&mesh).unwrap();
+    assert_eq!(bytes.len(), 1364);
+    let table: Vec<_> = (0..4).map(|k| section(&bytes, k)).collect();
+    assert_eq!(table, [(256, 48), (512, 48), (768, 64), (1024, 340)]);
+}
+
+#[test]
 fn empty_mesh_round_trips() {
     for format in ColorFormat::ALL {
         let mesh = PackedMesh { format, ..PackedMesh::default() };
@@ -283,6 +294,30 @@ fn every_byte_flip_is_refused() {
 }
 
 #[test]
+fn resealed_byte_flips_are_refused_or_within_bounds() {
+    // With the checksum recomputed, a flip reaches the content checks: the reader must
+    // refuse it or return a mesh that satisfies every bound (which the writer re-checks).
+    for format in ColorFormat::ALL {
+        let bytes = to_bytes(&tetrahedron(format)).unwrap();
+        let mut accepted = 0;
+        for mask in [0xFF, 0x01, 0x80, 0x10] {
+            for at in (0..bytes.len()).filter(|&at| !(CHECKSUM_AT..CHECKSUM_AT + 4).contains(&at)) {
+                let mut flipped = bytes.clone();
+                flipped[at] ^= mask;
+                reseal(&mut flipped);
+                if let Ok(mesh) = from_bytes(&flipped) {
+                    accepted += 1;
+                    let again = to_bytes(&mesh).unwrap_or_else(|e| panic!("byte {at} ^ {mask:#x}: {e}"));
+                    assert_eq!(from_bytes(&again).unwrap(), mesh);
+                }
+            }
+        }
+        // Colour bytes and some position bits are free data, so some flips are accepted.
+        assert!(accepted > 0);
+    }
+}
+
+#[test]
 fn appended_bytes_are_refused() {
     let mut bytes = to_bytes(&tetrahedron(ColorFormat::Rgba8Srgb)).unwrap();
     bytes.extend_from_slice(&[0; 4]);
@@ -365,6 +400,15 @@ fn malformed_headers_are_refused() {
         put_u64(b, SECTIONS_AT + 16 * RECORDS, indices as u64);
     });
     assert_contains(&message, &["face records section starts", "before the end of the indices"]);
+    let message = hostile(f, |b| b[200] = 1);
+    assert_contains(&message, &["padding byte at offset 200 is 0x01"]);
+    let message = hostile(f, |b| {
+        let (_, length) = section(b, INDICES);
+        let (offset, _) = section(b, RECORDS);
+        b[offset - 1] = 0xAB;
+        assert!(length < 255);
+    });
+    assert_contains(&message, &["padding byte at offset", "0xab"]);
     let message = hostile(f, |b| put_u64(b, SECTIONS_AT, 0));
     assert_contains(&message, &["before the end of the header"]);
 }
@@ -457,7 +501,12 @@ fn writer_refuses_meshes_the_reader_would_refuse() {
     refuse(&|m| m.positions[3][1] = f32::INFINITY, "vertex 3 is not finite");
     refuse(&|m| m.indices[0][2] = 4, "index 2 of triangle 0 is 4");
     refuse(&|m| m.indices[2] = [1, 1, 2], "triangle 2 repeats a corner");
-    refuse(&|m| m.face_records.pop().map(drop).unwrap_or(()), "4 triangles");
+    refuse(
+        &|m| {
+            m.face_records.pop();
+        },
+        "4 triangles",
+    );
     refuse(&|m| m.colors.push(0), "not a whole number of 4-byte samples");
     refuse(&|m| m.vertex_levels = 3, "needs vertex_levels >= 4");
     refuse(&|m| m.vertex_levels = 14, "vertex_levels is 14");

@@ -1,0 +1,354 @@
+//! The packer and the CPU reference sampler against independent truths: pack/unpack
+//! identity, store-vs-packed sampling, MIP values evaluated directly from thesis eq. 2.5
+//! and 2.6 on hand-built meshes with boundary and non-manifold edges, and buffer bounds.
+
+// Colour channels are indexed 0..4 in parallel arrays; an index reads clearest.
+#![allow(clippy::needless_range_loop)]
+
+use meshpaint::color::{ColorFormat, Rgba, decode_rgba8_srgb, encode_rgba8_srgb};
+use meshpaint::layout::{self, Resolution};
+use meshpaint::packed::PackedMesh;
+use meshpaint::packer::{PackError, pack, unpack};
+use meshpaint::sampler::{Filter, MeshColorSource, packed_sample_index, sample};
+use meshpaint::store::{ColorStore, SampleRef};
+use meshpaint::topology::Topology;
+
+fn r(value: u64) -> Resolution {
+    Resolution::new(value).unwrap()
+}
+
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn unit(&mut self) -> f32 {
+        (self.next() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// Octahedron positions and topology (closed, mixed edge orientations).
+fn octahedron() -> (Vec<[f32; 3]>, Topology) {
+    let positions =
+        vec![[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+    let triangles = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+    (positions, Topology::build(6, &triangles).unwrap())
+}
+
+/// Three fins on edge (0, 1) (non-manifold), one face sharing edge (1, 2) with fin 0
+/// (manifold), every other edge a boundary edge.
+fn fins() -> (Vec<[f32; 3]>, Topology) {
+    let positions =
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.5, -1.0, 0.0], [0.5, 0.0, 1.0], [1.5, 1.0, 0.0]];
+    let triangles = [[0, 1, 2], [1, 0, 3], [0, 1, 4], [2, 1, 5]];
+    (positions, Topology::build(6, &triangles).unwrap())
+}
+
+fn random_store(topology: Topology, resolutions: Vec<Resolution>, seed: u64) -> ColorStore {
+    let mut store = ColorStore::with_resolutions(topology, resolutions, [0.0; 4]).unwrap();
+    let mut rng = Rng(seed);
+    store.fill_with(|_| [rng.unit(), rng.unit(), rng.unit(), 0.5 + 0.5 * rng.unit()]);
+    store
+}
+
+fn mixed_octahedron_store(seed: u64) -> (Vec<[f32; 3]>, ColorStore) {
+    let (positions, topology) = octahedron();
+    let resolutions = [1, 2, 4, 8, 16, 4, 1, 32].map(r).to_vec();
+    (positions, random_store(topology, resolutions, seed))
+}
+
+#[test]
+fn rgba8_srgb_round_trips_every_byte() {
+    for value in 0..=255u8 {
+        let bytes = [value, value, value, value];
+        assert_eq!(encode_rgba8_srgb(decode_rgba8_srgb(bytes)), bytes);
+    }
+}
+
+#[test]
+fn pack_unpack_pack_is_the_identity_for_every_format() {
+    let (positions, store) = mixed_octahedron_store(5);
+    for format in ColorFormat::ALL {
+        let packed = pack(&store, &positions, format).unwrap();
+        assert_eq!(pack(&store, &positions, format).unwrap(), packed, "packing is deterministic");
+        let unpacked = unpack(&packed).unwrap();
+        let repacked = pack(&unpacked, &positions, format).unwrap();
+        assert_eq!(repacked, packed, "{format:?}");
+        assert_eq!(packed.face_record_bytes(), 16 * 8);
+        // Level 0 round trip: bit-exact for RGBA32F, within quantisation otherwise.
+        let mut worst = 0.0f32;
+        store.for_each_site(|site| {
+            let a = store.get(site.sample).unwrap();
+            let b = unpacked.get(site.sample).unwrap();
+            for c in 0..4 {
+                worst = worst.max((a[c] - b[c]).abs());
+            }
+        });
+        match format {
+            ColorFormat::Rgba32F => assert_eq!(worst, 0.0),
+            ColorFormat::Rgba16F => assert!(worst <= 1.0 / 2048.0, "{worst}"),
+            ColorFormat::Rgba8Srgb => assert!(worst <= 0.5 * 0.0132, "{worst}"), // half the largest sRGB step
+        }
+    }
+}
+
+#[test]
+fn sampler_on_packed_buffers_equals_the_sampler_on_the_store() {
+    let (positions, store) = mixed_octahedron_store(9);
+    let packed = pack(&store, &positions, ColorFormat::Rgba32F).unwrap();
+    let packed8 = pack(&store, &positions, ColorFormat::Rgba8Srgb).unwrap();
+    let mut rng = Rng(3);
+    for face in 0..8 {
+        for _ in 0..400 {
+            let (a, b) = (rng.unit(), rng.unit());
+            let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
+            let bary = [1.0 - a - b, a, b];
+            for filter in [Filter::Nearest, Filter::Linear] {
+                let truth = sample(&store, face, bary, filter, 0).unwrap();
+                assert_eq!(sample(&packed, face, bary, filter, 0).unwrap(), truth, "face {face} {filter:?}");
+                let quantised = sample(&packed8, face, bary, filter, 0).unwrap();
+                for c in 0..4 {
+                    assert!((quantised[c] - truth[c]).abs() <= 0.0066, "RGBA8 face {face}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn every_packed_lookup_stays_inside_the_colour_buffer() {
+    let (positions, store) = mixed_octahedron_store(2);
+    let packed = pack(&store, &positions, ColorFormat::Rgba8Srgb).unwrap();
+    for face in 0..8 {
+        let rf = packed.face_resolution(face).unwrap();
+        for level in 0..=rf.log2() + 2 {
+            let rl = rf.get() >> level.min(rf.log2());
+            for i in 0..=rl {
+                for j in 0..=rl - i {
+                    let index = packed_sample_index(&packed, face, level, i, j).unwrap();
+                    assert!(index < packed.sample_count(), "face {face} level {level} ({i}, {j})");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn faces_of_different_resolution_agree_on_shared_edges_at_every_level() {
+    let (positions, store) = mixed_octahedron_store(4);
+    let packed = pack(&store, &positions, ColorFormat::Rgba32F).unwrap();
+    let topology = store.topology();
+    for edge in 0..topology.edge_count() {
+        let faces = topology.faces_of_edge(edge);
+        let [lower, _] = topology.edge_vertices[edge as usize];
+        let coarsest = faces.iter().map(|&(f, _)| store.face_resolution(f).unwrap()).min().unwrap();
+        for level in 0..=coarsest.log2() {
+            let steps = coarsest.get() >> level;
+            for step in 0..=steps {
+                let colors: Vec<Rgba> = faces
+                    .iter()
+                    .map(|&(face, k)| {
+                        let rf = store.face_resolution(face).unwrap().at_level(level).unwrap();
+                        let scale = rf.get() / steps;
+                        let from_start = topology.face_vertices[face as usize][usize::from(k)] == lower;
+                        let along = if from_start { step } else { steps - step } * scale;
+                        let (i, j) = layout::edge_sample_coords(rf, k, along);
+                        packed.lattice_color(face, level, i, j).unwrap()
+                    })
+                    .collect();
+                assert!(colors.windows(2).all(|w| w[0] == w[1]), "edge {edge} level {level} step {step}");
+            }
+        }
+    }
+}
+
+fn close(a: Rgba, b: Rgba) -> bool {
+    (0..4).all(|c| (a[c] - b[c]).abs() <= 1e-6)
+}
+
+/// Direct evaluation of eq. 2.5 / 2.6 for level `level` of a uniform-resolution mesh,
+/// reading level `level − 1` through the packed sampler (level 0 through the store).
+#[test]
+fn mip_levels_match_thesis_equations_on_boundary_manifold_and_nonmanifold_edges() {
+    let (positions, topology) = fins();
+    let resolution = r(8);
+    let store = random_store(topology.clone(), vec![resolution; 4], 17);
+    let packed = pack(&store, &positions, ColorFormat::Rgba32F).unwrap();
+    let previous = |face: u32, level: u32, i: u32, j: u32| packed.lattice_color(face, level - 1, i, j).unwrap();
+    let mut checked = (0, 0, 0, 0, 0);
+    for level in 1..=resolution.log2() {
+        let rl = resolution.get() >> level;
+        for face in 0..topology.face_count() {
+            // Interior samples, eq. 2.6: ¼(C + ½ Σ six neighbours).
+            for i in 1..rl {
+                for j in 1..rl.saturating_sub(i) {
+                    let (ci, cj) = (2 * i, 2 * j);
+                    let n = [
+                        previous(face, level, ci, cj - 1),
+                        previous(face, level, ci, cj + 1),
+                        previous(face, level, ci - 1, cj),
+                        previous(face, level, ci - 1, cj + 1),
+                        previous(face, level, ci + 1, cj - 1),
+                        previous(face, level, ci + 1, cj),
+                    ];
+                    let c = previous(face, level, ci, cj);
+                    let expected: Rgba = std::array::from_fn(|ch| {
+                        0.25 * (c[ch] + 0.5 * (n[0][ch] + n[1][ch] + n[2][ch] + n[3][ch] + n[4][ch] + n[5][ch]))
+                    });
+                    assert!(close(packed.lattice_color(face, level, i, j).unwrap(), expected));
+                    checked.0 += 1;
+                }
+            }
+        }
+        // Edge samples: centre, two along the edge, two inside each incident face.
+        for edge in 0..topology.edge_count() {
+            let faces = topology.faces_of_edge(edge);
+            let (face0, k0) = faces[0];
+            for position in 1..rl {
+                // Walk from face0's point of view; other faces map the same physical point.
+                let [lower, _] = topology.edge_vertices[edge as usize];
+                let canonical = if topology.face_vertices[face0 as usize][usize::from(k0)] == lower {
+                    position
+                } else {
+                    rl - position
+                };
+                let mut neighbour_sum = [0.0f32; 4];
+                let mut count = 0;
+                let mut center = [0.0f32; 4];
+                for (n, &(face, k)) in faces.iter().enumerate() {
+                    let from_start = topology.face_vertices[face as usize][usize::from(k)] == lower;
+                    let along = 2 * if from_start { canonical } else { rl - canonical };
+                    let fine = Resolution::new(u64::from(2 * rl)).unwrap();
+                    let (pi, pj) = layout::edge_sample_coords(fine, k, along);
+                    if n == 0 {
+                        center = previous(face, level, pi, pj);
+                        let (ai, aj) = layout::edge_sample_coords(fine, k, along - 1);
+                        let (bi, bj) = layout::edge_sample_coords(fine, k, along + 1);
+                        for c in 0..4 {
+                            neighbour_sum[c] += previous(face, level, ai, aj)[c] + previous(face, level, bi, bj)[c];
+                        }
+                        count += 2;
+                    }
+                    // The two lattice neighbours strictly inside this face.
+                    let inside: Vec<(u32, u32)> = [(1i32, 0i32), (-1, 0), (0, 1), (0, -1), (1, -1), (-1, 1)]
+                        .iter()
+                        .map(|&(di, dj)| (pi as i32 + di, pj as i32 + dj))
+                        .filter(|&(a, b)| a >= 1 && b >= 1 && ((a + b) as u32) < 2 * rl)
+                        .map(|(a, b)| (a as u32, b as u32))
+                        .collect();
+                    assert_eq!(inside.len(), 2);
+                    for (a, b) in inside {
+                        for c in 0..4 {
+                            neighbour_sum[c] += previous(face, level, a, b)[c];
+                        }
+                        count += 1;
+                    }
+                }
+                let expected: Rgba =
+                    std::array::from_fn(|c| (center[c] + 0.5 * neighbour_sum[c]) / (1.0 + 0.5 * count as f32));
+                let (fi, fj) = layout::edge_sample_coords(Resolution::new(u64::from(rl)).unwrap(), k0, position);
+                assert!(close(packed.lattice_color(face0, level, fi, fj).unwrap(), expected), "edge {edge}");
+                match faces.len() {
+                    1 => checked.1 += 1,
+                    2 => checked.2 += 1,
+                    _ => checked.3 += 1,
+                }
+            }
+        }
+        // Vertices, eq. 2.5: 2/(2+v) (C + ½ Σ adjacent edge samples), v = valence.
+        for v in 0..topology.vertex_count {
+            let (face, corner) = topology
+                .face_vertices
+                .iter()
+                .enumerate()
+                .find_map(|(f, c)| c.iter().position(|&x| x == v).map(|k| (f as u32, k)))
+                .unwrap();
+            let fine = 2 * rl;
+            let corner_ij = [(0, 0), (fine, 0), (0, fine)][corner];
+            let c = previous(face, level, corner_ij.0, corner_ij.1);
+            let mut sum = [0.0f32; 4];
+            let mut valence = 0;
+            for edge in 0..topology.edge_count() {
+                let [a, b] = topology.edge_vertices[edge as usize];
+                if a != v && b != v {
+                    continue;
+                }
+                let (f, k) = topology.faces_of_edge(edge)[0];
+                let from_start = topology.face_vertices[f as usize][usize::from(k)] == v;
+                let along = if from_start { 1 } else { fine - 1 };
+                let (i, j) = layout::edge_sample_coords(Resolution::new(u64::from(fine)).unwrap(), k, along);
+                for ch in 0..4 {
+                    sum[ch] += previous(f, level, i, j)[ch];
+                }
+                valence += 1;
+            }
+            assert_eq!(valence, topology.vertex_valence[v as usize]);
+            let expected: Rgba = std::array::from_fn(|ch| 2.0 / (2.0 + valence as f32) * (c[ch] + 0.5 * sum[ch]));
+            let rl_res = Resolution::new(u64::from(rl)).unwrap();
+            let (ci, cj) = [(0, 0), (rl_res.get(), 0), (0, rl_res.get())][corner];
+            assert!(close(packed.lattice_color(face, level, ci, cj).unwrap(), expected), "vertex {v} level {level}");
+            checked.4 += 1;
+        }
+    }
+    let (interior, boundary, manifold, nonmanifold, vertices) = checked;
+    assert!(interior > 0 && boundary > 0 && manifold > 0 && nonmanifold > 0 && vertices > 0, "{checked:?}");
+}
+
+#[test]
+fn resolution_one_everywhere_packs_vertex_colours_only() {
+    let (positions, topology) = octahedron();
+    let store = random_store(topology, vec![Resolution::ONE; 8], 1);
+    let packed = pack(&store, &positions, ColorFormat::Rgba32F).unwrap();
+    assert_eq!((packed.vertex_levels, packed.sample_count()), (1, 6));
+    for v in 0..6 {
+        assert_eq!(packed.color(u64::from(v)), store.get(SampleRef::Vertex(v)));
+    }
+}
+
+#[test]
+fn largest_resolution_next_to_resolution_one_packs_and_samples() {
+    let topology = Topology::build(4, &[[0, 1, 2], [1, 0, 3]]).unwrap();
+    let positions = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0]];
+    let mut store = random_store(topology, vec![Resolution::ONE; 2], 8);
+    store.set_face_resolution(0, Resolution::MAX).unwrap();
+    let packed = pack(&store, &positions, ColorFormat::Rgba8Srgb).unwrap();
+    let n = u64::from(Resolution::MAX.get());
+    let expected = 4 * 13
+        + 3 * u64::from(layout::edge_chain_len(Resolution::MAX))
+        + u64::from(layout::interior_chain_len(Resolution::MAX));
+    assert_eq!(packed.sample_count(), expected);
+    assert!(expected > (n - 1) * (n - 2) / 2);
+    for bary in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.2, 0.3, 0.5], [0.0, 0.5, 0.5]] {
+        for level in [0, 5, 12, 13] {
+            for face in 0..2 {
+                let color = sample(&packed, face, bary, Filter::Linear, level).unwrap();
+                assert!(color.iter().all(|c| c.is_finite()));
+            }
+        }
+    }
+    let round = unpack(&packed).unwrap();
+    assert_eq!(pack(&round, &positions, ColorFormat::Rgba8Srgb).unwrap(), packed);
+}
+
+#[test]
+fn unpack_refuses_non_canonical_buffers() {
+    let (positions, store) = mixed_octahedron_store(1);
+    let packed = pack(&store, &positions, ColorFormat::Rgba8Srgb).unwrap();
+    let mut moved = packed.clone();
+    moved.face_records[3].edges[1] ^= 1;
+    assert!(matches!(unpack(&moved), Err(PackError::NotCanonical(_))));
+    let mut short = packed.clone();
+    short.colors.truncate(short.colors.len() - 4);
+    assert!(matches!(unpack(&short), Err(PackError::NotCanonical(_))));
+    let mut bad = packed;
+    bad.indices[0] = [0, 0, 1];
+    assert!(unpack(&bad).is_err());
+    let empty = ColorStore::uniform(Topology::build(0, &[]).unwrap(), Resolution::ONE, [0.0; 4]);
+    let empty_packed = pack(&empty, &[], ColorFormat::Rgba8Srgb).unwrap();
+    assert_eq!(empty_packed.sample_count(), 0);
+    assert!(unpack(&empty_packed).is_ok(), "an empty mesh is a valid (empty) document");
+    assert!(unpack(&PackedMesh::default()).is_err(), "vertex_levels = 0 is not canonical");
+}
