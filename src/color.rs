@@ -104,9 +104,32 @@ impl ColorFormat {
 
     /// The colour after an encode/decode round trip (what the GPU will see).
     pub fn quantize(self, color: Rgba) -> Rgba {
-        let mut bytes = Vec::with_capacity(16);
-        self.encode_into(color, &mut bytes);
-        self.decode(&bytes)
+        match self {
+            ColorFormat::Rgba8Srgb => decode_rgba8_srgb(encode_rgba8_srgb(color)),
+            ColorFormat::Rgba16F => color.map(|c| f16::from_f32(c).to_f32()),
+            ColorFormat::Rgba32F => color,
+        }
+    }
+
+    /// Encodes `colors` into `out`, which must be exactly
+    /// `colors.len() * bytes_per_sample()` long (extra input or output is ignored).
+    pub fn encode_slice(self, colors: &[Rgba], out: &mut [u8]) {
+        let size = self.bytes_per_sample();
+        for (color, bytes) in colors.iter().zip(out.chunks_exact_mut(size)) {
+            match self {
+                ColorFormat::Rgba8Srgb => bytes.copy_from_slice(&encode_rgba8_srgb(*color)),
+                ColorFormat::Rgba16F => {
+                    for (c, pair) in bytes.chunks_exact_mut(2).enumerate() {
+                        pair.copy_from_slice(&f16::from_f32(color[c]).to_bits().to_le_bytes());
+                    }
+                }
+                ColorFormat::Rgba32F => {
+                    for (c, quad) in bytes.chunks_exact_mut(4).enumerate() {
+                        quad.copy_from_slice(&color[c].to_le_bytes());
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -127,20 +150,70 @@ fn unorm8(x: f32) -> u8 {
     (x * 255.0).round() as u8
 }
 
+/// Tables for exact, fast RGBA8 sRGB conversion, built once in `f64`.
+struct SrgbTables {
+    /// Linear value of each 8-bit code.
+    decode: [f32; 256],
+    /// `thresholds[b]`: the linear value halfway (in encoded space) between codes `b`
+    /// and `b + 1`; a linear value encodes to the number of thresholds it reaches.
+    thresholds: [f32; 255],
+    /// A first guess of the code for `linear = k / GUESS_STEPS`, corrected by
+    /// comparing with the thresholds (the answer is exact, the table only makes it fast).
+    guess: Vec<u8>,
+}
+
+const GUESS_STEPS: usize = 16384;
+
+fn srgb_tables() -> &'static SrgbTables {
+    static TABLES: std::sync::OnceLock<SrgbTables> = std::sync::OnceLock::new();
+    TABLES.get_or_init(|| {
+        let to_linear = |encoded: f64| {
+            if encoded <= 0.040_45 { encoded / 12.92 } else { ((encoded + 0.055) / 1.055).powf(2.4) }
+        };
+        let thresholds: [f32; 255] = std::array::from_fn(|b| to_linear((b as f64 + 0.5) / 255.0) as f32);
+        let guess = (0..=GUESS_STEPS)
+            .map(|k| {
+                let linear = k as f32 / GUESS_STEPS as f32;
+                thresholds.partition_point(|&t| t <= linear) as u8
+            })
+            .collect();
+        SrgbTables { decode: std::array::from_fn(|b| to_linear(b as f64 / 255.0) as f32), thresholds, guess }
+    })
+}
+
+/// Encodes one linear channel as an 8-bit sRGB code: the code whose exact encoded value
+/// is nearest (rounding in encoded space), found among precomputed thresholds.
+pub fn encode_srgb8(linear: f32) -> u8 {
+    let tables = srgb_tables();
+    if linear.is_nan() || linear <= 0.0 {
+        return 0;
+    }
+    if linear >= 1.0 {
+        return 255;
+    }
+    let mut code = usize::from(tables.guess[(linear * GUESS_STEPS as f32) as usize]);
+    while code < 255 && tables.thresholds[code] <= linear {
+        code += 1;
+    }
+    while code > 0 && tables.thresholds[code - 1] > linear {
+        code -= 1;
+    }
+    code as u8
+}
+
+/// Decodes an 8-bit sRGB code to a linear channel value.
+pub fn decode_srgb8(code: u8) -> f32 {
+    srgb_tables().decode[usize::from(code)]
+}
+
 /// Encodes a linear colour as RGBA8 with sRGB-encoded RGB and linear alpha.
 pub fn encode_rgba8_srgb(color: Rgba) -> [u8; 4] {
-    [
-        unorm8(linear_to_srgb(color[0])),
-        unorm8(linear_to_srgb(color[1])),
-        unorm8(linear_to_srgb(color[2])),
-        unorm8(color[3]),
-    ]
+    [encode_srgb8(color[0]), encode_srgb8(color[1]), encode_srgb8(color[2]), unorm8(color[3])]
 }
 
 /// Decodes RGBA8 with sRGB-encoded RGB and linear alpha to a linear colour.
 pub fn decode_rgba8_srgb(bytes: [u8; 4]) -> Rgba {
-    let channel = |b: u8| srgb_to_linear(f32::from(b) / 255.0);
-    [channel(bytes[0]), channel(bytes[1]), channel(bytes[2]), f32::from(bytes[3]) / 255.0]
+    [decode_srgb8(bytes[0]), decode_srgb8(bytes[1]), decode_srgb8(bytes[2]), f32::from(bytes[3]) / 255.0]
 }
 
 /// `a * (1 - t) + b * t` per channel.

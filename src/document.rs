@@ -105,8 +105,29 @@ pub fn bounds(positions: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
     (min, std::array::from_fn(|a| max[a] - min[a]))
 }
 
+/// Colours every sample of `store` with [`position_color`] at its position on `positions`.
+fn fill_with_position_colors(store: &mut ColorStore, positions: &[[f32; 3]]) {
+    let (min, size) = bounds(positions);
+    let corners = store.topology().face_vertices.clone();
+    store.fill_with(|site| {
+        let Some(face) = corners.get(site.face as usize) else {
+            return [1.0; 4];
+        };
+        let corner = |k: usize| positions.get(face[k] as usize).copied().unwrap_or([0.0; 3]);
+        let (p0, p1, p2) = (corner(0), corner(1), corner(2));
+        let p: [f32; 3] = std::array::from_fn(|a| {
+            site.barycentric[0] * p0[a] + site.barycentric[1] * p1[a] + site.barycentric[2] * p2[a]
+        });
+        position_color(p, min, size)
+    });
+}
+
 impl Document {
     /// Opens `path`: a packed file (by magic) or glTF at uniform `gltf_resolution`.
+    ///
+    /// A glTF mesh whose materials carry a base-colour texture or a non-white factor is
+    /// baked from them ([`crate::bake::bake_texture`]); otherwise it gets
+    /// [`position_color`].
     pub fn open(path: &Path, gltf_resolution: Resolution) -> Result<Self, DocumentError> {
         let mut head = [0u8; 8];
         let is_packed = {
@@ -125,21 +146,14 @@ impl Document {
         let topology = Topology::build(welded.positions_world.len() as u32, &welded.triangles)
             .map_err(|source| DocumentError::Topology { path: path.to_owned(), source })?;
         let mut store = ColorStore::uniform(topology, gltf_resolution, [1.0; 4]);
-        let (min, size) = bounds(&welded.positions_world);
-        let corners = store.topology().face_vertices.clone();
-        let positions = welded.positions_world;
-        store.fill_with(|site| {
-            let face = corners[site.face as usize];
-            let p: [f32; 3] = std::array::from_fn(|a| {
-                site.barycentric[0] * positions[face[0] as usize][a]
-                    + site.barycentric[1] * positions[face[1] as usize][a]
-                    + site.barycentric[2] * positions[face[2] as usize][a]
-            });
-            position_color(p, min, size)
-        });
+        if crate::bake::has_base_color(&welded, &scene) {
+            crate::bake::bake_texture(&mut store, &welded, &scene);
+        } else {
+            fill_with_position_colors(&mut store, &welded.positions_world);
+        }
         store.take_dirty();
         Ok(Document {
-            positions,
+            positions: welded.positions_world,
             store,
             degenerate_triangles_dropped: welded.degenerate_triangles_dropped,
             source: SourceKind::Gltf,

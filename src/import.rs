@@ -3,7 +3,8 @@
 //! What is read: every triangle primitive (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN) of
 //! every mesh instance reachable from the default scene (scene 0 when the file names no
 //! default), with the node transforms composed from the scene root, the base-colour part
-//! of the materials and their decoded base-colour textures.
+//! of the materials, their decoded base-colour textures and the vertex colours
+//! (COLOR_0: float VEC3/VEC4 or normalized unsigned byte/short, as linear RGBA).
 //!
 //! What is ignored, with one line in [`Scene::warnings`]: point and line primitives,
 //! skins, morph targets, animations, cameras and `KHR_lights_punctual` lights.
@@ -154,6 +155,8 @@ const BUDGET_BASE: u64 = 64 << 20;
 const BUDGET_PER_INPUT_BYTE: u64 = 32;
 /// Largest external image file read.
 const MAX_IMAGE_FILE: u64 = 256 << 20;
+/// glTF's neutral vertex colour, used where a primitive has no COLOR_0.
+const WHITE: [f32; 4] = [1.0; 4];
 /// Largest decoded texture side.
 const MAX_TEXTURE_SIDE: u32 = 16384;
 
@@ -667,6 +670,13 @@ fn decode_vec2(bytes: &[u8], format: ElementFormat) -> Option<[f32; 2]> {
     Some([component_f32(bytes, format, 0)?, component_f32(bytes, format, 1)?])
 }
 
+/// A COLOR_0 element as RGBA; a three-component element gets alpha 1.
+fn decode_color(bytes: &[u8], format: ElementFormat) -> Option<[f32; 4]> {
+    let [r, g, b] = decode_vec3(bytes, format)?;
+    let a = if format.components >= 4 { component_f32(bytes, format, 3)? } else { 1.0 };
+    Some([r, g, b, a])
+}
+
 fn decode_index(bytes: &[u8], format: ElementFormat) -> Option<u32> {
     index_value(bytes, format.component)
 }
@@ -1170,6 +1180,11 @@ impl Importer<'_, '_> {
                 None => vec![[0.0, 0.0]; vertex_count],
             };
 
+            let colors = match primitive.attributes.get(&Checked::Valid(Semantic::Colors(0))) {
+                Some(accessor) => Some(self.read_colors(accessor.value(), &label, vertex_count)?),
+                None => None,
+            };
+
             let material = match primitive.material {
                 Some(material) => Some(self.material_for(material.value())?),
                 None => None,
@@ -1178,10 +1193,65 @@ impl Importer<'_, '_> {
             mesh.positions_local.extend_from_slice(&positions);
             mesh.normals_local.extend_from_slice(&normals);
             mesh.uvs.extend_from_slice(&uvs);
+            match colors {
+                Some(colors) => {
+                    // Earlier primitives without COLOR_0 get glTF's neutral white.
+                    mesh.colors.resize(base, WHITE);
+                    mesh.colors.extend_from_slice(&colors);
+                }
+                None if !mesh.colors.is_empty() => mesh.colors.resize(base + vertex_count, WHITE),
+                None => {}
+            }
             mesh.triangle_materials.extend(std::iter::repeat_n(material, triangles.len()));
             mesh.triangles.extend(triangles.iter().map(|t| t.map(|i| i + base_u32)));
         }
         Ok(mesh)
+    }
+
+    /// Reads COLOR_0 (float VEC3/VEC4 or normalized unsigned byte/short) as linear RGBA:
+    /// RGB gets alpha 1, non-finite colours become white and values outside `[0, 1]` are
+    /// clamped (each with one warning per primitive).
+    fn read_colors(&mut self, index: usize, label: &str, vertex_count: usize) -> Result<Vec<[f32; 4]>, Fail> {
+        let purpose = format!("{label} COLOR_0");
+        let ty = match self.root.accessors.get(index).map(|accessor| accessor.type_) {
+            Some(Checked::Valid(Type::Vec3)) => Type::Vec3,
+            Some(Checked::Valid(Type::Vec4)) | None | Some(Checked::Invalid) => Type::Vec4,
+            Some(Checked::Valid(other)) => {
+                return invalid(format!(
+                    "{purpose} (accessor {index}): wrong accessor type {} (expected VEC3 or VEC4)",
+                    type_name(other)
+                ));
+            }
+        };
+        let mut colors = self.read_accessor(
+            index,
+            &Expect {
+                purpose,
+                ty,
+                components: &[(ComponentType::F32, false), (ComponentType::U8, true), (ComponentType::U16, true)],
+            },
+            decode_color,
+        )?;
+        if colors.len() != vertex_count {
+            return invalid(format!("{label}: COLOR_0 has {} elements but POSITION has {vertex_count}", colors.len()));
+        }
+        let (mut replaced, mut clamped) = (0usize, 0usize);
+        for color in &mut colors {
+            if !color.iter().all(|c| c.is_finite()) {
+                *color = WHITE;
+                replaced += 1;
+            } else if color.iter().any(|c| !(0.0..=1.0).contains(c)) {
+                *color = color.map(|c| c.clamp(0.0, 1.0));
+                clamped += 1;
+            }
+        }
+        if replaced > 0 {
+            self.scene.warnings.push(format!("{label}: {replaced} non-finite vertex colour(s) replaced by white"));
+        }
+        if clamped > 0 {
+            self.scene.warnings.push(format!("{label}: {clamped} vertex colour(s) outside [0, 1] clamped"));
+        }
+        Ok(colors)
     }
 
     fn material_for(&mut self, index: usize) -> Result<u32, Fail> {
@@ -1498,6 +1568,7 @@ mod tests {
                         assert!(mesh.triangles.iter().flatten().all(|&i| (i as usize) < n));
                         assert_eq!(mesh.normals_local.len(), n);
                         assert_eq!(mesh.uvs.len(), n);
+                        assert!(mesh.colors.is_empty() || mesh.colors.len() == n);
                     }
                 }
                 Ok(Err(_)) => refused += 1,

@@ -25,6 +25,12 @@
 //! | [`packer`] | store → packed (MIP chains, eq. 2.5/2.6) and packed → store |
 //! | [`sampler`] | the CPU reference sampler (nearest, linear, MIP level) on the store and on packed buffers |
 //! | [`document`] | open glTF or packed files into a store; pack for export |
+//! | [`export_gltf`] | store → .glb tessellated at each face's resolution, one vertex (COLOR_0) per sample |
+//! | [`camera`] | the orbit camera: matrices, framing, pixel rays (shared by render, picking, replay) |
+//! | [`picking`] | obvhs BVH over the mesh, watertight ray casts with our own barycentrics |
+//! | [`bake`] | base-colour texture → mesh colors (texture conversion) |
+//! | [`render`] | **GPU**: wgpu context, packed buffers on the GPU, sampling pipelines, readback |
+//! | [`bench`] | the measurements behind `meshpaint bench` (time and size, as JSON) |
 //! | [`packed_file`] | the packed file format (docs/FORMAT.md): writer and hostile-input-proof reader |
 //!
 //! ## Data flow
@@ -42,13 +48,19 @@
 //!
 //! The binary (`src/main.rs`) is the only place where everything meets.
 
+pub mod bake;
+pub mod bench;
+pub mod camera;
 pub mod color;
 pub mod document;
+pub mod export_gltf;
 pub mod import;
 pub mod layout;
 pub mod packed;
 pub mod packed_file;
 pub mod packer;
+pub mod picking;
+pub mod render;
 pub mod resample;
 pub mod sampler;
 pub mod scene;

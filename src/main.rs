@@ -34,6 +34,11 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Measure speed (and error where it applies); prints JSON.
+    Bench {
+        #[command(subcommand)]
+        what: BenchCommand,
+    },
     /// Pack a mesh's colours into linear buffers with MIP chains and write a packed file.
     Pack {
         /// A .glb / .gltf file, or a packed file (unpacked and packed again).
@@ -49,6 +54,41 @@ enum Command {
         #[arg(long, short = 'o')]
         output: PathBuf,
     },
+    /// Render a mesh offscreen on the GPU (lavapipe without one) and write a PNG.
+    Render(RenderArgs),
+    /// Export a mesh's colours: OUT ending in .glb gets the mesh tessellated at each face's
+    /// resolution with one COLOR_0 vertex per sample; any other name gets a packed file.
+    Export {
+        /// A .glb / .gltf file or a packed file.
+        file: PathBuf,
+        /// Uniform face resolution R for glTF input (a power of two, 1..=4096).
+        #[arg(long, short = 'r', default_value_t = 8)]
+        resolution: u64,
+        /// Colour format of a packed output: rgba8 (sRGB, default), rgba16f or rgba32f.
+        #[arg(long, value_parser = parse_format)]
+        format: Option<ColorFormat>,
+        /// Output file: .glb (tessellated, vertex colours) or a packed file (e.g. .mpk).
+        #[arg(long, short = 'o')]
+        output: PathBuf,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+enum BenchCommand {
+    /// Repack (store → face records + colour buffer with MIP chains) vs memcpy of the same bytes.
+    Pack {
+        /// A .glb / .gltf file or a packed file.
+        file: PathBuf,
+        /// Uniform face resolution R for glTF input.
+        #[arg(long, short = 'r', default_value_t = 16)]
+        resolution: u64,
+        /// Colour formats to measure (default: all three).
+        #[arg(long, value_parser = parse_format)]
+        format: Vec<ColorFormat>,
+        /// Repetitions per measurement (the best and the median are reported).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+    },
 }
 
 fn parse_format(name: &str) -> Result<ColorFormat, String> {
@@ -61,7 +101,7 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            eprintln!("error: {error:#}");
+            eprintln!("error: {}", error_message(&error));
             ExitCode::FAILURE
         }
     }
@@ -71,6 +111,9 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Info { file, resolution, json } => info(&file, resolution, json),
         Command::Pack { file, resolution, format, output } => pack(&file, resolution, format, &output),
+        Command::Bench { what } => bench(what),
+        Command::Render(args) => render(args),
+        Command::Export { file, resolution, format, output } => export(&file, resolution, format, &output),
     }
 }
 
@@ -83,7 +126,50 @@ fn open(path: &Path, resolution: u64) -> Result<Document> {
     Ok(document)
 }
 
+/// The error and its causes on one line, skipping causes its message already quotes
+/// (our error types name the file and include the cause's text).
+fn error_message(error: &anyhow::Error) -> String {
+    let mut message = String::new();
+    for cause in error.chain() {
+        let text = cause.to_string();
+        if !message.contains(&text) {
+            if !message.is_empty() {
+                message.push_str(": ");
+            }
+            message.push_str(&text);
+        }
+    }
+    message
+}
+
+/// Whether `path` starts with the packed-file magic.
+fn is_packed_file(path: &Path) -> Result<bool> {
+    use std::io::Read;
+    let mut head = [0u8; 8];
+    let mut file = std::fs::File::open(path).with_context(|| path.display().to_string())?;
+    let read = file.read(&mut head).with_context(|| path.display().to_string())?;
+    Ok(packed_file::looks_like_packed(&head[..read]))
+}
+
 fn info(path: &Path, resolution: u64, json: bool) -> Result<()> {
+    if !is_packed_file(path)? {
+        // Counts need the welded topology only, not the samples: stay cheap at any R.
+        let resolution = Resolution::new(resolution).context("--resolution")?;
+        let scene = meshpaint::import::import_gltf(path)?;
+        for warning in &scene.warnings {
+            log::warn!("{}: {warning}", path.display());
+        }
+        let mesh = meshpaint::weld::weld_scene(&scene);
+        let topology = meshpaint::topology::Topology::build(mesh.positions_world.len() as u32, &mesh.triangles)
+            .with_context(|| format!("{}: building topology", path.display()))?;
+        let stats = MeshStats::new(&topology, mesh.degenerate_triangles_dropped, resolution);
+        if json {
+            println!("{}", serde_json::Value::Object(stats.to_json()));
+        } else {
+            print!("{}:\n{}", path.display(), stats.to_text());
+        }
+        return Ok(());
+    }
     let document = open(path, resolution)?;
     let store = &document.store;
     let max_resolution = store.face_resolutions().iter().copied().max().unwrap_or(Resolution::ONE);
@@ -113,6 +199,30 @@ fn info(path: &Path, resolution: u64, json: bool) -> Result<()> {
     Ok(())
 }
 
+fn bench(what: BenchCommand) -> Result<()> {
+    match what {
+        BenchCommand::Pack { file, resolution, format, runs } => {
+            let document = open(&file, resolution)?;
+            let formats = if format.is_empty() { ColorFormat::ALL.to_vec() } else { format };
+            let mut results = Vec::new();
+            for format in formats {
+                let result = meshpaint::bench::bench_pack(&document, format, runs)?;
+                results.push(result.to_json());
+            }
+            let report = serde_json::json!({
+                "bench": "pack",
+                "file": file.display().to_string(),
+                "triangles": document.store.topology().face_count(),
+                "resolution": resolution,
+                "threads": 1,
+                "results": results,
+            });
+            println!("{report}");
+            Ok(())
+        }
+    }
+}
+
 fn pack(path: &Path, resolution: u64, format: Option<ColorFormat>, output: &Path) -> Result<()> {
     let document = open(path, resolution)?;
     let format = match (format, document.source) {
@@ -130,6 +240,153 @@ fn pack(path: &Path, resolution: u64, format: Option<ColorFormat>, output: &Path
         packed.sample_count(),
         packed.face_record_bytes(),
         packed.color_bytes(),
+        format.name()
+    );
+    Ok(())
+}
+
+/// Arguments of `meshpaint render`.
+#[derive(Debug, clap::Args)]
+struct RenderArgs {
+    /// A .glb / .gltf file or a packed file.
+    file: PathBuf,
+    /// Output PNG.
+    #[arg(long, short = 'o')]
+    output: PathBuf,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 1024)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 768)]
+    height: u32,
+    /// Filter: nearest, linear, mip (linear at --level) or trilinear (automatic level).
+    #[arg(long, value_enum, default_value_t = RenderFilter::Trilinear)]
+    filter: RenderFilter,
+    /// MIP level for --filter mip (also selects a level for nearest or linear).
+    #[arg(long)]
+    level: Option<u32>,
+    /// Uniform face resolution R for glTF input (a power of two, 1..=4096).
+    #[arg(long, short = 'r', default_value_t = 8)]
+    resolution: u64,
+    /// Shading: unlit (the exact colour) or lit (Lambert + ambient).
+    #[arg(long, value_enum, default_value_t = RenderShading::Lit)]
+    shading: RenderShading,
+    /// Camera yaw around +Y in degrees (0 looks along −Z).
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    yaw: f64,
+    /// Camera pitch above the horizon in degrees.
+    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
+    pitch: f64,
+    /// Eye distance from the scene centre (default: frame the bounding sphere).
+    #[arg(long)]
+    distance: Option<f64>,
+    /// Overlay triangle edges.
+    #[arg(long)]
+    wireframe: bool,
+    /// Show per-face resolution as a heat map instead of the colours.
+    #[arg(long)]
+    heatmap: bool,
+    /// Draw the glTF UVs and base-colour texture (the baseline) instead of mesh colors.
+    #[arg(long)]
+    baseline_uv: bool,
+}
+
+/// `--filter` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum RenderFilter {
+    Nearest,
+    Linear,
+    Mip,
+    Trilinear,
+}
+
+/// `--shading` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum RenderShading {
+    Unlit,
+    Lit,
+}
+
+fn render(args: RenderArgs) -> Result<()> {
+    use meshpaint::render::{FilterMode, Overlays, RenderRequest, Shading};
+    let filter = match (args.filter, args.level) {
+        (RenderFilter::Nearest, None) => FilterMode::Nearest,
+        (RenderFilter::Nearest, Some(level)) => FilterMode::NearestMipLevel(level),
+        (RenderFilter::Linear, None) => FilterMode::Linear,
+        (RenderFilter::Linear | RenderFilter::Mip, Some(level)) => FilterMode::MipLevel(level),
+        (RenderFilter::Mip, None) => anyhow::bail!("--filter mip needs --level N"),
+        (RenderFilter::Trilinear, None) => FilterMode::Trilinear,
+        (RenderFilter::Trilinear, Some(_)) => anyhow::bail!("--level does not apply to --filter trilinear"),
+    };
+    if let Some(distance) = args.distance {
+        anyhow::ensure!(distance.is_finite() && distance > 0.0, "--distance must be a positive number");
+    }
+    let request = RenderRequest {
+        path: args.file.clone(),
+        resolution: Resolution::new(args.resolution).context("--resolution")?,
+        width: args.width,
+        height: args.height,
+        filter,
+        shading: match args.shading {
+            RenderShading::Unlit => Shading::Unlit,
+            RenderShading::Lit => Shading::Lit,
+        },
+        overlays: Overlays { wireframe: args.wireframe, heatmap: args.heatmap },
+        yaw_degrees: args.yaw,
+        pitch_degrees: args.pitch,
+        distance: args.distance,
+        baseline_uv: args.baseline_uv,
+    };
+    let started = std::time::Instant::now();
+    let rendered = meshpaint::render::render_file(&request)?;
+    rendered.image.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
+    eprintln!(
+        "{} → {}: {}×{}, {} triangles, {} samples, {} ({:.2} s)",
+        args.file.display(),
+        args.output.display(),
+        args.width,
+        args.height,
+        rendered.triangles,
+        rendered.samples,
+        rendered.adapter,
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// `meshpaint export`: a tessellated vertex-colour .glb, or a packed file.
+fn export(path: &Path, resolution: u64, format: Option<ColorFormat>, output: &Path) -> Result<()> {
+    let extension = output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if extension.as_deref() == Some("gltf") {
+        anyhow::bail!("{}: glTF output is written as binary glTF only; name the output .glb", output.display());
+    }
+    if extension.as_deref() == Some("glb") && format.is_some() {
+        anyhow::bail!("--format applies to packed output only (.glb colours are always float, linear)");
+    }
+    let document = open(path, resolution)?;
+    if extension.as_deref() == Some("glb") {
+        let summary = meshpaint::export_gltf::write_tessellated_glb(output, &document.positions, &document.store)
+            .with_context(|| format!("exporting {}", path.display()))?;
+        eprintln!(
+            "{} → {}: {} faces, {} vertices (one per sample), {} triangles, {} B",
+            path.display(),
+            output.display(),
+            document.store.topology().face_count(),
+            summary.vertices,
+            summary.triangles,
+            summary.bytes
+        );
+        return Ok(());
+    }
+    let format = format.unwrap_or_default();
+    let packed = document.pack(format).with_context(|| format!("packing {}", path.display()))?;
+    packed_file::write_file(output, &packed)?;
+    eprintln!(
+        "{} → {}: {} faces, {} samples ({})",
+        path.display(),
+        output.display(),
+        packed.face_records.len(),
+        packed.sample_count(),
         format.name()
     );
     Ok(())

@@ -29,7 +29,6 @@ use thiserror::Error;
 use crate::color::{ColorFormat, Rgba};
 use crate::layout::{self, Resolution};
 use crate::packed::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
-use crate::resample::LATTICE_DIRECTIONS;
 use crate::store::{ColorStore, SampleRef};
 use crate::topology::{Topology, TopologyError};
 
@@ -110,41 +109,6 @@ impl PackLayout {
     }
 }
 
-/// Colour buffer in linear `f32` with the addressing of a [`PackLayout`].
-struct ChainBuffer<'a> {
-    store: &'a ColorStore,
-    layout: &'a PackLayout,
-    colors: Vec<Rgba>,
-}
-
-impl ChainBuffer<'_> {
-    fn vertex_index(&self, v: u32, level: u32) -> usize {
-        (v * self.layout.vertex_levels + level.min(self.layout.vertex_levels - 1)) as usize
-    }
-
-    /// Edge sample at `position` (0..=R_e>>level, endpoints are the vertices) of `edge`.
-    fn edge_at(&self, edge: u32, level: u32, position: u32) -> Rgba {
-        let r_edge = self.store.edge_resolution(edge).unwrap_or(Resolution::ONE);
-        let [lower, higher] = self.store.topology().edge_vertices[edge as usize];
-        let r_level = r_edge.get() >> level;
-        if position == 0 {
-            return self.colors[self.vertex_index(lower, level)];
-        }
-        if position >= r_level {
-            return self.colors[self.vertex_index(higher, level)];
-        }
-        let offset = layout::edge_level_offset(r_edge, level).unwrap_or(0) + position - 1;
-        self.colors[(self.layout.edge_base[edge as usize] + offset) as usize]
-    }
-
-    fn interior_index(&self, face: u32, level: u32, i: u32, j: u32) -> usize {
-        let r = self.store.face_resolution(face).unwrap_or(Resolution::ONE);
-        let r_level = Resolution::from_log2(r.log2() - level).unwrap_or(Resolution::ONE);
-        let offset = layout::interior_level_offset(r, level).unwrap_or(0) + layout::interior_offset(r_level, i, j);
-        (self.layout.interior_base[face as usize] + offset) as usize
-    }
-}
-
 /// `(C + ½ Σ N) / (1 + n/2)`: the thesis' MIP filter with the weights taken.
 fn mip_filter(center: Rgba, neighbours: &[Rgba]) -> Rgba {
     let mut sum = [0.0f32; 4];
@@ -178,110 +142,276 @@ fn vertex_edges(topology: &Topology) -> (Vec<u32>, Vec<u32>) {
     (offsets, edges)
 }
 
+/// Start of interior row `i` (`i >= 1`) of a face at resolution `r` (thesis eq. 3.2).
+fn interior_row_start(r: usize, i: usize) -> usize {
+    (i - 1) * (2 * r - 2 - i) / 2
+}
+
+/// Computes one face's whole interior chain in place: `chain` starts with level 0.
+fn reduce_interior_chain(chain: &mut [Rgba], r: Resolution) {
+    for level in 1..=r.log2() {
+        let r_src = (r.get() >> (level - 1)) as usize;
+        let r_dst = r_src / 2;
+        if r_dst < 3 {
+            break; // no interior samples at this level or below
+        }
+        let src_start = layout::interior_level_offset(r, level - 1).unwrap_or(0) as usize;
+        let dst_start = layout::interior_level_offset(r, level).unwrap_or(0) as usize;
+        let (head, tail) = chain.split_at_mut(dst_start);
+        let src = &head[src_start..];
+        let mut k = 0;
+        for i in 1..r_dst - 1 {
+            let a = 2 * i;
+            let (row_c, row_m, row_p) =
+                (interior_row_start(r_src, a), interior_row_start(r_src, a - 1), interior_row_start(r_src, a + 1));
+            for j in 1..r_dst - i {
+                let b = 2 * j;
+                // Lattice directions (1,0), (−1,0), (0,1), (0,−1), (1,−1), (−1,1).
+                let n = [
+                    src[row_p + b - 1],
+                    src[row_m + b - 1],
+                    src[row_c + b],
+                    src[row_c + b - 2],
+                    src[row_p + b - 2],
+                    src[row_m + b],
+                ];
+                tail[k] = mip_filter(src[row_c + b - 1], &n);
+                k += 1;
+            }
+        }
+    }
+}
+
+/// Runs `work` over `items` split into at most `threads` contiguous chunks.
+fn in_parallel<T: Send>(items: &mut [T], threads: usize, work: impl Fn(&mut [T]) + Sync) {
+    let chunk = items.len().div_ceil(threads.max(1)).max(1);
+    std::thread::scope(|scope| {
+        for part in items.chunks_mut(chunk) {
+            let work = &work;
+            scope.spawn(move || work(part));
+        }
+    });
+}
+
+/// Worker threads used by the packer (the machine's parallelism, at most 8).
+pub fn pack_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get()).min(8)
+}
+
 /// Computes every element's full MIP chain in linear `f32`.
 fn build_chains(store: &ColorStore, layout: &PackLayout, format: ColorFormat) -> Vec<Rgba> {
     let topology = store.topology();
-    let mut buffer = ChainBuffer { store, layout, colors: vec![[0.0; 4]; layout.sample_count as usize] };
-    // Level 0, quantised to the output format.
-    for v in 0..topology.vertex_count {
-        let color = format.quantize(store.vertex_color(v).unwrap_or([0.0; 4]));
-        let index = buffer.vertex_index(v, 0);
-        buffer.colors[index] = color;
+    let threads = pack_threads();
+    let mut colors = vec![[0.0f32; 4]; layout.sample_count as usize];
+    // Level 0, quantised to the output format (so the chain filters what is stored).
+    let levels = layout.vertex_levels as usize;
+    let vertex_section = topology.vertex_count as usize * levels;
+    for v in 0..topology.vertex_count as usize {
+        colors[v * levels] = format.quantize(store.vertex_color(v as u32).unwrap_or([0.0; 4]));
     }
     for edge in 0..topology.edge_count() {
         let base = layout.edge_base[edge as usize] as usize;
-        for (offset, &color) in store.edge_samples(edge).iter().enumerate() {
-            buffer.colors[base + offset] = format.quantize(color);
+        let samples = store.edge_samples(edge);
+        for (slot, &color) in colors[base..base + samples.len()].iter_mut().zip(samples) {
+            *slot = format.quantize(color);
         }
     }
-    for face in 0..topology.face_count() {
-        let base = layout.interior_base[face as usize] as usize;
-        for (offset, &color) in store.interior_samples(face).iter().enumerate() {
-            buffer.colors[base + offset] = format.quantize(color);
-        }
-    }
-    let (vertex_edge_offsets, vertex_edge_list) = vertex_edges(topology);
-    let mut neighbours: Vec<Rgba> = Vec::with_capacity(16);
-    for level in 1..layout.vertex_levels {
-        let previous = level - 1;
-        // Interiors.
+    // Interiors: each face's chain is contiguous and independent; faces are laid out in
+    // order, so the interior section splits into per-face slices processed in parallel.
+    {
+        let interior_start = layout.interior_base.iter().copied().find(|&b| b != 0).unwrap_or(0) as usize;
+        let interior_start = interior_start.max(vertex_section);
+        let (_, interiors) = colors.split_at_mut(interior_start.min(layout.sample_count as usize));
+        let mut faces: Vec<(u32, &mut [Rgba])> = Vec::with_capacity(topology.face_count() as usize);
+        let mut rest = interiors;
         for face in 0..topology.face_count() {
             let r = store.face_resolution(face).unwrap_or(Resolution::ONE);
-            let Ok(r_level) = r.at_level(level) else {
-                continue;
-            };
-            for offset in 0..layout::interior_sample_count(r_level) {
-                let Some((i, j)) = layout::interior_sample_at(r_level, offset) else {
-                    continue;
-                };
-                let (ci, cj) = (2 * i, 2 * j);
-                let center = buffer.colors[buffer.interior_index(face, previous, ci, cj)];
-                neighbours.clear();
-                for (di, dj) in LATTICE_DIRECTIONS {
-                    let (ni, nj) = ((ci as i32 + di) as u32, (cj as i32 + dj) as u32);
-                    neighbours.push(buffer.colors[buffer.interior_index(face, previous, ni, nj)]);
-                }
-                let index = buffer.interior_index(face, level, i, j);
-                buffer.colors[index] = mip_filter(center, &neighbours);
-            }
+            let len = layout::interior_chain_len(r) as usize;
+            let (chain, tail) = std::mem::take(&mut rest).split_at_mut(len);
+            rest = tail;
+            faces.push((face, chain));
         }
-        // Edges.
-        for edge in 0..topology.edge_count() {
+        in_parallel(&mut faces, threads, |part| {
+            for (face, chain) in part.iter_mut() {
+                let r = store.face_resolution(*face).unwrap_or(Resolution::ONE);
+                let level0 = store.interior_samples(*face);
+                for (slot, &color) in chain.iter_mut().zip(level0) {
+                    *slot = format.quantize(color);
+                }
+                reduce_interior_chain(chain, r);
+            }
+        });
+    }
+    reduce_edges_and_vertices(store, layout, &mut colors, threads);
+    colors
+}
+
+/// Per-edge data the edge and vertex passes read in their inner loops.
+struct EdgeInfo {
+    log2: u32,
+    base: usize,
+    vertices: [u32; 2],
+    /// Incident faces at the edge's resolution: (interior chain base, face edge, reversed).
+    full_faces: Vec<(usize, u8, bool)>,
+}
+
+/// Edge MIP levels (eq. 2.6 on edges) and vertex MIP levels (eq. 2.5), level by level.
+/// The buffer splits into vertex / edge / interior sections: a pass writes one section
+/// in parallel chunks while reading the others.
+fn reduce_edges_and_vertices(store: &ColorStore, layout: &PackLayout, colors: &mut [Rgba], threads: usize) {
+    let topology = store.topology();
+    let levels = layout.vertex_levels as usize;
+    let vertex_section = topology.vertex_count as usize * levels;
+    let edges: Vec<EdgeInfo> = (0..topology.edge_count())
+        .map(|edge| {
             let r_edge = store.edge_resolution(edge).unwrap_or(Resolution::ONE);
-            let Ok(r_level) = r_edge.at_level(level) else {
-                continue;
-            };
-            let r_previous = r_level.get() * 2;
-            let base = layout.edge_base[edge as usize] + layout::edge_level_offset(r_edge, level).unwrap_or(0);
-            for k in 1..r_level.get() {
-                let position = 2 * k;
-                let center = buffer.edge_at(edge, previous, position);
-                neighbours.clear();
-                neighbours.push(buffer.edge_at(edge, previous, position - 1));
-                neighbours.push(buffer.edge_at(edge, previous, position + 1));
-                for &(face, face_edge) in topology.faces_of_edge(edge) {
-                    if store.face_resolution(face) != Some(r_edge) {
-                        continue;
-                    }
-                    let reversed = topology.is_reversed(face, usize::from(face_edge));
-                    let along = if reversed { r_previous - position } else { position };
-                    let r_face_previous = Resolution::from_log2(r_edge.log2() - previous).unwrap_or(Resolution::ONE);
-                    let (pi, pj) = layout::edge_sample_coords(r_face_previous, face_edge, along);
-                    for (di, dj) in LATTICE_DIRECTIONS {
-                        let (ni, nj) = (pi as i32 + di, pj as i32 + dj);
-                        if ni < 1 || nj < 1 || (ni + nj) as u32 >= r_previous {
-                            continue; // not strictly inside the face
-                        }
-                        let index = buffer.interior_index(face, previous, ni as u32, nj as u32);
-                        neighbours.push(buffer.colors[index]);
-                    }
-                }
-                buffer.colors[(base + k - 1) as usize] = mip_filter(center, &neighbours);
+            let full_faces = topology
+                .faces_of_edge(edge)
+                .iter()
+                .filter(|&&(face, _)| store.face_resolution(face) == Some(r_edge))
+                .map(|&(face, k)| {
+                    (layout.interior_base[face as usize] as usize, k, topology.is_reversed(face, usize::from(k)))
+                })
+                .collect();
+            EdgeInfo {
+                log2: r_edge.log2(),
+                base: layout.edge_base[edge as usize] as usize,
+                vertices: topology.edge_vertices[edge as usize],
+                full_faces,
             }
+        })
+        .collect();
+    let edge_section_end = edges
+        .iter()
+        .map(|e| e.base + layout::edge_chain_len(Resolution::from_log2(e.log2).unwrap_or(Resolution::ONE)) as usize)
+        .max()
+        .unwrap_or(vertex_section)
+        .max(vertex_section);
+    let (vertex_colors, rest) = colors.split_at_mut(vertex_section);
+    let (edge_colors, interior_colors) = rest.split_at_mut(edge_section_end - vertex_section);
+    let interior_colors: &[Rgba] = interior_colors;
+    let interior_start = edge_section_end;
+    let (vertex_edge_offsets, vertex_edge_list) = vertex_edges(topology);
+    for level in 1..levels {
+        let previous = level - 1;
+        // Edges: each edge's chain is its own slice.
+        {
+            let vertex_colors: &[Rgba] = vertex_colors;
+            let mut chains: Vec<(&EdgeInfo, &mut [Rgba])> = Vec::with_capacity(edges.len());
+            let mut rest: &mut [Rgba] = edge_colors;
+            let mut cursor = vertex_section;
+            for info in &edges {
+                let len = layout::edge_chain_len(Resolution::from_log2(info.log2).unwrap_or(Resolution::ONE)) as usize;
+                if len == 0 {
+                    continue;
+                }
+                let (_, tail) = std::mem::take(&mut rest).split_at_mut(info.base - cursor);
+                let (chain, tail) = tail.split_at_mut(len);
+                rest = tail;
+                cursor = info.base + len;
+                chains.push((info, chain));
+            }
+            in_parallel(&mut chains, threads, |part| {
+                let mut neighbours: Vec<Rgba> = Vec::with_capacity(16);
+                for (info, chain) in part.iter_mut() {
+                    reduce_edge_level(
+                        info,
+                        chain,
+                        level as u32,
+                        vertex_colors,
+                        levels,
+                        interior_colors,
+                        interior_start,
+                        &mut neighbours,
+                    );
+                }
+            });
         }
-        // Vertices.
-        for v in 0..topology.vertex_count {
-            let center = buffer.colors[buffer.vertex_index(v, previous)];
-            neighbours.clear();
-            let edges = &vertex_edge_list
-                [vertex_edge_offsets[v as usize] as usize..vertex_edge_offsets[v as usize + 1] as usize];
-            for &edge in edges {
-                let r_edge = store.edge_resolution(edge).unwrap_or(Resolution::ONE);
-                let Ok(r_previous) = r_edge.at_level(previous) else {
-                    continue;
-                };
-                if r_previous.get() < 2 {
-                    continue;
+        // Vertices: each vertex's levels are a slice of `levels` colours.
+        {
+            let edge_colors: &[Rgba] = edge_colors;
+            let mut slots: Vec<(u32, &mut [Rgba])> =
+                vertex_colors.chunks_mut(levels).enumerate().map(|(v, s)| (v as u32, s)).collect();
+            in_parallel(&mut slots, threads, |part| {
+                let mut neighbours: Vec<Rgba> = Vec::with_capacity(16);
+                for (v, slot) in part.iter_mut() {
+                    neighbours.clear();
+                    let range =
+                        vertex_edge_offsets[*v as usize] as usize..vertex_edge_offsets[*v as usize + 1] as usize;
+                    for &edge in &vertex_edge_list[range] {
+                        let info = &edges[edge as usize];
+                        if info.log2 < previous as u32 + 1 {
+                            continue; // the edge has no samples at the previous level
+                        }
+                        let r_previous = 1u32 << (info.log2 - previous as u32);
+                        let r_edge = Resolution::from_log2(info.log2).unwrap_or(Resolution::ONE);
+                        let level_start =
+                            info.base + layout::edge_level_offset(r_edge, previous as u32).unwrap_or(0) as usize;
+                        let position = if *v == info.vertices[0] { 1 } else { r_previous - 1 };
+                        neighbours.push(edge_colors[level_start - vertex_section + position as usize - 1]);
+                    }
+                    slot[level] = mip_filter(slot[previous], &neighbours);
                 }
-                let [lower, _] = topology.edge_vertices[edge as usize];
-                let position = if v == lower { 1 } else { r_previous.get() - 1 };
-                neighbours.push(buffer.edge_at(edge, previous, position));
-            }
-            let index = buffer.vertex_index(v, level);
-            buffer.colors[index] = mip_filter(center, &neighbours);
+            });
         }
     }
-    buffer.colors
+}
+
+/// Level `level` of one edge chain from level `level − 1`.
+#[allow(clippy::too_many_arguments)]
+fn reduce_edge_level(
+    info: &EdgeInfo,
+    chain: &mut [Rgba],
+    level: u32,
+    vertex_colors: &[Rgba],
+    levels: usize,
+    interior_colors: &[Rgba],
+    interior_start: usize,
+    neighbours: &mut Vec<Rgba>,
+) {
+    if info.log2 < level + 1 {
+        return; // resolution 1 at this level: no edge samples
+    }
+    let r_edge = Resolution::from_log2(info.log2).unwrap_or(Resolution::ONE);
+    let r_level = 1u32 << (info.log2 - level);
+    let r_previous = 2 * r_level;
+    let previous_start = layout::edge_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
+    let level_start = layout::edge_level_offset(r_edge, level).unwrap_or(0) as usize;
+    let [lower, higher] = info.vertices;
+    let lower_color = vertex_colors[lower as usize * levels + level as usize - 1];
+    let higher_color = vertex_colors[higher as usize * levels + level as usize - 1];
+    let face_level_offset = layout::interior_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
+    let rp = r_previous as usize;
+    for k in 1..r_level {
+        let position = 2 * k;
+        let at = |p: u32| -> Rgba {
+            if p == 0 {
+                lower_color
+            } else if p >= r_previous {
+                higher_color
+            } else {
+                chain[previous_start + p as usize - 1]
+            }
+        };
+        let center = at(position);
+        neighbours.clear();
+        neighbours.push(at(position - 1));
+        neighbours.push(at(position + 1));
+        for &(face_base, face_edge, reversed) in &info.full_faces {
+            let p = if reversed { r_previous - position } else { position } as usize;
+            // The two lattice neighbours strictly inside the face, in LATTICE_DIRECTIONS order.
+            let inside = match face_edge {
+                0 => [(p, 1), (p - 1, 1)],
+                1 => [(rp - p - 1, p), (rp - p, p - 1)],
+                _ => [(1, rp - p), (1, rp - p - 1)],
+            };
+            let start = face_base - interior_start + face_level_offset;
+            for (i, j) in inside {
+                neighbours.push(interior_colors[start + interior_row_start(rp, i) + j - 1]);
+            }
+        }
+        chain[level_start + k as usize - 1] = mip_filter(center, neighbours);
+    }
 }
 
 /// Packs the store with `positions` (one per vertex) into linear buffers.
@@ -292,10 +422,14 @@ pub fn pack(store: &ColorStore, positions: &[[f32; 3]], format: ColorFormat) -> 
     }
     let layout = PackLayout::of(store)?;
     let chains = build_chains(store, &layout, format);
-    let mut colors = Vec::with_capacity(chains.len() * format.bytes_per_sample());
-    for color in chains {
-        format.encode_into(color, &mut colors);
-    }
+    let size = format.bytes_per_sample();
+    let mut colors = vec![0u8; chains.len() * size];
+    let chunk = chains.len().div_ceil(pack_threads()).max(1);
+    std::thread::scope(|scope| {
+        for (source, out) in chains.chunks(chunk).zip(colors.chunks_mut(chunk * size)) {
+            scope.spawn(move || format.encode_slice(source, out));
+        }
+    });
     Ok(PackedMesh {
         positions: positions.to_vec(),
         indices: topology.face_vertices.clone(),

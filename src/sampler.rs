@@ -3,13 +3,19 @@
 //! `sample(source, face, barycentric, filter, level)` evaluates mesh colors on one face:
 //! nearest (the highest-weight sample, thesis 2.2.3) or linear (three samples, eq. 2.4)
 //! at MIP level `level` (clamped to the face's last level, where only vertex colours
-//! remain). It is defined on the editable store (level 0; the store holds no MIP chains)
-//! and on packed buffers (every level), through [`MeshColorSource`]. The arithmetic is
-//! `f32` in the order the shaders use.
+//! remain), through [`MeshColorSource`], implemented by
+//! - [`ColorStore`]: level 0, read straight from the editable maps;
+//! - [`StoreMips`]: every level of a store, its MIP chains evaluated in full `f32`
+//!   (the packer's filters with RGBA32F, whose quantisation is the identity);
+//! - [`PackedMesh`]: every level of packed buffers in any colour format.
+//!
+//! The arithmetic is `f32` in the order the shaders use.
 
+use crate::color::ColorFormat;
 use crate::color::Rgba;
 use crate::layout::{self, Resolution, SampleLocation};
 use crate::packed::PackedMesh;
+use crate::packer::{PackError, pack};
 use crate::store::ColorStore;
 
 /// How colours between samples are reconstructed.
@@ -40,6 +46,30 @@ impl MeshColorSource for ColorStore {
             return None;
         }
         self.face_sample(face, i, j)
+    }
+}
+
+/// A store with its MIP chains evaluated in `f32`, for level-`l` reference sampling.
+#[derive(Debug, Clone)]
+pub struct StoreMips {
+    chains: PackedMesh,
+}
+
+impl StoreMips {
+    /// Evaluates every MIP chain of `store` (no quantisation).
+    pub fn new(store: &ColorStore) -> Result<Self, PackError> {
+        let positions = vec![[0.0f32; 3]; store.topology().vertex_count as usize];
+        Ok(StoreMips { chains: pack(store, &positions, ColorFormat::Rgba32F)? })
+    }
+}
+
+impl MeshColorSource for StoreMips {
+    fn face_resolution(&self, face: u32) -> Option<Resolution> {
+        self.chains.face_resolution(face)
+    }
+
+    fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
+        self.chains.lattice_color(face, level, i, j)
     }
 }
 

@@ -8,7 +8,8 @@ use glam::Mat4;
 /// One glTF mesh (all of its triangle primitives), in the mesh's local space.
 ///
 /// Vertices are the glTF vertices of every primitive concatenated; they are *not*
-/// welded yet. Attribute vectors all have `positions_local.len()` entries.
+/// welded yet. Attribute vectors all have `positions_local.len()` entries, except
+/// [`SourceMesh::colors`], which is empty when the mesh has no vertex colours.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SourceMesh {
     /// Name from the glTF file, or `mesh N`.
@@ -19,6 +20,10 @@ pub struct SourceMesh {
     pub normals_local: Vec<[f32; 3]>,
     /// TEXCOORD_0, or `[0, 0]` when the primitive has none.
     pub uvs: Vec<[f32; 2]>,
+    /// COLOR_0 per vertex as linear RGBA (RGB colours get alpha 1), clamped to `[0, 1]`.
+    /// Empty when no primitive of the mesh has COLOR_0; when only some have it, the
+    /// vertices of the others are white (glTF's neutral vertex colour).
+    pub colors: Vec<[f32; 4]>,
     /// Triangles as indices into the vertex arrays above (strips and fans already expanded).
     pub triangles: Vec<[u32; 3]>,
     /// For each triangle, the index into [`Scene::materials`] (or `None` for the default material).

@@ -352,3 +352,61 @@ fn unpack_refuses_non_canonical_buffers() {
     assert!(unpack(&empty_packed).is_ok(), "an empty mesh is a valid (empty) document");
     assert!(unpack(&PackedMesh::default()).is_err(), "vertex_levels = 0 is not canonical");
 }
+
+#[test]
+fn srgb8_encoding_rounds_to_the_nearest_code_in_encoded_space() {
+    // Independent truth: the f64 transfer function, rounded.
+    let reference = |linear: f64| -> u8 {
+        let x = linear.clamp(0.0, 1.0);
+        let encoded = if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
+        (encoded * 255.0).round() as u8
+    };
+    let mut mismatches = 0;
+    for k in 0..=200_000u32 {
+        let linear = k as f32 / 200_000.0;
+        let got = meshpaint::color::encode_srgb8(linear);
+        let want = reference(f64::from(linear));
+        if got != want {
+            // Only values within float noise of a rounding boundary may differ.
+            mismatches += 1;
+            assert!(got.abs_diff(want) == 1, "{linear}: {got} vs {want}");
+        }
+    }
+    assert!(mismatches < 20, "{mismatches} boundary mismatches");
+    assert_eq!(meshpaint::color::encode_srgb8(f32::NAN), 0);
+    assert_eq!(meshpaint::color::encode_srgb8(-1.0), 0);
+    assert_eq!(meshpaint::color::encode_srgb8(7.0), 255);
+}
+
+#[test]
+fn store_mip_sampling_matches_packed_sampling_at_every_level_within_quantisation() {
+    use meshpaint::sampler::StoreMips;
+    let (positions, store) = mixed_octahedron_store(21);
+    let mips = StoreMips::new(&store).unwrap();
+    let packed8 = pack(&store, &positions, ColorFormat::Rgba8Srgb).unwrap();
+    let packed16 = pack(&store, &positions, ColorFormat::Rgba16F).unwrap();
+    let mut rng = Rng(77);
+    for face in 0..8 {
+        for level in 0..=6 {
+            for _ in 0..100 {
+                let (a, b) = (rng.unit(), rng.unit());
+                let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
+                let bary = [1.0 - a - b, a, b];
+                for filter in [Filter::Nearest, Filter::Linear] {
+                    let truth = sample(&mips, face, bary, filter, level).unwrap();
+                    if level == 0 {
+                        assert_eq!(sample(&store, face, bary, filter, 0).unwrap(), truth);
+                    }
+                    // RGBA8 quantises level 0 before filtering, then each level again.
+                    for (packed, tolerance) in [(&packed8, 0.0135), (&packed16, 0.002)] {
+                        let got = sample(packed, face, bary, filter, level).unwrap();
+                        for c in 0..4 {
+                            assert!((got[c] - truth[c]).abs() <= tolerance, "face {face} level {level}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(sample(&store, 7, [1.0, 0.0, 0.0], Filter::Linear, 1), None, "the store itself has no MIP chains");
+}

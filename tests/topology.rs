@@ -155,6 +155,7 @@ fn mesh(positions: Vec<[f32; 3]>, uvs: Vec<[f32; 2]>, triangles: Vec<[u32; 3]>) 
         positions_local: positions,
         normals_local: vec![[0.0, 0.0, 1.0]; n],
         uvs,
+        colors: Vec::new(),
         triangle_materials: vec![None; triangles.len()],
         triangles,
     }

@@ -1,0 +1,86 @@
+// The UV baseline: the same mesh drawn the conventional way, with its glTF UVs and
+// base-colour texture through a hardware sampler (linear, trilinear mipmaps, repeat).
+// It is the reference for visual equivalence with mesh colors and the baseline every
+// speed ratio is measured against, so it does the same shading work as
+// shaders/mesh_colors.wgsl (lighting, wireframe) and nothing more.
+//
+// Vertices come from a vertex buffer, three per face (faces keep their own UVs across
+// seams), positions relative to the render origin.
+
+// Keep in sync with `FrameUniforms` in src/render/uniforms.rs and shaders/mesh_colors.wgsl
+// (160 bytes). The baseline reads clip_from_world, light, wire_color, tint (the glTF
+// baseColorFactor), flags and wire_width.
+struct FrameUniforms {
+    clip_from_world: mat4x4<f32>,
+    light: vec4<f32>,
+    wire_color: vec4<f32>,
+    tint: vec4<f32>,
+    filter_kind: u32,
+    level_mode: u32,
+    level: u32,
+    flags: u32,
+    atlas_width: u32,
+    sample_count: u32,
+    vertex_levels: u32,
+    wire_width: f32,
+    face_count: u32,
+    vertex_count: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+const FLAG_LIT: u32 = 1u;
+const FLAG_WIREFRAME: u32 = 2u;
+
+@group(0) @binding(0) var<uniform> u: FrameUniforms;
+@group(0) @binding(1) var base_color: texture_2d<f32>;
+@group(0) @binding(2) var base_sampler: sampler;
+
+// Keep in sync with `BaselineVertex` in src/render/baseline.rs.
+struct VertexIn {
+    @builtin(vertex_index) vertex_index: u32,
+    @location(0) position: vec3<f32>,
+    @location(1) uv: vec2<f32>,
+    @location(2) normal: vec3<f32>,
+}
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+    @location(1) bary: vec3<f32>,
+    @location(2) @interpolate(flat) normal: vec3<f32>,
+}
+
+@vertex
+fn vs_main(in: VertexIn) -> VertexOut {
+    let corner = in.vertex_index % 3u;
+    var out: VertexOut;
+    out.clip = u.clip_from_world * vec4<f32>(in.position, 1.0);
+    out.uv = in.uv;
+    out.bary = vec3<f32>(f32(corner == 0u), f32(corner == 1u), f32(corner == 2u));
+    out.normal = in.normal;
+    return out;
+}
+
+@fragment
+fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    // Implicit derivatives (textureSample) and fwidth in uniform control flow.
+    let texel = textureSample(base_color, base_sampler, in.uv);
+    let bary_width = fwidth(in.bary);
+
+    var rgb = texel.rgb * u.tint.rgb;
+    let alpha = texel.a * u.tint.a;
+    if (u.flags & FLAG_LIT) != 0u {
+        let n = select(-in.normal, in.normal, front_facing);
+        let ambient = u.light.w;
+        let diffuse = max(dot(n, u.light.xyz), 0.0);
+        rgb = rgb * (ambient + (1.0 - ambient) * diffuse);
+    }
+    if (u.flags & FLAG_WIREFRAME) != 0u {
+        let pixels = in.bary / max(bary_width, vec3<f32>(1e-12));
+        let edge = min(pixels.x, min(pixels.y, pixels.z));
+        let coverage = clamp(0.5 * u.wire_width + 0.5 - edge, 0.0, 1.0);
+        rgb = mix(rgb, u.wire_color.rgb, coverage * u.wire_color.a);
+    }
+    return vec4<f32>(rgb, alpha);
+}

@@ -1,0 +1,296 @@
+//! Texture conversion: a glTF base-colour texture becomes mesh colors.
+//!
+//! Every stored sample is evaluated once, in its *owner* face (the lowest face id that
+//! contains it, see [`crate::store::SampleSite`]): the owner's corner UVs are interpolated
+//! with the sample's barycentric coordinates and the owner's material is evaluated there,
+//! `base_color_factor × texture` in linear light. Across a UV seam the two faces of an edge
+//! map it to different texels; the owner's mapping wins, so the result is deterministic.
+//!
+//! # Texture conventions (glTF 2.0)
+//!
+//! - texels are RGBA8 with sRGB-encoded colour and linear alpha; they are decoded to linear
+//!   light before any filtering;
+//! - UV `(0, 0)` is the top-left corner of the image (`u` to the right, `v` down the rows);
+//!   texel `(x, y)` has its centre at `((x + ½)/W, (y + ½)/H)`;
+//! - wrapping is `REPEAT` on both axes (the importer does not keep samplers);
+//! - faces without a material use the glTF default material (white), faces whose material
+//!   has no texture get `base_color_factor`.
+//!
+//! # Filtering
+//!
+//! A mesh-colors sample stands for the area around it, so point-sampling a texture finer
+//! than the sample spacing would alias. Each texture gets a MIP pyramid built in linear
+//! light with an exact box filter (area weights, so odd sizes are handled), and each
+//! sample is read trilinearly at
+//!
+//! ```text
+//! lod = log2( max(1, longest UV edge of the owner face in texels / R) )
+//! ```
+//!
+//! where `R` is the resolution the sample lives at (the face's, or the edge's for edge
+//! samples). Pyramids are built once per texture and only for textures in use.
+
+use crate::color::{Rgba, srgb_to_linear};
+use crate::scene::{Scene, Texture};
+use crate::store::{ColorStore, SampleRef, SampleSite};
+use crate::weld::WeldedMesh;
+
+/// One level of a [`TexturePyramid`]: linear RGBA texels, rows top to bottom.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MipLevel {
+    /// Width in texels (at least 1).
+    pub width: u32,
+    /// Height in texels (at least 1).
+    pub height: u32,
+    /// `width * height` linear RGBA texels.
+    pub texels: Vec<Rgba>,
+}
+
+impl MipLevel {
+    /// The texel at `(x, y)` with `REPEAT` wrapping.
+    fn texel(&self, x: i64, y: i64) -> Rgba {
+        let x = x.rem_euclid(i64::from(self.width)) as usize;
+        let y = y.rem_euclid(i64::from(self.height)) as usize;
+        self.texels.get(y * self.width as usize + x).copied().unwrap_or([0.0; 4])
+    }
+
+    /// Bilinear sample at `uv` (glTF convention, `REPEAT`).
+    pub fn sample_bilinear(&self, uv: [f32; 2]) -> Rgba {
+        let x = f64::from(uv[0]) * f64::from(self.width) - 0.5;
+        let y = f64::from(uv[1]) * f64::from(self.height) - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let mut out = [0.0; 4];
+        for (dx, dy, weight) in
+            [(0, 0, (1.0 - fx) * (1.0 - fy)), (1, 0, fx * (1.0 - fy)), (0, 1, (1.0 - fx) * fy), (1, 1, fx * fy)]
+        {
+            if weight == 0.0 {
+                continue;
+            }
+            let texel = self.texel(x0 + dx, y0 + dy);
+            for c in 0..4 {
+                out[c] += weight * texel[c];
+            }
+        }
+        out
+    }
+}
+
+/// A texture's MIP pyramid in linear light: level 0 is the image, each next level halves
+/// both sides (rounding down, at least 1) with an exact box filter, down to 1 × 1.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TexturePyramid {
+    levels: Vec<MipLevel>,
+}
+
+impl TexturePyramid {
+    /// Builds the pyramid of `texture`, or `None` when its size and data disagree or a
+    /// side is zero.
+    pub fn new(texture: &Texture) -> Option<Self> {
+        let (width, height) = (texture.width, texture.height);
+        let count = (width as usize).checked_mul(height as usize)?;
+        if count == 0 || texture.rgba8_srgb.len() != count.checked_mul(4)? {
+            return None;
+        }
+        // sRGB decoding through a 256-entry table.
+        let table: Vec<f32> = (0..=255u8).map(|b| srgb_to_linear(f32::from(b) / 255.0)).collect();
+        let texels = texture
+            .rgba8_srgb
+            .chunks_exact(4)
+            .map(|p| [table[p[0] as usize], table[p[1] as usize], table[p[2] as usize], f32::from(p[3]) / 255.0])
+            .collect();
+        let mut levels = vec![MipLevel { width, height, texels }];
+        while let Some(last) = levels.last()
+            && (last.width > 1 || last.height > 1)
+        {
+            let next = downsample(last);
+            levels.push(next);
+        }
+        Some(TexturePyramid { levels })
+    }
+
+    /// The levels, finest first.
+    pub fn levels(&self) -> &[MipLevel] {
+        &self.levels
+    }
+
+    /// Width and height of level 0.
+    pub fn size(&self) -> (u32, u32) {
+        self.levels.first().map_or((0, 0), |l| (l.width, l.height))
+    }
+
+    /// Trilinear sample at `uv` and level-of-detail `lod` (clamped to the pyramid):
+    /// bilinear on the two nearest levels, linearly blended.
+    pub fn sample_trilinear(&self, uv: [f32; 2], lod: f32) -> Rgba {
+        let last = self.levels.len().saturating_sub(1);
+        let lod = if lod.is_nan() { 0.0 } else { lod.clamp(0.0, last as f32) };
+        let lower = (lod.floor() as usize).min(last);
+        let upper = (lower + 1).min(last);
+        let t = lod - lower as f32;
+        let Some(a) = self.levels.get(lower).map(|l| l.sample_bilinear(uv)) else {
+            return [0.0; 4];
+        };
+        if t == 0.0 || upper == lower {
+            return a;
+        }
+        let b = self.levels.get(upper).map_or(a, |l| l.sample_bilinear(uv));
+        crate::color::lerp(a, b, t)
+    }
+}
+
+/// Box weights that map `source` texels onto `target` (≤ source) texels along one axis:
+/// target texel `i` covers source interval `[i·s/t, (i+1)·s/t)`, each source texel weighted
+/// by its overlap, normalised.
+fn box_weights(source: u32, target: u32) -> Vec<Vec<(usize, f32)>> {
+    let ratio = f64::from(source) / f64::from(target);
+    (0..target)
+        .map(|i| {
+            let (lo, hi) = (f64::from(i) * ratio, f64::from(i + 1) * ratio);
+            let mut weights = Vec::new();
+            let mut x = lo.floor() as u32;
+            while f64::from(x) < hi && x < source {
+                let overlap = (hi.min(f64::from(x + 1)) - lo.max(f64::from(x))).max(0.0);
+                if overlap > 0.0 {
+                    weights.push((x as usize, (overlap / ratio) as f32));
+                }
+                x += 1;
+            }
+            weights
+        })
+        .collect()
+}
+
+/// The next MIP level: sides halved (at least 1), exact box filter, separable.
+fn downsample(level: &MipLevel) -> MipLevel {
+    let (w, h) = (level.width, level.height);
+    let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+    let wx = box_weights(w, nw);
+    let wy = box_weights(h, nh);
+    // Horizontal pass: h rows of nw texels.
+    let mut rows = vec![[0.0f32; 4]; nw as usize * h as usize];
+    for y in 0..h as usize {
+        for (x, weights) in wx.iter().enumerate() {
+            let mut sum = [0.0; 4];
+            for &(sx, weight) in weights {
+                let texel = level.texels[y * w as usize + sx];
+                for c in 0..4 {
+                    sum[c] += weight * texel[c];
+                }
+            }
+            rows[y * nw as usize + x] = sum;
+        }
+    }
+    // Vertical pass.
+    let mut texels = vec![[0.0f32; 4]; nw as usize * nh as usize];
+    for (y, weights) in wy.iter().enumerate() {
+        for x in 0..nw as usize {
+            let mut sum = [0.0; 4];
+            for &(sy, weight) in weights {
+                let texel = rows[sy * nw as usize + x];
+                for c in 0..4 {
+                    sum[c] += weight * texel[c];
+                }
+            }
+            texels[y * nw as usize + x] = sum;
+        }
+    }
+    MipLevel { width: nw, height: nh, texels }
+}
+
+/// What a face's material needs at bake time.
+#[derive(Debug, Clone, Copy)]
+struct FaceMaterial {
+    factor: Rgba,
+    /// Index into the pyramid cache, if the material has a usable texture.
+    texture: Option<usize>,
+    /// Longest UV edge of the face in texels of level 0 (0 without a texture).
+    longest_uv_edge_texels: f32,
+}
+
+/// Whether any face of `mesh` has a material with a base-colour texture or a non-white
+/// base-colour factor, i.e. whether [`bake_texture`] gives anything but white.
+pub fn has_base_color(mesh: &WeldedMesh, scene: &Scene) -> bool {
+    mesh.triangle_materials.iter().flatten().any(|&m| {
+        scene
+            .materials
+            .get(m as usize)
+            .is_some_and(|material| material.base_color_texture.is_some() || material.base_color_factor != [1.0; 4])
+    })
+}
+
+/// Sets every sample of `store` to the base colour of its owner face at the sample's
+/// UV (`base_color_factor × texture`, linear light, trilinear MIP filtering matched to the
+/// sample spacing). `store` must be the store of `mesh` (same faces); faces the mesh does
+/// not describe get white. Marks everything dirty.
+pub fn bake_texture(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene) {
+    // Pyramids, built once per texture in use.
+    let mut pyramids: Vec<Option<Option<TexturePyramid>>> = vec![None; scene.textures.len()];
+    let faces: Vec<FaceMaterial> = (0..store.topology().face_count() as usize)
+        .map(|face| {
+            let material =
+                mesh.triangle_materials.get(face).copied().flatten().and_then(|m| scene.materials.get(m as usize));
+            let Some(material) = material else {
+                return FaceMaterial { factor: [1.0; 4], texture: None, longest_uv_edge_texels: 0.0 };
+            };
+            let texture = material.base_color_texture.map(|t| t as usize).filter(|&t| {
+                let Some(slot) = pyramids.get_mut(t) else {
+                    return false;
+                };
+                slot.get_or_insert_with(|| scene.textures.get(t).and_then(TexturePyramid::new)).is_some()
+            });
+            let longest = match (texture, mesh.corner_uvs.get(face)) {
+                (Some(t), Some(uvs)) => {
+                    let (w, h) = scene.textures.get(t).map_or((0, 0), |tex| (tex.width, tex.height));
+                    longest_uv_edge_texels(*uvs, w, h)
+                }
+                _ => 0.0,
+            };
+            FaceMaterial { factor: material.base_color_factor, texture, longest_uv_edge_texels: longest }
+        })
+        .collect();
+    let pyramids: Vec<Option<TexturePyramid>> = pyramids.into_iter().map(Option::flatten).collect();
+    let edge_resolution: Vec<u32> =
+        (0..store.topology().edge_count()).map(|e| store.edge_resolution(e).map_or(1, |r| r.get())).collect();
+    let face_resolution: Vec<u32> = store.face_resolutions().iter().map(|r| r.get()).collect();
+
+    store.fill_with(|site: SampleSite| {
+        let face = site.face as usize;
+        let Some(material) = faces.get(face) else {
+            return [1.0; 4];
+        };
+        let Some(pyramid) = material.texture.and_then(|t| pyramids.get(t)).and_then(Option::as_ref) else {
+            return material.factor;
+        };
+        let resolution = match site.sample {
+            SampleRef::Edge { edge, .. } => edge_resolution.get(edge as usize).copied(),
+            _ => face_resolution.get(face).copied(),
+        }
+        .unwrap_or(1)
+        .max(1);
+        let spacing = material.longest_uv_edge_texels / resolution as f32;
+        let lod = if spacing > 1.0 { spacing.log2() } else { 0.0 };
+        let uv = mesh.corner_uvs.get(face).map_or([0.0; 2], |uvs| interpolate_uv(*uvs, site.barycentric));
+        let texel = pyramid.sample_trilinear(uv, lod);
+        std::array::from_fn(|c| material.factor[c] * texel[c])
+    });
+}
+
+/// `w0·uv0 + w1·uv1 + w2·uv2`, non-finite UVs read as `(0, 0)`.
+fn interpolate_uv(uvs: [[f32; 2]; 3], w: [f32; 3]) -> [f32; 2] {
+    let clean = |x: f32| if x.is_finite() { x } else { 0.0 };
+    std::array::from_fn(|a| (0..3).map(|k| w[k] * clean(uvs[k][a])).sum())
+}
+
+/// Longest edge of a UV triangle measured in texels of a `width × height` image.
+fn longest_uv_edge_texels(uvs: [[f32; 2]; 3], width: u32, height: u32) -> f32 {
+    let (w, h) = (width as f32, height as f32);
+    (0..3)
+        .map(|k| {
+            let (a, b) = (uvs[k], uvs[(k + 1) % 3]);
+            let (du, dv) = ((b[0] - a[0]) * w, (b[1] - a[1]) * h);
+            let length = (du * du + dv * dv).sqrt();
+            if length.is_finite() { length } else { 0.0 }
+        })
+        .fold(0.0, f32::max)
+}

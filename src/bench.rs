@@ -1,0 +1,124 @@
+//! Measurements behind `meshpaint bench …`: every figure we report comes from here.
+//!
+//! Timings take the best of several runs (the least-disturbed one on a shared machine)
+//! and report the median too. Comparisons are made inside one run, as ratios.
+
+use std::time::{Duration, Instant};
+
+use crate::color::ColorFormat;
+use crate::document::Document;
+use crate::packed::PackedMesh;
+use crate::packer::PackError;
+
+/// Best and median of repeated timings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Timing {
+    /// Fastest run, seconds.
+    pub best_seconds: f64,
+    /// Median run, seconds.
+    pub median_seconds: f64,
+    /// Number of runs.
+    pub runs: usize,
+}
+
+impl Timing {
+    /// Times `run` `runs` times (at least once).
+    pub fn measure<T>(runs: usize, mut run: impl FnMut() -> T) -> (Timing, T) {
+        let mut times: Vec<Duration> = Vec::new();
+        let mut last;
+        loop {
+            let start = Instant::now();
+            last = run();
+            times.push(start.elapsed());
+            if times.len() >= runs.max(1) {
+                break;
+            }
+        }
+        times.sort();
+        let timing = Timing {
+            best_seconds: times[0].as_secs_f64(),
+            median_seconds: times[times.len() / 2].as_secs_f64(),
+            runs: times.len(),
+        };
+        (timing, last)
+    }
+
+    /// As a JSON object.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "best_seconds": self.best_seconds,
+            "median_seconds": self.median_seconds,
+            "runs": self.runs,
+        })
+    }
+}
+
+/// Result of the repack benchmark.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PackBench {
+    /// Colour format packed.
+    pub format: ColorFormat,
+    /// Level-0 samples in the store.
+    pub store_samples: u64,
+    /// Samples written, MIP chains included.
+    pub packed_samples: u64,
+    /// Bytes of face records plus colours written.
+    pub bytes_written: u64,
+    /// Repack (store → packed buffers) timing.
+    pub pack: Timing,
+    /// `memcpy` of the same number of bytes, same run.
+    pub memcpy: Timing,
+}
+
+impl PackBench {
+    /// Bytes written per second by the packer (best run).
+    pub fn pack_bytes_per_second(&self) -> f64 {
+        self.bytes_written as f64 / self.pack.best_seconds
+    }
+
+    /// Bytes copied per second by `memcpy` (best run).
+    pub fn memcpy_bytes_per_second(&self) -> f64 {
+        self.bytes_written as f64 / self.memcpy.best_seconds
+    }
+
+    /// How many times slower than a plain copy of the output the repack is.
+    pub fn ratio_to_memcpy(&self) -> f64 {
+        self.pack.best_seconds / self.memcpy.best_seconds
+    }
+
+    /// As a JSON object.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "format": self.format.name(),
+            "store_samples": self.store_samples,
+            "packed_samples": self.packed_samples,
+            "bytes_written": self.bytes_written,
+            "pack": self.pack.to_json(),
+            "memcpy": self.memcpy.to_json(),
+            "pack_bytes_per_second": self.pack_bytes_per_second(),
+            "memcpy_bytes_per_second": self.memcpy_bytes_per_second(),
+            "ratio_to_memcpy": self.ratio_to_memcpy(),
+        })
+    }
+}
+
+/// Times repacking `document` in `format` against a `memcpy` of the output size.
+pub fn bench_pack(document: &Document, format: ColorFormat, runs: usize) -> Result<PackBench, PackError> {
+    let (pack_timing, packed) = Timing::measure(runs, || document.pack(format));
+    let packed: PackedMesh = packed?;
+    let bytes_written = packed.face_record_bytes() + packed.color_bytes();
+    let source = vec![0x5Au8; bytes_written as usize];
+    let mut destination = vec![0u8; bytes_written as usize];
+    let (memcpy_timing, ()) = Timing::measure(runs.max(5), || {
+        destination.copy_from_slice(std::hint::black_box(&source));
+        std::hint::black_box(&mut destination);
+    });
+    Ok(PackBench {
+        format,
+        store_samples: document.store.sample_count(),
+        packed_samples: packed.sample_count(),
+        bytes_written,
+        pack: pack_timing,
+        memcpy: memcpy_timing,
+    })
+}

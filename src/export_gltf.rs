@@ -1,0 +1,565 @@
+//! glTF export: the mesh tessellated at each face's resolution, one vertex per mesh-colors
+//! sample, with the sample colours as `COLOR_0`.
+//!
+//! # What is written
+//!
+//! A binary glTF (`.glb`) with one scene, one node, one mesh and one triangle primitive:
+//!
+//! - **one vertex per sample** that a face reads. Samples shared between faces (mesh
+//!   vertices, edge samples) become one shared glTF vertex, keyed by the store's
+//!   [`SampleRef`]; a face coarser than its edge reads the edge with stride (exactly the
+//!   samples [`ColorStore::face_sample_ref`] returns), so its lattice joins the finer
+//!   neighbour's at every other (every `R_e / R_f`-th) edge vertex;
+//! - `POSITION` (float VEC3, with the `min`/`max` glTF requires): sample `(i, j)` of a face
+//!   with corners `c0, c1, c2` at resolution `R` sits at
+//!   `((R − i − j)/R)·c0 + (i/R)·c1 + (j/R)·c2`, computed in `f64` and rounded to `f32`;
+//! - `COLOR_0` (float VEC4): the sample colour, linear RGBA as glTF defines COLOR_0, the
+//!   store's `f32` values unchanged except that components outside `[0, 1]` (which glTF
+//!   forbids; the store's exact-inverse reduction can overshoot) are clamped to it;
+//! - indices (unsigned short when every index fits, else unsigned int): for each face in
+//!   face order, for `i` in `0..R`, for `j` in `0..R − i`, the sub-triangle
+//!   `(i, j), (i+1, j), (i, j+1)` and then, when `i + j ≤ R − 2`, the sub-triangle
+//!   `(i+1, j), (i+1, j+1), (i, j+1)` — `R²` triangles per face, with the face's winding;
+//! - a material with metallic factor 0 and roughness factor 1, so that viewers show the
+//!   colours as diffuse colour; no `NORMAL` (glTF viewers then use flat normals).
+//!
+//! A glTF viewer interpolates `COLOR_0` linearly across each sub-triangle, which is exactly
+//! meshpaint's linear filter ([`crate::sampler`], thesis eq. 2.4).
+//!
+//! Vertices are numbered in order of first use along the index order above, so the same
+//! store gives the same bytes.
+//!
+//! # Refused
+//!
+//! A store with no faces (a glTF primitive needs at least one vertex), positions that do
+//! not match the store's vertex count or are non-finite, non-finite colours (glTF float
+//! accessors must be finite), and output past the limits of the format: more than
+//! `2^32 − 1` vertices (the largest index is reserved) or a GLB over `2^32 − 1` bytes. The
+//! limits are checked from the counts before anything large is allocated.
+
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use gltf::json;
+use gltf::json::validation::Checked::Valid;
+use gltf::json::validation::USize64;
+use thiserror::Error;
+
+use crate::layout::{self, Resolution};
+use crate::store::{ColorStore, SampleRef};
+
+/// The value of `asset.generator` in exported files.
+pub const GENERATOR: &str = "meshpaint";
+
+/// Errors of the glTF export.
+#[derive(Debug, Error)]
+pub enum ExportError {
+    /// The store has no faces: there is nothing to tessellate.
+    #[error("nothing to export: the mesh has no faces")]
+    Empty,
+    /// `positions` does not have one entry per store vertex.
+    #[error("expected {expected} vertex positions (one per mesh vertex), got {got}")]
+    PositionCount {
+        /// The store's vertex count.
+        expected: u64,
+        /// The number of positions given.
+        got: u64,
+    },
+    /// A vertex position is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite position")]
+    NonFinitePosition {
+        /// The vertex.
+        vertex: u32,
+    },
+    /// A sample colour is NaN or infinite.
+    #[error("face {face} sample ({i}, {j}) has a non-finite colour")]
+    NonFiniteColor {
+        /// The face reading the sample.
+        face: u32,
+        /// Lattice coordinate towards corner 1.
+        i: u32,
+        /// Lattice coordinate towards corner 2.
+        j: u32,
+    },
+    /// The store could not return a sample its own layout names (an inconsistent store).
+    #[error("face {face} sample ({i}, {j}) is missing from the store")]
+    MissingSample {
+        /// The face.
+        face: u32,
+        /// Lattice coordinate towards corner 1.
+        i: u32,
+        /// Lattice coordinate towards corner 2.
+        j: u32,
+    },
+    /// The tessellation exceeds what glTF / GLB can hold.
+    #[error(
+        "the tessellation is too large for glTF: {vertices} vertices and {triangles} triangles \
+         need {bytes} bytes ({limit})"
+    )]
+    TooLarge {
+        /// Vertices the tessellation needs.
+        vertices: u64,
+        /// Triangles the tessellation needs.
+        triangles: u64,
+        /// Bytes of the GLB's binary chunk.
+        bytes: u64,
+        /// Which limit is exceeded.
+        limit: &'static str,
+    },
+    /// Serialising the glTF JSON or assembling the GLB failed.
+    #[error("cannot encode the glTF: {0}")]
+    Encode(String),
+    /// Writing the output file failed.
+    #[error("{path}: cannot {action}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What was being done.
+        action: &'static str,
+        /// The cause.
+        source: std::io::Error,
+    },
+}
+
+/// A store tessellated at each face's resolution: one vertex per sample faces read.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Tessellation {
+    /// Vertex positions (barycentric combinations of the face corners).
+    pub positions: Vec<[f32; 3]>,
+    /// Vertex colours: the sample colours, linear RGBA, clamped to `[0, 1]`.
+    pub colors: Vec<[f32; 4]>,
+    /// The sample each vertex shows.
+    pub samples: Vec<SampleRef>,
+    /// Triangles, `R_f²` per face in face order (see the module documentation).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Vertex and triangle counts of the tessellation of `store`, from the counts alone.
+/// The vertex count assumes the store's rule that an edge's resolution is the finest of
+/// its faces (every stored edge sample is read); it is exact for any consistent store.
+pub fn tessellation_counts(store: &ColorStore) -> (u64, u64) {
+    let topology = store.topology();
+    let mut used = vec![false; topology.vertex_count as usize];
+    for corners in &topology.face_vertices {
+        for &v in corners {
+            if let Some(flag) = used.get_mut(v as usize) {
+                *flag = true;
+            }
+        }
+    }
+    let mut vertices = used.iter().filter(|&&u| u).count() as u64;
+    let mut triangles = 0u64;
+    for edge in 0..topology.edge_count() {
+        vertices += store.edge_samples(edge).len() as u64;
+    }
+    for &r in store.face_resolutions() {
+        vertices += u64::from(layout::interior_sample_count(r));
+        triangles += u64::from(r.get()) * u64::from(r.get());
+    }
+    (vertices, triangles)
+}
+
+/// Marks a sample that has no glTF vertex yet.
+const UNASSIGNED: u32 = u32::MAX;
+
+/// Bytes per vertex in the binary chunk: POSITION (3 × f32) + COLOR_0 (4 × f32).
+const VERTEX_BYTES: u64 = 12 + 16;
+
+/// Room left in the GLB for its headers and JSON chunk (a few kilobytes at most).
+const JSON_ALLOWANCE: u64 = 64 << 10;
+
+/// Whether `vertices` vertices are indexed with unsigned shorts (the largest value of
+/// the type is reserved, so at most 65 535 vertices).
+fn use_u16_indices(vertices: u64) -> bool {
+    vertices <= u64::from(u16::MAX)
+}
+
+/// Checks the glTF / GLB limits for a tessellation of this size.
+fn check_limits(vertices: u64, triangles: u64) -> Result<(), ExportError> {
+    let index_bytes = if use_u16_indices(vertices) { 2 } else { 4 };
+    let bytes = vertices
+        .saturating_mul(VERTEX_BYTES)
+        .saturating_add(triangles.saturating_mul(3 * index_bytes).next_multiple_of(4));
+    let too_large = |limit| ExportError::TooLarge { vertices, triangles, bytes, limit };
+    if vertices > u64::from(u32::MAX) {
+        return Err(too_large("at most 2^32 - 1 vertices can be indexed"));
+    }
+    if bytes.saturating_add(JSON_ALLOWANCE) > u64::from(u32::MAX) {
+        return Err(too_large("a GLB file holds at most 2^32 - 1 bytes"));
+    }
+    Ok(())
+}
+
+/// Tessellates `store` on `positions` (one per store vertex): see the module documentation.
+pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessellation, ExportError> {
+    let topology = store.topology();
+    if topology.face_count() == 0 {
+        return Err(ExportError::Empty);
+    }
+    if positions.len() as u64 != u64::from(topology.vertex_count) {
+        return Err(ExportError::PositionCount {
+            expected: u64::from(topology.vertex_count),
+            got: positions.len() as u64,
+        });
+    }
+    if let Some(vertex) = positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(ExportError::NonFinitePosition { vertex: vertex as u32 });
+    }
+    let (vertex_bound, triangle_count) = tessellation_counts(store);
+    check_limits(vertex_bound, triangle_count)?;
+
+    // Dense maps SampleRef → glTF vertex: one slot per mesh vertex and per stored edge
+    // sample. Interior samples belong to one face and are never looked up again.
+    let mut vertex_slots = vec![UNASSIGNED; topology.vertex_count as usize];
+    let mut edge_base = Vec::with_capacity(topology.edge_count() as usize);
+    let mut edge_total = 0usize;
+    for edge in 0..topology.edge_count() {
+        edge_base.push(edge_total);
+        edge_total += store.edge_samples(edge).len();
+    }
+    let mut edge_slots = vec![UNASSIGNED; edge_total];
+
+    let capacity = usize::try_from(vertex_bound).unwrap_or(0);
+    let mut out = Tessellation {
+        positions: Vec::with_capacity(capacity),
+        colors: Vec::with_capacity(capacity),
+        samples: Vec::with_capacity(capacity),
+        triangles: Vec::with_capacity(usize::try_from(triangle_count).unwrap_or(0)),
+    };
+    // Lattice point (i, j) of the current face → vertex, row by row (reused per face).
+    let mut lattice: Vec<u32> = Vec::new();
+    for (face, corners) in topology.face_vertices.iter().enumerate() {
+        let face = face as u32;
+        let Some(r) = store.face_resolution(face) else {
+            return Err(ExportError::MissingSample { face, i: 0, j: 0 });
+        };
+        let res = r.get();
+        let corner_positions = corners.map(|v| positions.get(v as usize).copied().unwrap_or([0.0; 3]));
+        lattice.clear();
+        for i in 0..=res {
+            for j in 0..=res - i {
+                let missing = ExportError::MissingSample { face, i, j };
+                let Some(sample) = store.face_sample_ref(face, i, j) else {
+                    return Err(missing);
+                };
+                let slot = match sample {
+                    SampleRef::Vertex(v) => vertex_slots.get_mut(v as usize),
+                    SampleRef::Edge { edge, offset } => {
+                        edge_base.get(edge as usize).and_then(|&base| edge_slots.get_mut(base + offset as usize))
+                    }
+                    SampleRef::Interior { .. } => None,
+                };
+                let known = slot.as_ref().map_or(UNASSIGNED, |s| **s);
+                let index = if known != UNASSIGNED {
+                    known
+                } else {
+                    let Some(color) = store.get(sample) else {
+                        return Err(missing);
+                    };
+                    if !color.iter().all(|c| c.is_finite()) {
+                        return Err(ExportError::NonFiniteColor { face, i, j });
+                    }
+                    let index = out.positions.len() as u32;
+                    out.positions.push(lattice_position(&corner_positions, r, i, j));
+                    out.colors.push(color.map(|c| c.clamp(0.0, 1.0)));
+                    out.samples.push(sample);
+                    if let Some(slot) = slot {
+                        *slot = index;
+                    }
+                    index
+                };
+                lattice.push(index);
+            }
+        }
+        // Row i starts at Σ_{k<i} (R + 1 − k) = i(2R + 3 − i)/2.
+        let at = |i: u32, j: u32| {
+            let row = (i as usize * (2 * res as usize + 3 - i as usize)) / 2;
+            lattice.get(row + j as usize).copied().unwrap_or(0)
+        };
+        for i in 0..res {
+            for j in 0..res - i {
+                out.triangles.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
+                if i + j + 2 <= res {
+                    out.triangles.push([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Position of lattice point `(i, j)` on the face with `corners` at resolution `r`:
+/// the barycentric combination in `f64`, rounded to `f32`.
+fn lattice_position(corners: &[[f32; 3]; 3], r: Resolution, i: u32, j: u32) -> [f32; 3] {
+    let w = layout::sample_barycentric(r, i, j);
+    std::array::from_fn(|a| {
+        (w[0] * f64::from(corners[0][a]) + w[1] * f64::from(corners[1][a]) + w[2] * f64::from(corners[2][a])) as f32
+    })
+}
+
+/// The tessellated mesh as a binary glTF (see the module documentation).
+pub fn export_tessellated_glb(positions: &[[f32; 3]], store: &ColorStore) -> Result<Vec<u8>, ExportError> {
+    let tessellation = tessellate(positions, store)?;
+    tessellation_to_glb(&tessellation)
+}
+
+/// Encodes a tessellation as a binary glTF.
+pub fn tessellation_to_glb(tessellation: &Tessellation) -> Result<Vec<u8>, ExportError> {
+    let vertices = tessellation.positions.len();
+    let triangles = tessellation.triangles.len();
+    check_limits(vertices as u64, triangles as u64)?;
+    if vertices == 0 || triangles == 0 {
+        return Err(ExportError::Empty);
+    }
+    if tessellation.colors.len() != vertices {
+        return Err(ExportError::Encode(format!("{} colours for {vertices} vertices", tessellation.colors.len())));
+    }
+    if let Some(&bad) = tessellation.triangles.iter().flatten().find(|&&index| index as usize >= vertices) {
+        return Err(ExportError::Encode(format!("index {bad} out of range ({vertices} vertices)")));
+    }
+
+    let mut min = [f32::INFINITY; 3];
+    let mut max = [f32::NEG_INFINITY; 3];
+    for p in &tessellation.positions {
+        for a in 0..3 {
+            min[a] = min[a].min(p[a]);
+            max[a] = max[a].max(p[a]);
+        }
+    }
+
+    // Binary chunk, little-endian: positions, colours, indices (each offset a multiple of 4).
+    let u16_indices = use_u16_indices(vertices as u64);
+    let index_bytes = if u16_indices { 2 } else { 4 } * 3 * triangles;
+    let mut bin: Vec<u8> = Vec::with_capacity(vertices * VERTEX_BYTES as usize + index_bytes + 3);
+    for value in tessellation.positions.iter().flatten() {
+        bin.extend_from_slice(&value.to_le_bytes());
+    }
+    let colors_offset = bin.len();
+    for value in tessellation.colors.iter().flatten() {
+        bin.extend_from_slice(&value.to_le_bytes());
+    }
+    let indices_offset = bin.len();
+    for &index in tessellation.triangles.iter().flatten() {
+        if u16_indices {
+            bin.extend_from_slice(&(index as u16).to_le_bytes());
+        } else {
+            bin.extend_from_slice(&index.to_le_bytes());
+        }
+    }
+    let buffer_length = bin.len();
+    // The BIN chunk is padded to 4 bytes here (not left to the GLB writer).
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+
+    let root = gltf_root(GltfLayout {
+        vertices,
+        triangles,
+        buffer_length,
+        colors_offset,
+        indices_offset,
+        u16_indices,
+        min,
+        max,
+    });
+    let json_string = json::serialize::to_string(&root).map_err(|err| ExportError::Encode(err.to_string()))?;
+    let total = 12 + 8 + json_string.len().next_multiple_of(4) + 8 + bin.len();
+    let Ok(length) = u32::try_from(total) else {
+        return Err(ExportError::TooLarge {
+            vertices: vertices as u64,
+            triangles: triangles as u64,
+            bytes: total as u64,
+            limit: "a GLB file holds at most 2^32 - 1 bytes",
+        });
+    };
+    let glb = gltf::binary::Glb {
+        header: gltf::binary::Header { magic: *b"glTF", version: 2, length },
+        json: Cow::Owned(json_string.into_bytes()),
+        bin: Some(Cow::Owned(bin)),
+    };
+    glb.to_vec().map_err(|err| ExportError::Encode(err.to_string()))
+}
+
+/// Where things are in the binary chunk, for the JSON.
+struct GltfLayout {
+    vertices: usize,
+    triangles: usize,
+    buffer_length: usize,
+    colors_offset: usize,
+    indices_offset: usize,
+    u16_indices: bool,
+    min: [f32; 3],
+    max: [f32; 3],
+}
+
+/// The glTF JSON describing the binary chunk laid out as `layout` says.
+fn gltf_root(layout: GltfLayout) -> json::Root {
+    use json::accessor::{ComponentType, GenericComponentType, Type};
+    use json::buffer::Target;
+
+    let mut root = json::Root {
+        asset: json::Asset { generator: Some(GENERATOR.to_owned()), ..json::Asset::default() },
+        ..json::Root::default()
+    };
+    let buffer = root.push(json::Buffer {
+        byte_length: USize64::from(layout.buffer_length),
+        extensions: None,
+        extras: Default::default(),
+        name: None,
+        uri: None,
+    });
+    let view = |root: &mut json::Root, offset: usize, end: usize, target: Target| {
+        root.push(json::buffer::View {
+            buffer,
+            byte_length: USize64::from(end - offset),
+            byte_offset: Some(USize64::from(offset)),
+            byte_stride: None,
+            extensions: None,
+            extras: Default::default(),
+            name: None,
+            target: Some(Valid(target)),
+        })
+    };
+    let positions_view = view(&mut root, 0, layout.colors_offset, Target::ArrayBuffer);
+    let colors_view = view(&mut root, layout.colors_offset, layout.indices_offset, Target::ArrayBuffer);
+    let indices_view = view(&mut root, layout.indices_offset, layout.buffer_length, Target::ElementArrayBuffer);
+
+    let accessor =
+        |view, count: usize, component: ComponentType, ty: Type, bounds: Option<([f32; 3], [f32; 3])>| json::Accessor {
+            buffer_view: Some(view),
+            byte_offset: None,
+            count: USize64::from(count),
+            component_type: Valid(GenericComponentType(component)),
+            extensions: None,
+            extras: Default::default(),
+            type_: Valid(ty),
+            min: bounds.map(|(min, _)| json::Value::from(min.to_vec())),
+            max: bounds.map(|(_, max)| json::Value::from(max.to_vec())),
+            name: None,
+            normalized: false,
+            sparse: None,
+        };
+    let positions = root.push(accessor(
+        positions_view,
+        layout.vertices,
+        ComponentType::F32,
+        Type::Vec3,
+        Some((layout.min, layout.max)),
+    ));
+    let colors = root.push(accessor(colors_view, layout.vertices, ComponentType::F32, Type::Vec4, None));
+    let index_type = if layout.u16_indices { ComponentType::U16 } else { ComponentType::U32 };
+    let indices = root.push(accessor(indices_view, 3 * layout.triangles, index_type, Type::Scalar, None));
+
+    let material = root.push(json::Material {
+        name: Some("meshpaint vertex colours".to_owned()),
+        pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+            metallic_factor: json::material::StrengthFactor(0.0),
+            roughness_factor: json::material::StrengthFactor(1.0),
+            ..Default::default()
+        },
+        ..Default::default()
+    });
+    let primitive = json::mesh::Primitive {
+        attributes: BTreeMap::from([
+            (Valid(json::mesh::Semantic::Positions), positions),
+            (Valid(json::mesh::Semantic::Colors(0)), colors),
+        ]),
+        extensions: None,
+        extras: Default::default(),
+        indices: Some(indices),
+        material: Some(material),
+        mode: Valid(json::mesh::Mode::Triangles),
+        targets: None,
+    };
+    let mesh = root.push(json::Mesh {
+        extensions: None,
+        extras: Default::default(),
+        name: Some("meshpaint".to_owned()),
+        primitives: vec![primitive],
+        weights: None,
+    });
+    let node = root.push(json::Node { mesh: Some(mesh), name: Some("meshpaint".to_owned()), ..Default::default() });
+    let scene = root.push(json::Scene { extensions: None, extras: Default::default(), name: None, nodes: vec![node] });
+    root.scene = Some(scene);
+    root
+}
+
+/// What [`write_tessellated_glb`] wrote.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ExportSummary {
+    /// glTF vertices: one per sample the faces read.
+    pub vertices: u64,
+    /// Triangles: `Σ R_f²`.
+    pub triangles: u64,
+    /// Size of the file in bytes.
+    pub bytes: u64,
+}
+
+/// Tessellates `store` on `positions` and writes the binary glTF to `path` atomically:
+/// the bytes go to a temporary file in the same directory, which is flushed to disk and
+/// then renamed over `path`.
+pub fn write_tessellated_glb(
+    path: &Path,
+    positions: &[[f32; 3]],
+    store: &ColorStore,
+) -> Result<ExportSummary, ExportError> {
+    let tessellation = tessellate(positions, store)?;
+    let bytes = tessellation_to_glb(&tessellation)?;
+    write_atomically(path, &bytes)?;
+    Ok(ExportSummary {
+        vertices: tessellation.positions.len() as u64,
+        triangles: tessellation.triangles.len() as u64,
+        bytes: bytes.len() as u64,
+    })
+}
+
+/// Writes `bytes` to `path` through a synced temporary file in the same directory.
+fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
+    let io_error = |path: &Path, action: &'static str| {
+        let path = path.to_path_buf();
+        move |source: std::io::Error| ExportError::Io { path, action, source }
+    };
+    let Some(file_name) = path.file_name() else {
+        return Err(io_error(path, "write a file at a path without a file name")(
+            std::io::ErrorKind::InvalidInput.into(),
+        ));
+    };
+    let dir = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let mut temp_name = std::ffi::OsString::from(".");
+    temp_name.push(file_name);
+    temp_name.push(format!(".{}-{}.tmp", std::process::id(), temp_counter()));
+    let temp = dir.join(temp_name);
+    let written = (|| {
+        let mut file = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&temp)
+            .map_err(io_error(&temp, "create the temporary file"))?;
+        file.write_all(bytes).map_err(io_error(&temp, "write the temporary file"))?;
+        file.sync_all().map_err(io_error(&temp, "flush the temporary file to disk"))?;
+        drop(file);
+        std::fs::rename(&temp, path).map_err(io_error(path, "rename the temporary file onto"))
+    })();
+    if let Err(error) = written {
+        // Best effort: the temporary file may not exist (any more).
+        let _ = std::fs::remove_file(&temp);
+        return Err(error);
+    }
+    // Make the rename itself durable where directories can be synced (best effort).
+    if let Ok(dir_handle) = std::fs::File::open(dir) {
+        let _ = dir_handle.sync_all();
+    }
+    Ok(())
+}
+
+/// A process-wide counter making temporary names unique across threads.
+fn temp_counter() -> u64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    COUNTER.fetch_add(1, Ordering::Relaxed)
+}

@@ -1,0 +1,260 @@
+//! The UV baseline: a mesh drawn with its glTF UVs and base-colour texture through a
+//! hardware sampler (linear, trilinear mipmaps built on the CPU in linear light, repeat).
+//!
+//! It is the visual reference mesh colors are compared with and the baseline every speed
+//! ratio is measured against.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DVec3, Vec3};
+use wgpu::util::DeviceExt;
+
+use super::{GpuContext, RenderError, Renderer};
+use crate::camera::BoundingSphere;
+use crate::color::{linear_to_srgb, srgb_to_linear};
+use crate::scene::Texture;
+
+/// One vertex of the baseline's vertex buffer (three per face: faces keep their own UVs).
+///
+/// Keep in sync with `struct VertexIn` in shaders/uv_baseline.wgsl (32 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+pub struct BaselineVertex {
+    /// Position relative to the render origin.
+    pub position: [f32; 3],
+    /// glTF TEXCOORD_0 (origin top-left, v down, as wgpu textures).
+    pub uv: [f32; 2],
+    /// Unit face normal (counter-clockwise front; +Z for a degenerate face).
+    pub normal: [f32; 3],
+}
+
+const _: () = assert!(std::mem::size_of::<BaselineVertex>() == 32);
+
+impl BaselineVertex {
+    /// The vertex buffer layout: locations 0 (position), 1 (uv), 2 (normal).
+    pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<BaselineVertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x2, 2 => Float32x3],
+    };
+}
+
+/// The mip chain of an RGBA8 sRGB texture, built in linear light: each level halves each
+/// side (down to 1) and averages the 2×2 texels below it (clamped at odd edges) after
+/// decoding sRGB; alpha is averaged as is. Level 0 is the input. Returns
+/// `(width, height, rgba8_srgb)` per level.
+pub fn mip_chain_linear(texture: &Texture) -> Vec<(u32, u32, Vec<u8>)> {
+    let decode: Vec<f32> = (0..=255u8).map(|b| srgb_to_linear(f32::from(b) / 255.0)).collect();
+    let encode = |linear: f32| (linear_to_srgb(linear) * 255.0).round() as u8;
+    let mut levels = vec![(texture.width, texture.height, texture.rgba8_srgb.clone())];
+    while let Some((w, h, src)) = levels.last() {
+        let (w, h) = (*w, *h);
+        if w <= 1 && h <= 1 {
+            break;
+        }
+        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+        let mut out = Vec::with_capacity(nw as usize * nh as usize * 4);
+        for y in 0..nh {
+            for x in 0..nw {
+                let mut sum = [0.0f32; 4];
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let sx = (2 * x + dx).min(w - 1) as usize;
+                    let sy = (2 * y + dy).min(h - 1) as usize;
+                    let k = (sy * w as usize + sx) * 4;
+                    for c in 0..3 {
+                        sum[c] += decode[usize::from(src[k + c])];
+                    }
+                    sum[3] += f32::from(src[k + 3]) / 255.0;
+                }
+                out.extend_from_slice(&[
+                    encode(sum[0] * 0.25),
+                    encode(sum[1] * 0.25),
+                    encode(sum[2] * 0.25),
+                    (sum[3] * 0.25 * 255.0).round() as u8,
+                ]);
+            }
+        }
+        levels.push((nw, nh, out));
+    }
+    levels
+}
+
+/// A mesh with UVs and a base-colour texture on the GPU, for the baseline pipeline.
+#[derive(Debug)]
+pub struct BaselineMesh {
+    /// The render origin (bounding-sphere centre): positions on the GPU are `p − origin`.
+    pub origin: DVec3,
+    /// The mesh's bounding sphere (for framing).
+    pub bounds: BoundingSphere,
+    /// Vertices drawn: three per face.
+    pub vertex_count: u32,
+    /// Multiplies the texture (glTF `baseColorFactor`, linear RGBA).
+    pub base_color_factor: [f32; 4],
+    vertices: wgpu::Buffer,
+    texture: wgpu::Texture,
+    pub(crate) uniforms: wgpu::Buffer,
+    pub(crate) bind_group: wgpu::BindGroup,
+}
+
+impl BaselineMesh {
+    /// Uploads a mesh for the baseline: `positions` (world), `triangles` (vertex ids),
+    /// `corner_uvs` (one UV per face corner, e.g. [`crate::weld::WeldedMesh::corner_uvs`]),
+    /// the base-colour `texture` (RGBA8 sRGB; mipmaps are generated here) and the material's
+    /// `base_color_factor` (use `[1.0; 4]` for none).
+    pub fn new(
+        ctx: &GpuContext,
+        renderer: &Renderer,
+        positions: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+        corner_uvs: &[[[f32; 2]; 3]],
+        texture: &Texture,
+        base_color_factor: [f32; 4],
+    ) -> Result<Self, RenderError> {
+        ctx.checked(|| Self::new_unchecked(ctx, renderer, positions, triangles, corner_uvs, texture, base_color_factor))
+    }
+
+    fn new_unchecked(
+        ctx: &GpuContext,
+        renderer: &Renderer,
+        positions: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+        corner_uvs: &[[[f32; 2]; 3]],
+        texture: &Texture,
+        base_color_factor: [f32; 4],
+    ) -> Result<Self, RenderError> {
+        if corner_uvs.len() != triangles.len() {
+            return Err(RenderError::InvalidMesh(format!(
+                "{} corner UV triples for {} triangles",
+                corner_uvs.len(),
+                triangles.len()
+            )));
+        }
+        let limits = ctx.limits();
+        let max = limits.max_texture_dimension_2d;
+        if texture.width == 0 || texture.height == 0 || texture.width > max || texture.height > max {
+            return Err(RenderError::InvalidTexture(format!(
+                "{}×{} is outside 1..={max} per side",
+                texture.width, texture.height
+            )));
+        }
+        let expected = texture.width as usize * texture.height as usize * 4;
+        if texture.rgba8_srgb.len() != expected {
+            return Err(RenderError::InvalidTexture(format!(
+                "{}×{} needs {expected} bytes, got {}",
+                texture.width,
+                texture.height,
+                texture.rgba8_srgb.len()
+            )));
+        }
+        let vertex_total = triangles.len() * 3;
+        let vertex_count = u32::try_from(vertex_total)
+            .map_err(|_| RenderError::InvalidMesh(format!("{} triangles", triangles.len())))?;
+
+        let bounds = BoundingSphere::of_points(positions);
+        let origin = DVec3::from_array(bounds.center);
+        let relative = |v: u32| -> Result<Vec3, RenderError> {
+            let p = positions.get(v as usize).ok_or_else(|| {
+                RenderError::InvalidMesh(format!("vertex {v} out of range ({} vertices)", positions.len()))
+            })?;
+            Ok((DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - origin).as_vec3())
+        };
+        let mut vertices = Vec::with_capacity(vertex_total);
+        for (corners, uvs) in triangles.iter().zip(corner_uvs) {
+            let p = [relative(corners[0])?, relative(corners[1])?, relative(corners[2])?];
+            let n = (p[1] - p[0]).cross(p[2] - p[0]);
+            let normal = if n.length() > 0.0 && n.length().is_finite() { n.normalize() } else { Vec3::Z };
+            for k in 0..3 {
+                vertices.push(BaselineVertex { position: p[k].to_array(), uv: uvs[k], normal: normal.to_array() });
+            }
+        }
+        let bytes = (vertices.len() * std::mem::size_of::<BaselineVertex>()) as u64;
+        if bytes > limits.max_buffer_size {
+            return Err(RenderError::BufferTooLarge {
+                what: "baseline vertices",
+                bytes,
+                limit: limits.max_buffer_size,
+            });
+        }
+        let mut contents: Vec<u8> = bytemuck::cast_slice(&vertices).to_vec();
+        contents.resize(contents.len().max(32), 0);
+        let vertex_buffer = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("baseline vertices"),
+            contents: &contents,
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+
+        let levels = mip_chain_linear(texture);
+        let gpu_texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("baseline base colour"),
+            size: wgpu::Extent3d { width: texture.width, height: texture.height, depth_or_array_layers: 1 },
+            mip_level_count: levels.len() as u32,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        for (level, (w, h, data)) in levels.iter().enumerate() {
+            ctx.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &gpu_texture,
+                    mip_level: level as u32,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                data,
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(w * 4), rows_per_image: Some(*h) },
+                wgpu::Extent3d { width: *w, height: *h, depth_or_array_layers: 1 },
+            );
+        }
+        let view = gpu_texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("baseline trilinear repeat"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            address_mode_w: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let uniforms = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("baseline uniforms"),
+            size: std::mem::size_of::<super::FrameUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("baseline bind group"),
+            layout: renderer.baseline_bind_group_layout(),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&sampler) },
+            ],
+        });
+        Ok(BaselineMesh {
+            origin,
+            bounds,
+            vertex_count,
+            base_color_factor,
+            vertices: vertex_buffer,
+            texture: gpu_texture,
+            uniforms,
+            bind_group,
+        })
+    }
+
+    pub(crate) fn vertex_buffer(&self) -> &wgpu::Buffer {
+        &self.vertices
+    }
+
+    /// GPU memory of the vertex buffer and the texture with its mip chain, in bytes.
+    pub fn gpu_bytes(&self) -> u64 {
+        let size = self.texture.size();
+        let mut texels = 0u64;
+        for level in 0..self.texture.mip_level_count() {
+            texels += u64::from((size.width >> level).max(1)) * u64::from((size.height >> level).max(1));
+        }
+        self.vertices.size() + texels * 4
+    }
+}

@@ -1,0 +1,284 @@
+//! A [`PackedMesh`] on the GPU: positions, indices and face records in storage buffers,
+//! the colour buffer in a 2D colour-atlas texture.
+
+use glam::DVec3;
+use wgpu::util::DeviceExt;
+
+use super::{GpuContext, RenderError, Renderer};
+use crate::camera::BoundingSphere;
+use crate::color::ColorFormat;
+use crate::packed::{FaceRecord, PackedMesh};
+
+/// The default atlas width: `min(16384, max_texture_dimension_2d)`.
+///
+/// A 16384² atlas holds `2^28` samples, [`crate::packed::MAX_SAMPLES`] exactly.
+pub fn default_atlas_width(limits: &wgpu::Limits) -> u32 {
+    limits.max_texture_dimension_2d.min(16384)
+}
+
+/// Bytes written per `write_texture` call when uploading many rows (bounds staging memory).
+const UPLOAD_BAND_BYTES: u64 = 64 << 20;
+
+/// Where samples live in the colour atlas.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AtlasLayout {
+    /// Atlas width `W` in texels.
+    pub width: u32,
+    /// Atlas height: `ceil(samples / W)` rows, at least 1.
+    pub height: u32,
+    /// Samples stored.
+    pub samples: u64,
+}
+
+impl AtlasLayout {
+    /// The layout of `samples` samples in rows of `width`, checked against `max_dimension`.
+    pub fn new(samples: u64, width: u32, max_dimension: u32) -> Result<Self, RenderError> {
+        if width == 0 || width > max_dimension {
+            return Err(RenderError::InvalidAtlasWidth { width, max_dimension });
+        }
+        let rows = samples.div_ceil(u64::from(width)).max(1);
+        let height = u32::try_from(rows)
+            .ok()
+            .filter(|&height| height <= max_dimension)
+            .ok_or(RenderError::AtlasTooLarge { samples, width, rows, max_dimension })?;
+        Ok(AtlasLayout { width, height, samples })
+    }
+
+    /// The texel `(x, y)` of sample `index`: `(index % W, index / W)`.
+    pub fn texel(&self, index: u64) -> (u32, u32) {
+        let width = u64::from(self.width);
+        ((index % width) as u32, (index / width) as u32)
+    }
+}
+
+/// How to upload a mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct MeshUploadOptions {
+    /// Atlas width; `None` means [`default_atlas_width`]. Tests force tiny widths (e.g. 61)
+    /// to prove the wrapping.
+    pub atlas_width: Option<u32>,
+}
+
+/// The texture format holding samples of `format`: RGBA8 sRGB → `Rgba8UnormSrgb` (decoded
+/// to linear by `textureLoad`), RGBA16F → `Rgba16Float`, RGBA32F → `Rgba32Float`.
+pub fn atlas_texture_format(format: ColorFormat) -> wgpu::TextureFormat {
+    match format {
+        ColorFormat::Rgba8Srgb => wgpu::TextureFormat::Rgba8UnormSrgb,
+        ColorFormat::Rgba16F => wgpu::TextureFormat::Rgba16Float,
+        ColorFormat::Rgba32F => wgpu::TextureFormat::Rgba32Float,
+    }
+}
+
+/// A packed mesh uploaded for the mesh-colors pipeline.
+#[derive(Debug)]
+pub struct GpuMesh {
+    /// The render origin (bounding-sphere centre, world space, `f64`): positions on the GPU
+    /// are `p − origin`, and cameras must use the same origin.
+    pub origin: DVec3,
+    /// The mesh's bounding sphere (for framing).
+    pub bounds: BoundingSphere,
+    /// Number of faces (the draw is `3 · face_count` vertices).
+    pub face_count: u32,
+    /// Number of vertices.
+    pub vertex_count: u32,
+    /// Colours per vertex in the colour buffer.
+    pub vertex_levels: u32,
+    /// Encoding of the colour atlas.
+    pub format: ColorFormat,
+    /// Where samples live in the atlas.
+    pub atlas: AtlasLayout,
+    positions: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    face_records: wgpu::Buffer,
+    atlas_texture: wgpu::Texture,
+    pub(crate) uniforms: wgpu::Buffer,
+    pub(crate) bind_group: wgpu::BindGroup,
+}
+
+/// Creates a storage buffer of `bytes` (padded to 16 bytes: empty bindings are invalid),
+/// refusing buffers larger than the binding limit.
+fn storage_buffer(ctx: &GpuContext, what: &'static str, bytes: &[u8]) -> Result<wgpu::Buffer, RenderError> {
+    let limit = ctx.limits().max_storage_buffer_binding_size;
+    if bytes.len() as u64 > limit {
+        return Err(RenderError::BufferTooLarge { what, bytes: bytes.len() as u64, limit });
+    }
+    let padded;
+    let contents = if bytes.len() < 16 || !bytes.len().is_multiple_of(4) {
+        let mut data = bytes.to_vec();
+        data.resize(bytes.len().next_multiple_of(4).max(16), 0);
+        padded = data;
+        &padded[..]
+    } else {
+        bytes
+    };
+    Ok(ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(what),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+    }))
+}
+
+impl GpuMesh {
+    /// Uploads `packed` for drawing with `renderer`: positions relative to the bounding-sphere
+    /// centre (subtracted in `f64`), indices, face records and the colour atlas.
+    pub fn upload(
+        ctx: &GpuContext,
+        renderer: &Renderer,
+        packed: &PackedMesh,
+        options: &MeshUploadOptions,
+    ) -> Result<Self, RenderError> {
+        ctx.checked(|| Self::upload_unchecked(ctx, renderer, packed, options))
+    }
+
+    fn upload_unchecked(
+        ctx: &GpuContext,
+        renderer: &Renderer,
+        packed: &PackedMesh,
+        options: &MeshUploadOptions,
+    ) -> Result<Self, RenderError> {
+        let vertex_count = u32::try_from(packed.positions.len())
+            .map_err(|_| RenderError::InvalidMesh(format!("{} vertices", packed.positions.len())))?;
+        let face_count = u32::try_from(packed.indices.len())
+            .map_err(|_| RenderError::InvalidMesh(format!("{} faces", packed.indices.len())))?;
+        if packed.face_records.len() != packed.indices.len() {
+            return Err(RenderError::InvalidMesh(format!(
+                "{} face records for {} faces",
+                packed.face_records.len(),
+                packed.indices.len()
+            )));
+        }
+        if let Some((face, corners)) =
+            packed.indices.iter().enumerate().find(|(_, corners)| corners.iter().any(|&v| v >= vertex_count))
+        {
+            return Err(RenderError::InvalidMesh(format!(
+                "face {face} uses vertex {corners:?}, but there are only {vertex_count} vertices"
+            )));
+        }
+        let bytes_per_sample = packed.format.bytes_per_sample();
+        if !packed.colors.len().is_multiple_of(bytes_per_sample) {
+            return Err(RenderError::InvalidMesh(format!(
+                "colour buffer of {} bytes is not a whole number of {bytes_per_sample}-byte samples",
+                packed.colors.len()
+            )));
+        }
+
+        let limits = ctx.limits();
+        let width = options.atlas_width.unwrap_or_else(|| default_atlas_width(&limits));
+        let atlas = AtlasLayout::new(packed.sample_count(), width, limits.max_texture_dimension_2d)?;
+
+        let bounds = BoundingSphere::of_points(&packed.positions);
+        let origin = DVec3::from_array(bounds.center);
+        let relative: Vec<f32> = packed
+            .positions
+            .iter()
+            .flat_map(|p| {
+                let p = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - origin;
+                [p.x as f32, p.y as f32, p.z as f32]
+            })
+            .collect();
+        let positions =
+            storage_buffer(ctx, "positions (relative to the render origin)", bytemuck::cast_slice(&relative))?;
+        let indices = storage_buffer(ctx, "indices", bytemuck::cast_slice(&packed.indices))?;
+        let face_records =
+            storage_buffer(ctx, "face records", bytemuck::cast_slice::<FaceRecord, u8>(&packed.face_records))?;
+
+        let atlas_texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("colour atlas"),
+            size: wgpu::Extent3d { width: atlas.width, height: atlas.height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: atlas_texture_format(packed.format),
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let atlas_view = atlas_texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let uniforms = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("mesh colors uniforms"),
+            size: std::mem::size_of::<super::FrameUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("mesh colors bind group"),
+            layout: renderer.mesh_bind_group_layout(),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: positions.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: indices.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: face_records.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&atlas_view) },
+            ],
+        });
+        let mesh = GpuMesh {
+            origin,
+            bounds,
+            face_count,
+            vertex_count,
+            vertex_levels: packed.vertex_levels,
+            format: packed.format,
+            atlas,
+            positions,
+            indices,
+            face_records,
+            atlas_texture,
+            uniforms,
+            bind_group,
+        };
+        mesh.write_samples(ctx, 0, &packed.colors)?;
+        Ok(mesh)
+    }
+
+    /// Overwrites samples `first..first + n` of the colour atlas with `encoded` (`n` samples
+    /// in the mesh's format), e.g. the dirty range of a paint stroke.
+    pub fn write_samples(&self, ctx: &GpuContext, first: u64, encoded: &[u8]) -> Result<(), RenderError> {
+        let bytes_per_sample = self.format.bytes_per_sample() as u64;
+        let count = encoded.len() as u64 / bytes_per_sample;
+        if !(encoded.len() as u64).is_multiple_of(bytes_per_sample) || first.saturating_add(count) > self.atlas.samples
+        {
+            return Err(RenderError::InvalidMesh(format!(
+                "writing {} bytes at sample {first} overruns the {} samples of the colour atlas",
+                encoded.len(),
+                self.atlas.samples
+            )));
+        }
+        let width = u64::from(self.atlas.width);
+        let band_rows = (UPLOAD_BAND_BYTES / (width * bytes_per_sample)).max(1);
+        let mut done = 0u64;
+        while done < count {
+            let (x, y) = self.atlas.texel(first + done);
+            let remaining = count - done;
+            // A partial row (unaligned start or the tail), else a band of full rows.
+            let (texels_per_row, rows) = if x != 0 || remaining < width {
+                ((width - u64::from(x)).min(remaining), 1)
+            } else {
+                (width, (remaining / width).min(band_rows))
+            };
+            let start = (done * bytes_per_sample) as usize;
+            let end = start + (texels_per_row * rows * bytes_per_sample) as usize;
+            ctx.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &self.atlas_texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x, y, z: 0 },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &encoded[start..end],
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some((texels_per_row * bytes_per_sample) as u32),
+                    rows_per_image: Some(rows as u32),
+                },
+                wgpu::Extent3d { width: texels_per_row as u32, height: rows as u32, depth_or_array_layers: 1 },
+            );
+            done += texels_per_row * rows;
+        }
+        Ok(())
+    }
+
+    /// GPU memory of the mesh's buffers and atlas, in bytes.
+    pub fn gpu_bytes(&self) -> u64 {
+        let atlas = u64::from(self.atlas.width) * u64::from(self.atlas.height) * self.format.bytes_per_sample() as u64;
+        self.positions.size() + self.indices.size() + self.face_records.size() + atlas
+    }
+}

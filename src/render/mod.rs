@@ -1,0 +1,126 @@
+//! The GPU renderer: wgpu context, packed mesh colors on the GPU, sampling pipelines,
+//! the UV-texture baseline, offscreen targets and readback.
+//!
+//! # Design
+//!
+//! - **Vertex pulling.** The mesh-colors pipeline has no vertex buffer: it draws `3·F`
+//!   vertices; the vertex shader takes `face = vertex_index / 3`, `corner = vertex_index % 3`
+//!   and reads the corner's vertex id and position from storage buffers. The face id
+//!   reaches the fragment shader as a flat varying, the barycentrics as `(1,0,0)`,
+//!   `(0,1,0)`, `(0,0,1)` interpolated perspective-correct. No `primitive_index` feature
+//!   is needed, so it runs on every backend.
+//! - **Colour atlas.** The colour buffer (all samples with their MIP chains) is a 2D
+//!   texture of width `W` used as an array: sample `index` is texel `(index % W, index / W)`.
+//!   One storage binding is limited to 128 MiB on lavapipe and WebGPU defaults while a
+//!   16384² atlas holds `2^28` samples, exactly [`crate::packed::MAX_SAMPLES`]. RGBA8 sRGB
+//!   samples go into an `Rgba8UnormSrgb` texture, so `textureLoad` returns linear colour.
+//! - **Render origin.** Positions are uploaded relative to the mesh's bounding-sphere
+//!   centre, subtracted in `f64` on the CPU, and the camera matrix is built relative to
+//!   the same origin ([`crate::camera::OrbitCamera::clip_from_world_relative`]): a mesh at
+//!   `1e6` renders without jitter.
+//! - **Exactness.** `shaders/mesh_colors.wgsl` mirrors [`crate::sampler::packed_sample_index`]
+//!   and [`crate::layout::linear_samples_uv`] operation for operation; `tests/gpu_render.rs`
+//!   compares GPU pixels with [`crate::sampler::sample`].
+//! - **Colour.** Samples are linear; shaders output linear colour into an `Rgba8UnormSrgb`
+//!   target (or an sRGB view of a window surface), which encodes it.
+//!
+//! The renderer is target-agnostic: [`Renderer::draw`] records into any colour view of the
+//! format the renderer was built for; [`Renderer::render_image`] is the offscreen path
+//! (render, copy, read back into an [`image::RgbaImage`]).
+
+mod baseline;
+mod context;
+mod headless;
+mod mesh_gpu;
+mod renderer;
+mod uniforms;
+
+pub use baseline::{BaselineMesh, BaselineVertex, mip_chain_linear};
+pub use context::{GpuContext, backends_from_env};
+pub use headless::{RenderFileError, RenderRequest, RenderedFile, default_camera, render_file};
+pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshUploadOptions, atlas_texture_format, default_atlas_width};
+pub use renderer::{DrawItem, FilterMode, Overlays, RenderSettings, RenderTarget, Renderer, Shading};
+pub use uniforms::FrameUniforms;
+
+use thiserror::Error;
+
+/// Colour format of offscreen render targets (and of [`Renderer::render_image`]).
+pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// Depth format of every render pass.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Errors of the GPU renderer.
+#[derive(Debug, Error)]
+pub enum RenderError {
+    /// No GPU adapter (not even a software one such as lavapipe) was found.
+    #[error("no GPU adapter found (backends {backends}): {reason}; install mesa-vulkan-drivers for lavapipe")]
+    NoAdapter {
+        /// The backends that were searched.
+        backends: String,
+        /// Why the request failed.
+        reason: String,
+    },
+    /// The adapter refused to create a device.
+    #[error("cannot create a GPU device on {adapter}: {reason}")]
+    RequestDevice {
+        /// The adapter's name.
+        adapter: String,
+        /// Why the request failed.
+        reason: String,
+    },
+    /// The colour buffer does not fit in an atlas of the requested width.
+    #[error(
+        "colour buffer of {samples} samples needs {rows} rows at atlas width {width}, \
+         but textures are limited to {max_dimension} texels per side"
+    )]
+    AtlasTooLarge {
+        /// Samples in the colour buffer.
+        samples: u64,
+        /// Atlas width.
+        width: u32,
+        /// Rows needed.
+        rows: u64,
+        /// The device's `max_texture_dimension_2d`.
+        max_dimension: u32,
+    },
+    /// An atlas width of zero or beyond the device limit was requested.
+    #[error("atlas width {width} is outside 1..={max_dimension}")]
+    InvalidAtlasWidth {
+        /// The requested width.
+        width: u32,
+        /// The device's `max_texture_dimension_2d`.
+        max_dimension: u32,
+    },
+    /// A storage buffer would exceed the device's binding limit.
+    #[error("{what} needs {bytes} bytes, more than the device's storage binding limit of {limit} bytes")]
+    BufferTooLarge {
+        /// Which buffer.
+        what: &'static str,
+        /// Bytes needed.
+        bytes: u64,
+        /// The device's `max_storage_buffer_binding_size`.
+        limit: u64,
+    },
+    /// A render target size of zero or beyond the device limit.
+    #[error("render size {width}×{height} is outside 1..={max_dimension} per side")]
+    InvalidTargetSize {
+        /// Requested width.
+        width: u32,
+        /// Requested height.
+        height: u32,
+        /// The device's `max_texture_dimension_2d`.
+        max_dimension: u32,
+    },
+    /// Mesh data that cannot be drawn (mismatched lengths, indices out of range…).
+    #[error("invalid mesh: {0}")]
+    InvalidMesh(String),
+    /// A texture whose size and data disagree.
+    #[error("invalid texture: {0}")]
+    InvalidTexture(String),
+    /// Mapping the readback buffer failed.
+    #[error("reading the rendered image back failed: {0}")]
+    Readback(String),
+    /// wgpu reported an error (validation, out of memory) while rendering.
+    #[error("GPU error: {0}")]
+    Gpu(String),
+}

@@ -1,0 +1,61 @@
+//! Uniform blocks shared with the WGSL shaders.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Per-draw uniforms of both pipelines.
+///
+/// Keep in sync with `struct FrameUniforms` in shaders/mesh_colors.wgsl and
+/// shaders/uv_baseline.wgsl (same fields, same order, 160 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct FrameUniforms {
+    /// Column-major `clip ← (world − render origin)`.
+    pub clip_from_world: [[f32; 4]; 4],
+    /// xyz: unit vector towards the light (world space); w: ambient term in `[0, 1]`.
+    pub light: [f32; 4],
+    /// Wireframe colour, linear RGBA (alpha = line opacity).
+    pub wire_color: [f32; 4],
+    /// Multiplies the base colour (the baseline's glTF `baseColorFactor`; 1 for mesh colors).
+    pub tint: [f32; 4],
+    /// Reconstruction filter: [`FrameUniforms::FILTER_NEAREST`] or [`FrameUniforms::FILTER_LINEAR`].
+    pub filter_kind: u32,
+    /// [`FrameUniforms::LEVEL_FIXED`] or [`FrameUniforms::LEVEL_AUTO`] (trilinear).
+    pub level_mode: u32,
+    /// The fixed MIP level (clamped per face to `log2 R_f` in the shader).
+    pub level: u32,
+    /// `FLAG_*` bits.
+    pub flags: u32,
+    /// Colour-atlas width `W`: sample `index` is texel `(index % W, index / W)`.
+    pub atlas_width: u32,
+    /// Samples in the colour buffer (at least 1: shaders clamp every index below it).
+    pub sample_count: u32,
+    /// Colours per vertex in the colour buffer (`1 + log2 max R`).
+    pub vertex_levels: u32,
+    /// Wireframe line width in pixels.
+    pub wire_width: f32,
+    /// Number of faces.
+    pub face_count: u32,
+    /// Number of vertices.
+    pub vertex_count: u32,
+    /// Padding to a multiple of 16 bytes.
+    pub _pad: [u32; 2],
+}
+
+const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 160);
+
+impl FrameUniforms {
+    /// Nearest-sample reconstruction.
+    pub const FILTER_NEAREST: u32 = 0;
+    /// Linear (three-sample) reconstruction.
+    pub const FILTER_LINEAR: u32 = 1;
+    /// Sample the fixed level [`FrameUniforms::level`].
+    pub const LEVEL_FIXED: u32 = 0;
+    /// Choose the level per pixel from screen-space derivatives, blend two levels.
+    pub const LEVEL_AUTO: u32 = 1;
+    /// Lambert + ambient shading with the face normal.
+    pub const FLAG_LIT: u32 = 1;
+    /// Wireframe overlay.
+    pub const FLAG_WIREFRAME: u32 = 2;
+    /// Per-face resolution heat map instead of the painted colour.
+    pub const FLAG_HEATMAP: u32 = 4;
+}

@@ -1,0 +1,900 @@
+//! glTF export against independent truths: the Khronos glTF-Validator (npm package
+//! `gltf-validator`, pinned in tools/validate-gltf), the importer reading the file back
+//! (closed-form vertex and triangle counts, colours bit for bit, positions), the CPU
+//! reference sampler's linear filter against plain barycentric interpolation of COLOR_0
+//! over the exported triangles found by geometry, determinism, and COLOR_0 import.
+
+// Colour channels and coordinates are indexed in parallel arrays; an index reads clearest.
+#![allow(clippy::needless_range_loop)]
+
+use std::collections::{BTreeSet, HashMap};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Mutex;
+
+use glam::Mat4;
+use meshpaint::document::Document;
+use meshpaint::export_gltf::{ExportError, GENERATOR, export_tessellated_glb, write_tessellated_glb};
+use meshpaint::import::{import_gltf, import_gltf_slice};
+use meshpaint::layout::Resolution;
+use meshpaint::sampler::{Filter, sample};
+use meshpaint::scene::SourceMesh;
+use meshpaint::store::{ColorStore, SampleRef};
+use meshpaint::topology::Topology;
+use serde_json::{Value, json};
+
+fn r(value: u64) -> Resolution {
+    Resolution::new(value).unwrap()
+}
+
+fn crate_path(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
+}
+
+fn model(relative: &str) -> PathBuf {
+    crate_path("assets/models").join(relative)
+}
+
+/// A directory under the temp dir, unique per process and test, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(test: &str) -> Self {
+        let path = std::env::temp_dir().join(format!("meshpaint-export-{}-{test}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&path);
+        std::fs::create_dir_all(&path).unwrap();
+        TempDir(path)
+    }
+
+    fn join(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// SplitMix64: a small deterministic generator (no rand dependency).
+struct Rng(u64);
+
+impl Rng {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn below(&mut self, n: u64) -> u64 {
+        self.next_u64() % n
+    }
+
+    fn unit(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    fn color(&mut self) -> [f32; 4] {
+        [self.unit(), self.unit(), self.unit(), self.unit()]
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Test meshes
+
+/// A document's positions and store.
+struct Painted {
+    name: String,
+    positions: Vec<[f32; 3]>,
+    store: ColorStore,
+}
+
+fn open_model(relative: &str, resolution: u64) -> Painted {
+    let document = Document::open(&model(relative), r(resolution)).unwrap();
+    Painted { name: format!("{relative}@R{resolution}"), positions: document.positions, store: document.store }
+}
+
+/// The resolutions of the mixed stores, in a pattern that puts different ones side by side.
+const MIXED: [u64; 4] = [1, 2, 8, 32];
+
+/// A wavy 4 × 4 quad grid (32 faces, open boundary, reversed edges on both diagonals)
+/// with faces at R = 1, 2, 8 and 32 next to each other and random colours.
+fn mixed_grid(seed: u64) -> Painted {
+    const N: u32 = 4;
+    let mut positions = Vec::new();
+    for y in 0..=N {
+        for x in 0..=N {
+            let (fx, fy) = (x as f32 * 0.5, y as f32 * 0.5);
+            positions.push([fx, fy, 0.1 * (3.0 * fx).sin() * (2.0 * fy).cos()]);
+        }
+    }
+    let at = |x: u32, y: u32| y * (N + 1) + x;
+    let mut triangles = Vec::new();
+    for y in 0..N {
+        for x in 0..N {
+            let (a, b, c, d) = (at(x, y), at(x + 1, y), at(x, y + 1), at(x + 1, y + 1));
+            if (x + y) % 2 == 0 {
+                triangles.extend([[a, b, d], [a, d, c]]);
+            } else {
+                triangles.extend([[a, b, c], [b, d, c]]);
+            }
+        }
+    }
+    let topology = Topology::build(positions.len() as u32, &triangles).unwrap();
+    let resolutions = (0..triangles.len()).map(|f| r(MIXED[(f + f / (2 * N as usize)) % 4])).collect();
+    let mut store = ColorStore::with_resolutions(topology, resolutions, [1.0; 4]).unwrap();
+    let mut rng = Rng(seed);
+    store.fill_with(|_| rng.color());
+    Painted { name: "mixed grid".into(), positions, store }
+}
+
+/// BoxTextured (closed, 12 faces) with faces at R = 1, 2, 8, 32 and random colours.
+fn mixed_box(seed: u64) -> Painted {
+    let mut painted = open_model("BoxTextured/BoxTextured.glb", 1);
+    for face in 0..painted.store.topology().face_count() {
+        painted.store.set_face_resolution(face, r(MIXED[face as usize % 4])).unwrap();
+    }
+    let mut rng = Rng(seed);
+    painted.store.fill_with(|_| rng.color());
+    painted.name = "mixed box".into();
+    painted
+}
+
+/// Pairs of different resolutions that meet at an edge.
+fn unequal_neighbours(store: &ColorStore) -> BTreeSet<(u32, u32)> {
+    let topology = store.topology();
+    let mut pairs = BTreeSet::new();
+    for edge in 0..topology.edge_count() {
+        let rs: Vec<u32> =
+            topology.faces_of_edge(edge).iter().map(|&(f, _)| store.face_resolution(f).unwrap().get()).collect();
+        for &a in &rs {
+            for &b in &rs {
+                if a < b {
+                    pairs.insert((a, b));
+                }
+            }
+        }
+    }
+    pairs
+}
+
+// ---------------------------------------------------------------------------------------
+// Independent counts
+
+/// Samples the faces read: every used vertex, `max_f R_f − 1` per edge (the finest face
+/// reads them all, coarser faces a subset), `(R − 1)(R − 2)/2` per face interior.
+fn expected_vertices(store: &ColorStore) -> u64 {
+    let topology = store.topology();
+    let used: BTreeSet<u32> = topology.face_vertices.iter().flatten().copied().collect();
+    let mut count = used.len() as u64;
+    for edge in 0..topology.edge_count() {
+        let finest = topology
+            .faces_of_edge(edge)
+            .iter()
+            .map(|&(f, _)| u64::from(store.face_resolution(f).unwrap().get()))
+            .max()
+            .unwrap();
+        count += finest - 1;
+    }
+    for face in 0..topology.face_count() {
+        let res = u64::from(store.face_resolution(face).unwrap().get());
+        count += (res - 1) * res.saturating_sub(2) / 2;
+    }
+    count
+}
+
+fn expected_triangles(store: &ColorStore) -> u64 {
+    store.face_resolutions().iter().map(|res| u64::from(res.get()).pow(2)).sum()
+}
+
+// ---------------------------------------------------------------------------------------
+// The Khronos validator
+
+/// Installs tools/validate-gltf/node_modules with `npm ci` when missing (once per run).
+fn ensure_validator_installed() {
+    static INSTALLED: Mutex<bool> = Mutex::new(false);
+    let mut installed = INSTALLED.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    if *installed {
+        return;
+    }
+    let dir = crate_path("tools/validate-gltf");
+    if !dir.join("node_modules/gltf-validator/package.json").is_file() {
+        let status = Command::new("npm").arg("ci").arg("--prefix").arg(&dir).current_dir(crate_path(".")).status();
+        match status {
+            Ok(status) => assert!(status.success(), "`npm ci --prefix tools/validate-gltf` failed ({status})"),
+            Err(error) => panic!(
+                "the Khronos glTF-Validator is not installed and `npm ci --prefix tools/validate-gltf` could not \
+                 run ({error}): this test needs Node.js and npm on PATH"
+            ),
+        }
+    }
+    *installed = true;
+}
+
+/// Runs the Khronos glTF-Validator on `path` and returns its summary (numErrors, ...).
+fn validate(path: &Path) -> Value {
+    ensure_validator_installed();
+    let output = Command::new("node")
+        .arg(crate_path("tools/validate-gltf/validate.mjs"))
+        .arg(path)
+        .current_dir(crate_path("."))
+        .output();
+    let output = match output {
+        Ok(output) => output,
+        Err(error) => panic!(
+            "cannot run `node` ({error}): the glTF-Validator test needs Node.js (>= 18) on PATH; it is not skipped"
+        ),
+    };
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let report: Value = serde_json::from_str(stdout.trim()).unwrap_or_else(|error| {
+        panic!("{}: validator printed no JSON ({error}); stdout: {stdout}; stderr: {stderr}", path.display())
+    });
+    assert_eq!(
+        output.status.code(),
+        Some(if report["numErrors"] == 0 { 0 } else { 1 }),
+        "{}: exit status {} disagrees with the report {report}; stderr: {stderr}",
+        path.display(),
+        output.status
+    );
+    report
+}
+
+fn assert_valid(bytes: &[u8], dir: &TempDir, name: &str) {
+    let path = dir.join(&format!("{}.glb", name.replace(['/', ' ', '@'], "_")));
+    std::fs::write(&path, bytes).unwrap();
+    let report = validate(&path);
+    assert_eq!(report["numErrors"], 0, "{name}: the validator found errors: {report}");
+    assert_eq!(report["numWarnings"], 0, "{name}: the validator found warnings: {report}");
+}
+
+#[test]
+fn khronos_validator_accepts_the_exports() {
+    let dir = TempDir::new("validator");
+    let mut cases = vec![
+        open_model("BoxTextured/BoxTextured.glb", 4),
+        open_model("Duck/Duck.glb", 8),
+        mixed_grid(1),
+        mixed_box(2),
+        open_model("BoxTextured/BoxTextured.glb", 1),
+    ];
+    // Out-of-range colours are clamped (the validator refuses COLOR_0 outside [0, 1]).
+    let mut overshoot = mixed_grid(3);
+    overshoot.store.set(SampleRef::Vertex(0), [1.5, -0.25, 0.5, 2.0]);
+    overshoot.name = "overshooting colours".into();
+    cases.push(overshoot);
+    assert!(unequal_neighbours(&cases[2].store).len() >= 5, "the mixed grid mixes resolutions");
+    assert!(unequal_neighbours(&cases[3].store).contains(&(1, 32)), "the mixed box has R=1 next to R=32");
+    for case in &cases {
+        let bytes = export_tessellated_glb(&case.positions, &case.store).unwrap();
+        assert_valid(&bytes, &dir, &case.name);
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Round trip through the importer
+
+/// Exports, imports the .glb back, and checks counts, triangles, colours and positions.
+fn check_round_trip(case: &Painted) -> SourceMesh {
+    let store = &case.store;
+    let name = &case.name;
+    let bytes = export_tessellated_glb(&case.positions, store).unwrap();
+    let scene = import_gltf_slice(&bytes, None, &format!("{name}.glb")).unwrap();
+    assert_eq!(scene.meshes.len(), 1, "{name}");
+    assert_eq!(scene.instances.len(), 1, "{name}");
+    assert_eq!(scene.instances[0].world_from_local, Mat4::IDENTITY, "{name}");
+    let mesh = scene.meshes.into_iter().next().unwrap();
+    let vertices = mesh.positions_local.len();
+    assert_eq!(vertices as u64, expected_vertices(store), "{name}: one vertex per sample the faces read");
+    assert_eq!(mesh.triangles.len() as u64, expected_triangles(store), "{name}: Σ R²");
+    assert_eq!(mesh.colors.len(), vertices, "{name}: COLOR_0 on every vertex");
+
+    let topology = store.topology();
+    let mut vertex_of: HashMap<SampleRef, u32> = HashMap::new();
+    let mut sample_of: HashMap<u32, SampleRef> = HashMap::new();
+    let mut t = 0usize;
+    for face in 0..topology.face_count() {
+        let res = store.face_resolution(face).unwrap().get();
+        let corners = topology.face_vertices[face as usize].map(|v| case.positions[v as usize]);
+        for i in 0..res {
+            for j in 0..res - i {
+                let mut expected = vec![[(i, j), (i + 1, j), (i, j + 1)]];
+                if i + j + 2 <= res {
+                    expected.push([(i + 1, j), (i + 1, j + 1), (i, j + 1)]);
+                }
+                for triangle in expected {
+                    let got = mesh.triangles[t];
+                    t += 1;
+                    for k in 0..3 {
+                        let (a, b) = triangle[k];
+                        let vertex = got[k];
+                        let sample = store.face_sample_ref(face, a, b).unwrap();
+                        assert_eq!(
+                            *vertex_of.entry(sample).or_insert(vertex),
+                            vertex,
+                            "{name}: {sample:?} is one vertex"
+                        );
+                        assert_eq!(
+                            *sample_of.entry(vertex).or_insert(sample),
+                            sample,
+                            "{name}: vertex {vertex} is one sample"
+                        );
+                        let color = store.face_sample(face, a, b).unwrap();
+                        assert_eq!(
+                            mesh.colors[vertex as usize].map(f32::to_bits),
+                            color.map(f32::to_bits),
+                            "{name}: face {face} sample ({a}, {b}) colour"
+                        );
+                        let w = [f64::from(res - a - b), f64::from(a), f64::from(b)].map(|w| w / f64::from(res));
+                        let position: [f32; 3] = std::array::from_fn(|c| {
+                            (0..3).map(|k| w[k] * f64::from(corners[k][c])).sum::<f64>() as f32
+                        });
+                        assert_eq!(mesh.positions_local[vertex as usize], position, "{name}: face {face} ({a}, {b})");
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(t, mesh.triangles.len());
+    assert_eq!(sample_of.len(), vertices, "{name}: every vertex is used");
+    mesh
+}
+
+#[test]
+fn round_trip_at_uniform_resolution_matches_the_closed_form() {
+    // (model, R, welded V, E, F as listed in assets/SOURCES.md)
+    for (relative, res, v, e, f) in [
+        ("BoxTextured/BoxTextured.glb", 4u64, 8u64, 18u64, 12u64),
+        ("Duck/Duck.glb", 8, 2108, 6318, 4212),
+        ("Suzanne/monkey.glb", 2, 505, 1473, 968),
+    ] {
+        let case = open_model(relative, res);
+        let topology = case.store.topology();
+        assert_eq!((u64::from(topology.vertex_count), u64::from(topology.edge_count())), (v, e), "{relative}");
+        assert_eq!(u64::from(topology.face_count()), f, "{relative}");
+        let mesh = check_round_trip(&case);
+        let closed_form = v + e * (res - 1) + f * (res - 1) * (res - 2) / 2;
+        assert_eq!(mesh.positions_local.len() as u64, closed_form, "{relative}: V + E(R−1) + F(R−1)(R−2)/2");
+        assert_eq!(mesh.triangles.len() as u64, f * res * res, "{relative}: F·R²");
+    }
+}
+
+#[test]
+fn round_trip_with_mixed_resolutions() {
+    for case in [mixed_grid(11), mixed_box(12)] {
+        let mesh = check_round_trip(&case);
+        assert_eq!(
+            mesh.positions_local.len() as u64,
+            case.store.sample_count(),
+            "{}: every stored sample is read",
+            case.name
+        );
+    }
+}
+
+#[test]
+fn resolution_one_exports_the_vertex_colours() {
+    let mut case = open_model("BoxTextured/BoxTextured.glb", 1);
+    let mut rng = Rng(5);
+    case.store.fill_with(|_| rng.color());
+    let mesh = check_round_trip(&case);
+    let topology = case.store.topology();
+    assert_eq!(mesh.positions_local.len(), topology.vertex_count as usize);
+    assert_eq!(mesh.triangles.len(), topology.face_count() as usize);
+    // The mesh itself, with its own positions, winding and vertex colours.
+    let mut vertex_of = HashMap::new();
+    for (face, triangle) in mesh.triangles.iter().enumerate() {
+        let corners = topology.face_vertices[face];
+        for k in 0..3 {
+            let (exported, original) = (triangle[k], corners[k]);
+            assert_eq!(*vertex_of.entry(original).or_insert(exported), exported);
+            assert_eq!(mesh.positions_local[exported as usize], case.positions[original as usize]);
+            assert_eq!(mesh.colors[exported as usize], case.store.vertex_color(original).unwrap());
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Linear filter = interpolation of COLOR_0 over the exported triangles
+
+/// Lattice coordinates `(u, v) = (R·w1, R·w2)` of `p` on the face with `corners`
+/// (least squares in the face plane, f64).
+fn lattice_coords(p: [f32; 3], corners: [[f32; 3]; 3], res: u32) -> (f64, f64) {
+    let c = corners.map(|c| c.map(f64::from));
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (e1, e2, d) = (sub(c[1], c[0]), sub(c[2], c[0]), sub(p.map(f64::from), c[0]));
+    let (a11, a12, a22, b1, b2) = (dot(e1, e1), dot(e1, e2), dot(e2, e2), dot(d, e1), dot(d, e2));
+    let det = a11 * a22 - a12 * a12;
+    let s = (b1 * a22 - b2 * a12) / det;
+    let t = (a11 * b2 - a12 * b1) / det;
+    (s * f64::from(res), t * f64::from(res))
+}
+
+/// Whether the face is well enough shaped for recovering lattice coordinates from f32
+/// positions (sliver faces of real models are skipped).
+fn well_shaped(corners: [[f32; 3]; 3]) -> bool {
+    let c = corners.map(|c| glam::DVec3::from_array(c.map(f64::from)));
+    let (e1, e2) = (c[1] - c[0], c[2] - c[0]);
+    let area2 = e1.cross(e2).length();
+    let longest = e1.length().max(e2.length()).max((c[2] - c[1]).length());
+    area2 > 1e-3 * longest * longest
+}
+
+/// The exported triangles of one face in lattice coordinates (recovered from geometry,
+/// rounded to the lattice and checked to be lattice points), with their vertices.
+fn face_triangles(
+    mesh: &SourceMesh,
+    range: std::ops::Range<usize>,
+    corners: [[f32; 3]; 3],
+    res: u32,
+) -> Vec<([(f64, f64); 3], [u32; 3])> {
+    mesh.triangles[range]
+        .iter()
+        .map(|triangle| {
+            let coords = triangle.map(|vertex| {
+                let (u, v) = lattice_coords(mesh.positions_local[vertex as usize], corners, res);
+                let (ru, rv) = (u.round(), v.round());
+                assert!(
+                    (u - ru).abs() < 1e-3 && (v - rv).abs() < 1e-3,
+                    "vertex {vertex} at ({u}, {v}) is not a lattice point"
+                );
+                (ru, rv)
+            });
+            (coords, *triangle)
+        })
+        .collect()
+}
+
+/// Barycentric coordinates of `(x, y)` in the 2D triangle `t`, and its signed double area.
+fn barycentric_2d(t: [(f64, f64); 3], x: f64, y: f64) -> ([f64; 3], f64) {
+    let area = (t[1].0 - t[0].0) * (t[2].1 - t[0].1) - (t[2].0 - t[0].0) * (t[1].1 - t[0].1);
+    let l1 = ((x - t[0].0) * (t[2].1 - t[0].1) - (t[2].0 - t[0].0) * (y - t[0].1)) / area;
+    let l2 = ((t[1].0 - t[0].0) * (y - t[0].1) - (x - t[0].0) * (t[1].1 - t[0].1)) / area;
+    ([1.0 - l1 - l2, l1, l2], area)
+}
+
+fn check_linear_filter(case: &Painted, points: usize, seed: u64) {
+    let store = &case.store;
+    let name = &case.name;
+    let bytes = export_tessellated_glb(&case.positions, store).unwrap();
+    let mesh = import_gltf_slice(&bytes, None, "linear.glb").unwrap().meshes.remove(0);
+    let topology = store.topology();
+    let mut starts = vec![0usize];
+    for res in store.face_resolutions() {
+        starts.push(starts.last().unwrap() + (res.get() * res.get()) as usize);
+    }
+    let mut rng = Rng(seed);
+    let mut checked = 0;
+    let mut cache: HashMap<u32, Vec<([(f64, f64); 3], [u32; 3])>> = HashMap::new();
+    while checked < points {
+        let face = rng.below(u64::from(topology.face_count())) as u32;
+        let res = store.face_resolution(face).unwrap().get();
+        let corners = topology.face_vertices[face as usize].map(|v| case.positions[v as usize]);
+        if !well_shaped(corners) {
+            continue;
+        }
+        let triangles = cache.entry(face).or_insert_with(|| {
+            let triangles = face_triangles(&mesh, starts[face as usize]..starts[face as usize + 1], corners, res);
+            // The sub-triangles tile the face with its winding: all positive, total R²/2.
+            let mut total = 0.0;
+            for (coords, _) in &triangles {
+                let (_, area) = barycentric_2d(*coords, 0.0, 0.0);
+                assert_eq!(area, 1.0, "{name}: face {face}: a unit sub-triangle with the face's winding");
+                total += area / 2.0;
+            }
+            assert_eq!(total, f64::from(res * res) / 2.0, "{name}: face {face}: the sub-triangles cover the face");
+            triangles
+        });
+        // Dyadic barycentrics (20 bits) sum to 1 exactly in f32, so sanitising leaves them.
+        const ONE: u64 = 1 << 20;
+        let (mut k1, mut k2) = (rng.below(ONE + 1), rng.below(ONE + 1));
+        if k1 + k2 > ONE {
+            (k1, k2) = (ONE - k1, ONE - k2);
+        }
+        // Some points exactly on lattice points, lattice lines and the face's edges.
+        match checked % 8 {
+            0 => k1 -= k1 % (ONE / u64::from(res)),
+            1 => k2 -= k2 % (ONE / u64::from(res)),
+            2 => k2 = ONE - k1,
+            _ => {}
+        }
+        let bary = [(ONE - k1 - k2) as f32, k1 as f32, k2 as f32].map(|k| k / ONE as f32);
+        let expected = sample(store, face, bary, Filter::Linear, 0).unwrap();
+        let (x, y) = (f64::from(bary[1]) * f64::from(res), f64::from(bary[2]) * f64::from(res));
+        let (lambda, vertices) = triangles
+            .iter()
+            .map(|(coords, vertices)| (barycentric_2d(*coords, x, y).0, *vertices))
+            .max_by(|a, b| {
+                let min = |l: &[f64; 3]| l[0].min(l[1]).min(l[2]);
+                min(&a.0).total_cmp(&min(&b.0))
+            })
+            .unwrap();
+        assert!(lambda.iter().all(|&l| l >= -1e-12), "{name}: face {face}: no exported triangle contains ({x}, {y})");
+        for c in 0..4 {
+            let got: f64 = (0..3).map(|k| lambda[k] * f64::from(mesh.colors[vertices[k] as usize][c])).sum();
+            assert!(
+                (got - f64::from(expected[c])).abs() <= 1e-6,
+                "{name}: face {face} at {bary:?}: sampler {expected:?}, COLOR_0 interpolation gives {got} in channel {c}"
+            );
+        }
+        checked += 1;
+    }
+}
+
+#[test]
+fn linear_filter_equals_interpolated_vertex_colours() {
+    check_linear_filter(&mixed_grid(21), 3000, 1);
+    check_linear_filter(&mixed_box(22), 3000, 2);
+    check_linear_filter(&open_model("Duck/Duck.glb", 8), 2000, 3);
+    check_linear_filter(&open_model("BoxTextured/BoxTextured.glb", 4), 500, 4);
+}
+
+// ---------------------------------------------------------------------------------------
+// Determinism, files, refusals
+
+#[test]
+fn export_is_deterministic_and_written_atomically() {
+    let dir = TempDir::new("determinism");
+    for (case, again) in [
+        (mixed_grid(31), mixed_grid(31)),
+        (mixed_box(32), mixed_box(32)),
+        (open_model("Duck/Duck.glb", 4), open_model("Duck/Duck.glb", 4)),
+    ] {
+        let first = export_tessellated_glb(&case.positions, &case.store).unwrap();
+        assert_eq!(first, export_tessellated_glb(&case.positions, &case.store).unwrap(), "{}", case.name);
+        assert_eq!(first, export_tessellated_glb(&again.positions, &again.store).unwrap(), "{}", case.name);
+        let path = dir.join("out.glb");
+        std::fs::write(&path, b"old contents").unwrap();
+        let summary = write_tessellated_glb(&path, &case.positions, &case.store).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), first, "{}", case.name);
+        assert_eq!(summary.bytes, first.len() as u64);
+        assert_eq!(summary.vertices, expected_vertices(&case.store));
+        assert_eq!(summary.triangles, expected_triangles(&case.store));
+        // The file reads back through the file importer too.
+        assert_eq!(import_gltf(&path).unwrap().meshes[0].triangles.len() as u64, summary.triangles);
+    }
+    let names: Vec<_> = std::fs::read_dir(&dir.0).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("out.glb")], "no temporary file is left behind");
+    // A path in a missing directory is an error naming the path.
+    let missing = dir.join("no/such/dir/out.glb");
+    let case = mixed_grid(33);
+    let error = write_tessellated_glb(&missing, &case.positions, &case.store).unwrap_err();
+    assert!(matches!(error, ExportError::Io { .. }), "{error}");
+    assert!(error.to_string().contains("no/such/dir"), "{error}");
+}
+
+/// The GLB container and the JSON the exporter writes.
+fn glb_json(bytes: &[u8]) -> Value {
+    assert_eq!(&bytes[0..4], b"glTF");
+    assert_eq!(u32::from_le_bytes(bytes[4..8].try_into().unwrap()), 2);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize, bytes.len());
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    assert_eq!(&bytes[16..20], b"JSON");
+    assert_eq!(json_len % 4, 0);
+    let bin_at = 20 + json_len;
+    let bin_len = u32::from_le_bytes(bytes[bin_at..bin_at + 4].try_into().unwrap()) as usize;
+    assert_eq!(&bytes[bin_at + 4..bin_at + 8], b"BIN\0");
+    assert_eq!(bin_len % 4, 0, "the BIN chunk is padded to 4 bytes");
+    assert_eq!(bin_at + 8 + bin_len, bytes.len());
+    let json: Value = serde_json::from_slice(&bytes[20..bin_at]).unwrap();
+    let declared = json["buffers"][0]["byteLength"].as_u64().unwrap() as usize;
+    assert!(declared <= bin_len && bin_len - declared < 4);
+    json
+}
+
+#[test]
+fn file_structure_bounds_and_index_width() {
+    for (case, index_type) in [
+        (open_model("BoxTextured/BoxTextured.glb", 4), 5123), // UNSIGNED_SHORT
+        (open_model("Duck/Duck.glb", 8), 5125),               // UNSIGNED_INT (134,786 vertices)
+    ] {
+        let bytes = export_tessellated_glb(&case.positions, &case.store).unwrap();
+        let json = glb_json(&bytes);
+        assert_eq!(json["asset"]["generator"], GENERATOR);
+        assert_eq!(json["asset"]["version"], "2.0");
+        assert_eq!(json["meshes"].as_array().unwrap().len(), 1);
+        assert_eq!(json["nodes"].as_array().unwrap().len(), 1);
+        assert_eq!(json["scenes"].as_array().unwrap().len(), 1);
+        let primitive = &json["meshes"][0]["primitives"][0];
+        let accessor = |index: &Value| &json["accessors"][index.as_u64().unwrap() as usize];
+        assert_eq!(accessor(&primitive["indices"])["componentType"], index_type, "{}", case.name);
+        let colors = accessor(&primitive["attributes"]["COLOR_0"]);
+        assert_eq!((colors["type"].as_str(), colors["componentType"].as_u64()), (Some("VEC4"), Some(5126)));
+        let positions = accessor(&primitive["attributes"]["POSITION"]);
+        let mesh = import_gltf_slice(&bytes, None, "x.glb").unwrap().meshes.remove(0);
+        for a in 0..3 {
+            let min = mesh.positions_local.iter().map(|p| p[a]).fold(f32::INFINITY, f32::min);
+            let max = mesh.positions_local.iter().map(|p| p[a]).fold(f32::NEG_INFINITY, f32::max);
+            assert_eq!(positions["min"][a].as_f64().unwrap() as f32, min);
+            assert_eq!(positions["max"][a].as_f64().unwrap() as f32, max);
+        }
+    }
+}
+
+#[test]
+fn an_empty_store_is_refused_with_a_clear_error() {
+    let store = ColorStore::uniform(Topology::build(0, &[]).unwrap(), r(4), [1.0; 4]);
+    let error = export_tessellated_glb(&[], &store).unwrap_err();
+    assert!(matches!(error, ExportError::Empty), "{error}");
+    assert!(error.to_string().contains("no faces"), "{error}");
+    // Vertices without faces are not enough either.
+    let store = ColorStore::uniform(Topology::build(3, &[]).unwrap(), r(1), [1.0; 4]);
+    assert!(matches!(export_tessellated_glb(&[[0.0; 3]; 3], &store), Err(ExportError::Empty)));
+}
+
+#[test]
+fn bad_inputs_are_refused() {
+    let case = mixed_grid(41);
+    let short = &case.positions[1..];
+    assert!(matches!(
+        export_tessellated_glb(short, &case.store),
+        Err(ExportError::PositionCount { expected: 25, got: 24 })
+    ));
+    let mut positions = case.positions.clone();
+    positions[7][1] = f32::NAN;
+    assert!(matches!(
+        export_tessellated_glb(&positions, &case.store),
+        Err(ExportError::NonFinitePosition { vertex: 7 })
+    ));
+    let mut store = case.store.clone();
+    store.set(SampleRef::Interior { face: 3, offset: 0 }, [0.5, f32::INFINITY, 0.5, 1.0]);
+    let error = export_tessellated_glb(&case.positions, &store).unwrap_err();
+    assert!(matches!(error, ExportError::NonFiniteColor { face: 3, .. }), "{error}");
+}
+
+#[test]
+fn out_of_range_colours_are_clamped() {
+    let mut case = mixed_grid(51);
+    case.store.set(SampleRef::Vertex(0), [1.5, -0.25, 0.5, 2.0]);
+    let bytes = export_tessellated_glb(&case.positions, &case.store).unwrap();
+    let mesh = import_gltf_slice(&bytes, None, "x.glb").unwrap().meshes.remove(0);
+    let vertex = mesh.positions_local.iter().position(|&p| p == case.positions[0]).unwrap();
+    assert_eq!(mesh.colors[vertex], [1.0, 0.0, 0.5, 1.0]);
+}
+
+// ---------------------------------------------------------------------------------------
+// The command line
+
+#[test]
+fn cli_exports_glb_and_packed_files() {
+    use meshpaint::packed_file;
+    const BIN: &str = env!("CARGO_BIN_EXE_meshpaint");
+    let dir = TempDir::new("cli");
+    let input = model("BoxTextured/BoxTextured.glb");
+    let glb = dir.join("box.glb");
+    let run = |args: &[&std::ffi::OsStr]| Command::new(BIN).args(args).output().unwrap();
+    let output = run(&[
+        "export".as_ref(),
+        input.as_os_str(),
+        "-o".as_ref(),
+        glb.as_os_str(),
+        "--resolution".as_ref(),
+        "4".as_ref(),
+    ]);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let expected = open_model("BoxTextured/BoxTextured.glb", 4);
+    assert_eq!(std::fs::read(&glb).unwrap(), export_tessellated_glb(&expected.positions, &expected.store).unwrap());
+
+    // Any other extension: a packed file, RGBA8 unless --format says otherwise.
+    let packed = dir.join("box.mpk");
+    let output =
+        run(&["export".as_ref(), input.as_os_str(), "-o".as_ref(), packed.as_os_str(), "-r".as_ref(), "2".as_ref()]);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let mesh = packed_file::read_file(&packed).unwrap();
+    assert_eq!(mesh.format, meshpaint::color::ColorFormat::Rgba8Srgb);
+    assert_eq!(mesh.face_records.len(), 12);
+    let packed16 = dir.join("box16.mpk");
+    let args = [
+        "export".as_ref(),
+        input.as_os_str(),
+        "-o".as_ref(),
+        packed16.as_os_str(),
+        "--format".as_ref(),
+        "rgba16f".as_ref(),
+    ];
+    assert!(run(&args).status.success());
+    assert_eq!(packed_file::read_file(&packed16).unwrap().format, meshpaint::color::ColorFormat::Rgba16F);
+
+    // A packed file exports to .glb too (its own per-face resolutions, here R = 2).
+    let from_packed = dir.join("from_packed.glb");
+    assert!(run(&["export".as_ref(), packed.as_os_str(), "-o".as_ref(), from_packed.as_os_str()]).status.success());
+    let scene = import_gltf(&from_packed).unwrap();
+    assert_eq!(scene.meshes[0].positions_local.len(), 8 + 18);
+    assert_eq!(scene.meshes[0].triangles.len(), 12 * 4);
+
+    // Refusals: .gltf output, --format with .glb, a missing input; nothing is written.
+    let (x, y, z, missing) = (dir.join("x.gltf"), dir.join("y.glb"), dir.join("z.glb"), dir.join("missing.glb"));
+    let refusals: [(Vec<&std::ffi::OsStr>, &str); 3] = [
+        (vec![input.as_os_str(), "-o".as_ref(), x.as_os_str()], ".glb"),
+        (vec![input.as_os_str(), "-o".as_ref(), y.as_os_str(), "--format".as_ref(), "rgba8".as_ref()], "--format"),
+        (vec![missing.as_os_str(), "-o".as_ref(), z.as_os_str()], "missing.glb"),
+    ];
+    for (args, message) in refusals {
+        let mut full = vec!["export".as_ref()];
+        full.extend(args);
+        let output = run(&full);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success() && stderr.contains(message), "{stderr}");
+    }
+    for name in ["x.gltf", "y.glb", "z.glb"] {
+        assert!(!dir.join(name).exists());
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// COLOR_0 import
+
+/// A COLOR_0 accessor for a test triangle: type, componentType, normalized, count, bytes.
+struct ColorAttribute {
+    ty: &'static str,
+    component: u32,
+    normalized: bool,
+    count: usize,
+    bytes: Vec<u8>,
+}
+
+fn f32_bytes(values: &[f32]) -> Vec<u8> {
+    values.iter().flat_map(|v| v.to_le_bytes()).collect()
+}
+
+/// A .glb with one mesh of one triangle primitive (3 vertices) per entry, each with the
+/// given COLOR_0 or none.
+fn triangle_glb(primitives: &[Option<ColorAttribute>]) -> Vec<u8> {
+    let mut bin = Vec::new();
+    let (mut views, mut accessors, mut json_primitives) = (Vec::new(), Vec::new(), Vec::new());
+    let mut add_view = |bin: &mut Vec<u8>, bytes: &[u8]| {
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        views.push(json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()}));
+        bin.extend_from_slice(bytes);
+        views.len() - 1
+    };
+    for (p, color) in primitives.iter().enumerate() {
+        let x = p as f32 * 2.0;
+        let positions = f32_bytes(&[x, 0.0, 0.0, x + 1.0, 0.0, 0.0, x, 1.0, 0.0]);
+        let view = add_view(&mut bin, &positions);
+        accessors.push(json!({"bufferView": view, "componentType": 5126, "count": 3, "type": "VEC3",
+            "min": [x, 0.0, 0.0], "max": [x + 1.0, 1.0, 0.0]}));
+        let mut attributes = json!({"POSITION": accessors.len() - 1});
+        if let Some(color) = color {
+            let view = add_view(&mut bin, &color.bytes);
+            accessors.push(json!({"bufferView": view, "componentType": color.component, "count": color.count,
+                "type": color.ty, "normalized": color.normalized}));
+            attributes["COLOR_0"] = json!(accessors.len() - 1);
+        }
+        json_primitives.push(json!({"attributes": attributes}));
+    }
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let root = json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": views,
+        "accessors": accessors,
+        "meshes": [{"primitives": json_primitives}],
+        "nodes": [{"mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0,
+    });
+    let mut json_bytes = serde_json::to_vec(&root).unwrap();
+    while json_bytes.len() % 4 != 0 {
+        json_bytes.push(b' ');
+    }
+    let mut glb = Vec::new();
+    glb.extend_from_slice(b"glTF");
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&((12 + 8 + json_bytes.len() + 8 + bin.len()) as u32).to_le_bytes());
+    glb.extend_from_slice(&(json_bytes.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"JSON");
+    glb.extend_from_slice(&json_bytes);
+    glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"BIN\0");
+    glb.extend_from_slice(&bin);
+    glb
+}
+
+fn import_colors(primitives: &[Option<ColorAttribute>]) -> Result<(Vec<[f32; 4]>, Vec<String>), String> {
+    import_gltf_slice(&triangle_glb(primitives), None, "colors.glb")
+        .map(|scene| (scene.meshes[0].colors.clone(), scene.warnings))
+        .map_err(|error| error.to_string())
+}
+
+#[test]
+fn color_0_is_imported_as_linear_rgba() {
+    let float4 = ColorAttribute {
+        ty: "VEC4",
+        component: 5126,
+        normalized: false,
+        count: 3,
+        bytes: f32_bytes(&[0.1, 0.2, 0.3, 0.4, 1.0, 0.0, 0.5, 1.0, 0.25, 0.75, 0.125, 0.0]),
+    };
+    let (colors, warnings) = import_colors(&[Some(float4)]).unwrap();
+    assert_eq!(colors, vec![[0.1, 0.2, 0.3, 0.4], [1.0, 0.0, 0.5, 1.0], [0.25, 0.75, 0.125, 0.0]]);
+    assert!(warnings.is_empty(), "{warnings:?}");
+
+    let float3 = ColorAttribute {
+        ty: "VEC3",
+        component: 5126,
+        normalized: false,
+        count: 3,
+        bytes: f32_bytes(&[0.1, 0.2, 0.3, 1.0, 0.0, 0.5, 0.25, 0.75, 0.125]),
+    };
+    let (colors, _) = import_colors(&[Some(float3)]).unwrap();
+    assert_eq!(colors, vec![[0.1, 0.2, 0.3, 1.0], [1.0, 0.0, 0.5, 1.0], [0.25, 0.75, 0.125, 1.0]]);
+
+    // Normalized integers: c / 255 and c / 65535 (glTF 2.0, 3.11), still linear.
+    let u8x4 = ColorAttribute {
+        ty: "VEC4",
+        component: 5121,
+        normalized: true,
+        count: 3,
+        bytes: vec![0, 255, 51, 128, 255, 0, 0, 255, 1, 2, 3, 4],
+    };
+    let (colors, _) = import_colors(&[Some(u8x4)]).unwrap();
+    assert_eq!(colors[0], [0.0, 1.0, 51.0 / 255.0, 128.0 / 255.0]);
+    assert_eq!(colors[1], [1.0, 0.0, 0.0, 1.0]);
+    assert_eq!(colors[2], [1.0 / 255.0, 2.0 / 255.0, 3.0 / 255.0, 4.0 / 255.0]);
+
+    let u16x3: Vec<u8> = [0u16, 65535, 13107, 65535, 0, 1, 32768, 2, 3].iter().flat_map(|v| v.to_le_bytes()).collect();
+    let u16x3 = ColorAttribute { ty: "VEC3", component: 5123, normalized: true, count: 3, bytes: u16x3 };
+    let (colors, _) = import_colors(&[Some(u16x3)]).unwrap();
+    assert_eq!(colors[0], [0.0, 1.0, 0.2, 1.0]);
+    assert_eq!(colors[1], [1.0, 0.0, 1.0 / 65535.0, 1.0]);
+    assert_eq!(colors[2], [32768.0 / 65535.0, 2.0 / 65535.0, 3.0 / 65535.0, 1.0]);
+
+    // No COLOR_0 anywhere: empty. Only on the second primitive: the first's vertices are white.
+    assert_eq!(import_colors(&[None, None]).unwrap().0, Vec::<[f32; 4]>::new());
+    let second = ColorAttribute {
+        ty: "VEC3",
+        component: 5121,
+        normalized: true,
+        count: 3,
+        bytes: vec![0, 0, 0, 255, 0, 0, 0, 255, 0],
+    };
+    let (colors, _) = import_colors(&[None, Some(second), None]).unwrap();
+    assert_eq!(colors.len(), 9);
+    assert_eq!(&colors[0..3], &[[1.0; 4]; 3]);
+    assert_eq!(&colors[3..6], &[[0.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 1.0]]);
+    assert_eq!(&colors[6..9], &[[1.0; 4]; 3]);
+
+    // Non-finite colours become white and out-of-range ones are clamped, with warnings.
+    let odd = ColorAttribute {
+        ty: "VEC4",
+        component: 5126,
+        normalized: false,
+        count: 3,
+        bytes: f32_bytes(&[f32::NAN, 0.0, 0.0, 1.0, 1.5, -0.5, 0.5, 1.0, 0.5, 0.5, 0.5, 0.5]),
+    };
+    let (colors, warnings) = import_colors(&[Some(odd)]).unwrap();
+    assert_eq!(colors, vec![[1.0; 4], [1.0, 0.0, 0.5, 1.0], [0.5; 4]]);
+    assert!(warnings.iter().any(|w| w.contains("non-finite vertex colour")), "{warnings:?}");
+    assert!(warnings.iter().any(|w| w.contains("clamped")), "{warnings:?}");
+}
+
+#[test]
+fn bad_color_0_accessors_are_refused() {
+    let cases = [
+        // (type, componentType, normalized, count, bytes, expected message part)
+        ("VEC4", 5121, false, 3, vec![0u8; 12], "wrong accessor type"),
+        ("VEC3", 5120, true, 3, vec![0u8; 12], "wrong accessor type"),
+        ("VEC4", 5125, true, 3, vec![0u8; 48], "wrong accessor type"),
+        ("VEC2", 5126, false, 3, vec![0u8; 24], "expected VEC3 or VEC4"),
+        ("SCALAR", 5126, false, 3, vec![0u8; 12], "expected VEC3 or VEC4"),
+        ("VEC4", 5126, false, 2, vec![0u8; 32], "COLOR_0 has 2 elements"),
+        ("VEC4", 5126, false, 3, vec![0u8; 40], "out of bounds"),
+    ];
+    for (ty, component, normalized, count, bytes, message) in cases {
+        let attribute = ColorAttribute { ty, component, normalized, count, bytes };
+        let error = import_colors(&[Some(attribute)]).unwrap_err();
+        assert!(error.contains(message) && error.contains("colors.glb"), "{ty} {component}: {error}");
+        if message == "wrong accessor type" || message == "out of bounds" {
+            assert!(error.contains("COLOR_0"), "{error}");
+        }
+    }
+}

@@ -1,0 +1,802 @@
+//! The GPU renderer against the CPU reference sampler, per pixel, on a real adapter
+//! (lavapipe on machines without a GPU). These tests FAIL when no adapter exists.
+//!
+//! Truth per pixel: the ray through the pixel centre (`OrbitCamera::ray_through_pixel`) is
+//! intersected with every triangle in `f64` (no BVH: a handful of triangles), giving the face
+//! and its barycentrics; `meshpaint::sampler::sample` on the same `PackedMesh` gives the
+//! colour, encoded to sRGB8 as the render target does. Errors are reported in 8-bit steps.
+//! Pixels whose centre lies within a margin of a triangle edge are skipped (coverage rules),
+//! and for nearest filtering so are pixels within 1e-3 lattice units of a cell boundary.
+
+// Colour channels and image rows are indexed in parallel arrays; indices read clearest.
+#![allow(clippy::needless_range_loop)]
+
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+use glam::DVec3;
+use image::RgbaImage;
+use meshpaint::camera::{BoundingSphere, OrbitCamera};
+use meshpaint::color::{ColorFormat, encode_rgba8_srgb};
+use meshpaint::layout::{self, Resolution};
+use meshpaint::packed::PackedMesh;
+use meshpaint::packer::pack;
+use meshpaint::render::{
+    DrawItem, FilterMode, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderSettings, Renderer, Shading,
+};
+use meshpaint::sampler::{Filter, sample};
+use meshpaint::store::ColorStore;
+use meshpaint::topology::Topology;
+
+const SIZE: u32 = 256;
+/// Largest allowed per-channel difference in 8-bit steps.
+const MAX_STEPS: u32 = 2;
+/// Pixels whose centre has a barycentric coordinate below this are edge pixels (skipped).
+const EDGE_MARGIN: f64 = 1e-4;
+/// Nearest filtering: pixels within this many lattice units of a cell boundary are skipped.
+const CELL_MARGIN: f32 = 1e-3;
+
+struct Gpu {
+    ctx: GpuContext,
+    renderer: Renderer,
+}
+
+fn gpu() -> &'static Gpu {
+    static GPU: OnceLock<Result<Gpu, String>> = OnceLock::new();
+    let gpu = GPU.get_or_init(|| {
+        let ctx = GpuContext::new_headless().map_err(|error| error.to_string())?;
+        eprintln!("adapter: {}", ctx.describe());
+        let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT).map_err(|error| error.to_string())?;
+        Ok(Gpu { ctx, renderer })
+    });
+    match gpu {
+        Ok(gpu) => gpu,
+        Err(error) => panic!("GPU tests need an adapter (lavapipe: apt-get install mesa-vulkan-drivers): {error}"),
+    }
+}
+
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn unit(&mut self) -> f32 {
+        (self.next() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+fn r(value: u64) -> Resolution {
+    Resolution::new(value).unwrap()
+}
+
+/// A test scene: triangles, a camera, and the store they are coloured with.
+struct Scene {
+    positions: Vec<[f32; 3]>,
+    triangles: Vec<[u32; 3]>,
+    camera: OrbitCamera,
+    store: ColorStore,
+}
+
+/// Random colours with alpha in [0.5, 1] (the background is transparent black, so
+/// coverage shows in alpha).
+fn random_store(vertex_count: u32, triangles: &[[u32; 3]], resolutions: Vec<Resolution>, seed: u64) -> ColorStore {
+    let topology = Topology::build(vertex_count, triangles).unwrap();
+    let mut store = ColorStore::with_resolutions(topology, resolutions, [0.0; 4]).unwrap();
+    let mut rng = Rng(seed);
+    store.fill_with(|_| [rng.unit(), rng.unit(), rng.unit(), 0.5 + 0.5 * rng.unit()]);
+    store
+}
+
+/// A camera looking along −Z at `center` (yaw 0, pitch 0), framing a sphere of `radius`.
+fn square_camera(center: [f64; 3], radius: f64) -> OrbitCamera {
+    OrbitCamera::framing(BoundingSphere { center, radius }, 0.0, 0.0)
+}
+
+/// The world point on the plane `z = center.z` seen through pixel position `(x, y)`.
+fn unproject_to_plane(camera: &OrbitCamera, x: f64, y: f64) -> [f32; 3] {
+    let (origin, direction) = camera.ray_through_pixel(x, y, SIZE, SIZE);
+    let t = (camera.target[2] - origin.z) / direction.z;
+    let p = origin + direction * t;
+    [p.x as f32, p.y as f32, p.z as f32]
+}
+
+/// A scene of triangles facing the camera squarely (constant depth), with vertices at the
+/// given pixel positions (integer positions land exactly on the rasteriser's grid).
+fn square_scene(
+    pixels: &[[f64; 2]],
+    triangles: Vec<[u32; 3]>,
+    resolutions: Vec<Resolution>,
+    center: [f64; 3],
+    seed: u64,
+) -> Scene {
+    let camera = square_camera(center, 1.0);
+    let positions: Vec<[f32; 3]> = pixels.iter().map(|&[x, y]| unproject_to_plane(&camera, x, y)).collect();
+    let store = random_store(positions.len() as u32, &triangles, resolutions, seed);
+    Scene { positions, triangles, camera, store }
+}
+
+/// What the reference says about one pixel.
+enum Truth {
+    /// No triangle: background.
+    Background,
+    /// Too close to an edge (or to another surface) to call.
+    Ambiguous,
+    /// Face and barycentrics of the closest hit.
+    Hit(u32, [f64; 3]),
+}
+
+impl Scene {
+    /// Intersects the pixel-centre ray with every triangle (Möller–Trumbore in f64,
+    /// barycentrics of the plane hit even outside the triangle).
+    fn truth(&self, x: u32, y: u32) -> Truth {
+        let (origin, direction) = self.camera.ray_through_pixel(f64::from(x) + 0.5, f64::from(y) + 0.5, SIZE, SIZE);
+        let p = |v: u32| {
+            let p = self.positions[v as usize];
+            DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
+        };
+        let mut hits = Vec::new();
+        let mut ambiguous = false;
+        for (face, tri) in self.triangles.iter().enumerate() {
+            let (a, b, c) = (p(tri[0]), p(tri[1]), p(tri[2]));
+            let (e1, e2) = (b - a, c - a);
+            let pv = direction.cross(e2);
+            let det = e1.dot(pv);
+            if det.abs() < 1e-300 {
+                continue;
+            }
+            let tv = origin - a;
+            let u = tv.dot(pv) / det;
+            let qv = tv.cross(e1);
+            let v = direction.dot(qv) / det;
+            let t = e2.dot(qv) / det;
+            let bary = [1.0 - u - v, u, v];
+            let min = bary.iter().copied().fold(f64::INFINITY, f64::min);
+            if t <= 0.0 || min < -EDGE_MARGIN {
+                continue;
+            }
+            if min < EDGE_MARGIN {
+                ambiguous = true;
+            }
+            hits.push((t, face as u32, bary, min >= EDGE_MARGIN));
+        }
+        hits.sort_by(|a, b| a.0.total_cmp(&b.0));
+        match hits.first() {
+            None => Truth::Background,
+            Some(&(t, face, bary, inside)) => {
+                let close_second = hits.get(1).is_some_and(|second| (second.0 - t).abs() < 1e-6 * t);
+                if !inside || close_second || (ambiguous && hits.iter().any(|h| !h.3 && h.0 < t * (1.0 + 1e-6))) {
+                    Truth::Ambiguous
+                } else {
+                    Truth::Hit(face, bary)
+                }
+            }
+        }
+    }
+
+    fn packed(&self, format: ColorFormat) -> PackedMesh {
+        pack(&self.store, &self.positions, format).unwrap()
+    }
+}
+
+/// Whether nearest filtering at `level` could pick another sample within `CELL_MARGIN`
+/// lattice units of `bary` (the pixel is on a cell boundary).
+fn near_cell_boundary(packed: &PackedMesh, face: u32, bary: [f32; 3], level: u32) -> bool {
+    let r_face = packed.face_records[face as usize].resolution().unwrap();
+    let level = level.min(r_face.log2());
+    let res = r_face.at_level(level).unwrap();
+    let chosen = layout::nearest_sample(res, bary);
+    let d = CELL_MARGIN / res.get() as f32;
+    let moves: [[f32; 3]; 6] = [[-d, d, 0.0], [d, -d, 0.0], [-d, 0.0, d], [d, 0.0, -d], [0.0, d, -d], [0.0, -d, d]];
+    moves.iter().any(|m| layout::nearest_sample(res, std::array::from_fn(|k| bary[k] + m[k])) != chosen)
+}
+
+/// Statistics of one comparison.
+#[derive(Debug, Default)]
+struct Comparison {
+    compared: u64,
+    skipped: u64,
+    max_steps: u32,
+    sum_steps: f64,
+    over_limit: u64,
+    coverage_errors: u64,
+}
+
+impl Comparison {
+    fn mean(&self) -> f64 {
+        if self.compared == 0 { 0.0 } else { self.sum_steps / (self.compared as f64 * 4.0) }
+    }
+}
+
+fn output_dir() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/test-output");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn render(scene_mesh: &GpuMesh, camera: OrbitCamera, filter: FilterMode) -> RgbaImage {
+    let gpu = gpu();
+    let mut settings = RenderSettings::new(camera);
+    settings.filter = filter;
+    settings.shading = Shading::Unlit;
+    settings.background = [0.0; 4];
+    gpu.renderer.render_image(&gpu.ctx, DrawItem::MeshColors(scene_mesh), &settings, SIZE, SIZE).unwrap()
+}
+
+/// Renders `scene` in `format` with `filter` and compares every pixel with the CPU
+/// reference `(cpu_filter, level)` (`None` level = trilinear with the analytic `lod`).
+/// Returns the statistics; writes PNGs on failure.
+fn compare(
+    name: &str,
+    scene: &Scene,
+    mesh: &GpuMesh,
+    filter: FilterMode,
+    reference: impl Fn(u32, [f32; 3]) -> Option<[f32; 4]>,
+    skip: impl Fn(u32, [f32; 3]) -> bool,
+) -> Comparison {
+    let image = render(mesh, scene.camera, filter);
+    let mut expected = RgbaImage::new(SIZE, SIZE);
+    let mut stats = Comparison::default();
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let actual = image.get_pixel(x, y).0;
+            match scene.truth(x, y) {
+                Truth::Background => {
+                    if actual != [0; 4] {
+                        stats.coverage_errors += 1;
+                    }
+                }
+                Truth::Ambiguous => stats.skipped += 1,
+                Truth::Hit(face, bary64) => {
+                    let bary = bary64.map(|w| w as f32);
+                    if skip(face, bary) {
+                        stats.skipped += 1;
+                        continue;
+                    }
+                    if actual[3] == 0 {
+                        stats.coverage_errors += 1;
+                        continue;
+                    }
+                    let cpu = reference(face, bary).unwrap_or_else(|| panic!("{name}: CPU sample failed"));
+                    let want = encode_rgba8_srgb(cpu);
+                    expected.put_pixel(x, y, image::Rgba(want));
+                    let mut pixel_max = 0;
+                    for c in 0..4 {
+                        let steps = u32::from(want[c].abs_diff(actual[c]));
+                        stats.sum_steps += f64::from(steps);
+                        pixel_max = pixel_max.max(steps);
+                    }
+                    stats.max_steps = stats.max_steps.max(pixel_max);
+                    if pixel_max > MAX_STEPS {
+                        stats.over_limit += 1;
+                    }
+                    stats.compared += 1;
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{name}: max {} steps, mean {:.4} steps, {} px compared, {} skipped, {} over {MAX_STEPS}, {} coverage errors",
+        stats.max_steps,
+        stats.mean(),
+        stats.compared,
+        stats.skipped,
+        stats.over_limit,
+        stats.coverage_errors
+    );
+    if stats.over_limit > 0 || stats.coverage_errors > 0 {
+        let dir = output_dir();
+        let file = name.replace([' ', '=', '/'], "_");
+        image.save(dir.join(format!("{file}.actual.png"))).unwrap();
+        expected.save(dir.join(format!("{file}.expected.png"))).unwrap();
+        let diff = RgbaImage::from_fn(SIZE, SIZE, |x, y| {
+            let (a, e) = (image.get_pixel(x, y).0, expected.get_pixel(x, y).0);
+            let d = |c: usize| a[c].abs_diff(e[c]).saturating_mul(16);
+            image::Rgba([d(0), d(1), d(2), 255])
+        });
+        diff.save(dir.join(format!("{file}.diff.png"))).unwrap();
+    }
+    stats
+}
+
+fn upload(packed: &PackedMesh, atlas_width: Option<u32>) -> GpuMesh {
+    let gpu = gpu();
+    GpuMesh::upload(&gpu.ctx, &gpu.renderer, packed, &MeshUploadOptions { atlas_width }).unwrap()
+}
+
+/// Nearest at level 0, then linear and nearest at every level of the finest face.
+fn fixed_filters(max_log2: u32) -> Vec<(FilterMode, Filter, u32)> {
+    let mut filters = vec![(FilterMode::Nearest, Filter::Nearest, 0), (FilterMode::Linear, Filter::Linear, 0)];
+    for level in 0..=max_log2 {
+        filters.push((FilterMode::MipLevel(level), Filter::Linear, level));
+        filters.push((FilterMode::NearestMipLevel(level), Filter::Nearest, level));
+    }
+    filters
+}
+
+fn filter_name(filter: FilterMode) -> String {
+    match filter {
+        FilterMode::Nearest => "nearest".into(),
+        FilterMode::Linear => "linear".into(),
+        FilterMode::MipLevel(level) => format!("linear L{level}"),
+        FilterMode::NearestMipLevel(level) => format!("nearest L{level}"),
+        FilterMode::Trilinear => "trilinear".into(),
+    }
+}
+
+/// Compares `scene` for every format and fixed filter; returns the failures.
+fn compare_all_fixed(label: &str, scene: &Scene, max_log2: u32) -> Vec<String> {
+    let mut failures = Vec::new();
+    for format in ColorFormat::ALL {
+        let packed = scene.packed(format);
+        let mesh = upload(&packed, None);
+        for (mode, cpu_filter, level) in fixed_filters(max_log2) {
+            let name = format!("{label} {} {}", format.name(), filter_name(mode));
+            let stats = compare(
+                &name,
+                scene,
+                &mesh,
+                mode,
+                |face, bary| sample(&packed, face, bary, cpu_filter, level),
+                |face, bary| cpu_filter == Filter::Nearest && near_cell_boundary(&packed, face, bary, level),
+            );
+            if stats.over_limit > 0 || stats.coverage_errors > 0 || stats.compared == 0 {
+                failures.push(format!("{name}: {stats:?}"));
+            }
+        }
+    }
+    failures
+}
+
+/// One large triangle facing the camera, vertices on integer pixel positions.
+fn big_triangle(resolution: u64, seed: u64) -> Scene {
+    square_scene(
+        &[[14.0, 236.0], [243.0, 221.0], [97.0, 9.0]],
+        vec![[0, 1, 2]],
+        vec![r(resolution)],
+        [0.0, 0.0, 0.0],
+        seed,
+    )
+}
+
+fn square_on_triangle(resolution: u64) {
+    let scene = big_triangle(resolution, 0x9E37_79B9 ^ resolution);
+    let failures = compare_all_fixed(&format!("triangle R={resolution}"), &scene, r(resolution).log2());
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn square_on_triangle_r1() {
+    square_on_triangle(1);
+}
+
+#[test]
+fn square_on_triangle_r2() {
+    square_on_triangle(2);
+}
+
+#[test]
+fn square_on_triangle_r8() {
+    square_on_triangle(8);
+}
+
+#[test]
+fn square_on_triangle_r64() {
+    square_on_triangle(64);
+}
+
+#[test]
+fn square_on_triangle_r4096() {
+    square_on_triangle(4096);
+}
+
+/// Trilinear: on a square-on triangle the lattice footprint per pixel is constant, so the
+/// level of detail is known analytically; the GPU must blend the two CPU levels.
+#[test]
+fn trilinear_matches_the_analytic_level_of_detail() {
+    let mut failures = Vec::new();
+    for resolution in [256u64, 4096] {
+        let scene = big_triangle(resolution, 77 + resolution);
+        // Screen-space gradient of (w1, w2) from the projected vertices.
+        let q: Vec<(f64, f64)> = scene
+            .positions
+            .iter()
+            .map(|p| {
+                let world = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+                scene.camera.project(world, SIZE, SIZE).unwrap()
+            })
+            .collect();
+        let area = (q[1].0 - q[0].0) * (q[2].1 - q[0].1) - (q[2].0 - q[0].0) * (q[1].1 - q[0].1);
+        // w1 = ((p − q0) × (q2 − q0)) / area, w2 = ((q1 − q0) × (p − q0)) / area.
+        let dw1 = ((q[2].1 - q[0].1) / area, -(q[2].0 - q[0].0) / area);
+        let dw2 = (-(q[1].1 - q[0].1) / area, (q[1].0 - q[0].0) / area);
+        let res = resolution as f64;
+        let along_x = res * (dw1.0 * dw1.0 + dw2.0 * dw2.0).sqrt();
+        let along_y = res * (dw1.1 * dw1.1 + dw2.1 * dw2.1).sqrt();
+        let lod = along_x.max(along_y).log2().clamp(0.0, res.log2());
+        let (l0, t) = (lod.floor() as u32, (lod - lod.floor()) as f32);
+        assert!(t > 0.01 && t < 0.99, "pick a geometry whose lod is not near an integer: {lod}");
+        for format in ColorFormat::ALL {
+            let packed = scene.packed(format);
+            let mesh = upload(&packed, None);
+            let name = format!("trilinear R={resolution} {} lod {lod:.3}", format.name());
+            let stats = compare(
+                &name,
+                &scene,
+                &mesh,
+                FilterMode::Trilinear,
+                |face, bary| {
+                    let a = sample(&packed, face, bary, Filter::Linear, l0)?;
+                    let b = sample(&packed, face, bary, Filter::Linear, l0 + 1)?;
+                    Some(std::array::from_fn(|c| a[c] + (b[c] - a[c]) * t))
+                },
+                |_, _| false,
+            );
+            if stats.over_limit > 0 || stats.coverage_errors > 0 || stats.compared == 0 {
+                failures.push(format!("{name}: {stats:?}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// R = 2 next to R = 32 across a shared edge that the two faces walk in opposite
+/// directions: both must read the shared edge chain correctly at every level.
+#[test]
+fn mixed_resolutions_across_a_shared_edge() {
+    let scene = square_scene(
+        &[[18.0, 31.0], [229.0, 44.0], [37.0, 223.0], [241.0, 238.0]],
+        vec![[0, 1, 2], [2, 1, 3]],
+        vec![r(2), r(32)],
+        [0.0, 0.0, 0.0],
+        4242,
+    );
+    assert!(scene.store.topology().is_reversed(1, 0), "face 1 walks the shared edge 2→1");
+    let failures = compare_all_fixed("shared edge R=2|32", &scene, 5);
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The octahedron in perspective with eight different resolutions (1..32): vertex pulling
+/// with many faces, perspective-correct barycentrics, every edge orientation.
+#[test]
+fn octahedron_in_perspective_with_mixed_resolutions() {
+    let positions =
+        vec![[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+    let triangles = vec![[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+    let resolutions = [1, 2, 4, 8, 16, 4, 1, 32].map(r).to_vec();
+    let store = random_store(6, &triangles, resolutions, 99);
+    let mut camera = OrbitCamera::framing(BoundingSphere::of_points(&positions), 35.0, 25.0);
+    camera.distance *= 0.8;
+    let scene = Scene { positions, triangles, camera, store };
+    let failures = compare_all_fixed("octahedron", &scene, 5);
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// A colour atlas forced to tiny widths (61, not a power of two; 1; 7) renders exactly the
+/// same image as the default width.
+#[test]
+fn tiny_atlas_widths_render_the_same_image() {
+    let scenes = [
+        ("triangle R=64", big_triangle(64, 5)),
+        (
+            "shared edge",
+            square_scene(
+                &[[18.0, 31.0], [229.0, 44.0], [37.0, 223.0], [241.0, 238.0]],
+                vec![[0, 1, 2], [2, 1, 3]],
+                vec![r(8), r(32)],
+                [0.0, 0.0, 0.0],
+                6,
+            ),
+        ),
+    ];
+    for (label, scene) in &scenes {
+        for format in ColorFormat::ALL {
+            let packed = scene.packed(format);
+            let reference = upload(&packed, None);
+            assert!(reference.atlas.height == 1, "the default atlas holds these samples in one row");
+            for width in [61u32, 7, 1] {
+                let narrow = upload(&packed, Some(width));
+                assert_eq!(narrow.atlas.width, width);
+                assert_eq!(u64::from(narrow.atlas.height), packed.sample_count().div_ceil(u64::from(width)));
+                for filter in [FilterMode::Nearest, FilterMode::Linear, FilterMode::MipLevel(2), FilterMode::Trilinear]
+                {
+                    let want = render(&reference, scene.camera, filter);
+                    let got = render(&narrow, scene.camera, filter);
+                    if want != got {
+                        let dir = output_dir();
+                        let file = format!("atlas_{}_{}_{width}", label.replace(' ', "_"), format.name());
+                        got.save(dir.join(format!("{file}.actual.png"))).unwrap();
+                        want.save(dir.join(format!("{file}.expected.png"))).unwrap();
+                        panic!(
+                            "{label} {} width {width} {filter:?}: image differs from the default width",
+                            format.name()
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A sliver (1.5 px tall, 230 px long) next to a zero-area face, lit and unlit: no NaN,
+/// no garbage, and the sliver's pixels match the CPU.
+#[test]
+fn sliver_and_degenerate_faces() {
+    let scene = square_scene(
+        &[[10.0, 100.0], [246.0, 103.0], [128.0, 103.0], [20.0, 200.0], [120.0, 200.0], [220.0, 200.0]],
+        vec![[0, 1, 2], [3, 4, 5]],
+        vec![r(16), r(4)],
+        [0.0, 0.0, 0.0],
+        11,
+    );
+    let mut failures = Vec::new();
+    for format in ColorFormat::ALL {
+        let packed = scene.packed(format);
+        let mesh = upload(&packed, None);
+        for (mode, cpu_filter, level) in [
+            (FilterMode::Nearest, Filter::Nearest, 0),
+            (FilterMode::Linear, Filter::Linear, 0),
+            (FilterMode::MipLevel(2), Filter::Linear, 2),
+        ] {
+            let name = format!("sliver {} {}", format.name(), filter_name(mode));
+            let stats = compare(
+                &name,
+                &scene,
+                &mesh,
+                mode,
+                |face, bary| sample(&packed, face, bary, cpu_filter, level),
+                |face, bary| cpu_filter == Filter::Nearest && near_cell_boundary(&packed, face, bary, level),
+            );
+            if stats.over_limit > 0 || stats.coverage_errors > 0 || stats.compared < 30 {
+                failures.push(format!("{name}: {stats:?}"));
+            }
+        }
+        // Lit with trilinear and overlays: every covered pixel is finite colour, the rest background.
+        let gpu = gpu();
+        let mut settings = RenderSettings::new(scene.camera);
+        settings.overlays.wireframe = true;
+        settings.background = [0.0; 4];
+        let image = gpu.renderer.render_image(&gpu.ctx, DrawItem::MeshColors(&mesh), &settings, SIZE, SIZE).unwrap();
+        let covered = image.pixels().filter(|p| p.0[3] != 0).count();
+        assert!((30..2000).contains(&covered), "{covered} pixels covered");
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The big triangle translated by 1e6 on every axis: positions go to the GPU relative to
+/// the render origin, so the image matches the CPU as well as at the origin.
+#[test]
+fn far_from_the_origin() {
+    let center = [1.0e6, -1.0e6, 1.0e6];
+    // Size the triangle so that f32 positions (spacing 0.0625 at 1e6) barely move it.
+    let camera = square_camera(center, 200.0);
+    let pixels = [[14.0, 236.0], [243.0, 221.0], [97.0, 9.0]];
+    let positions: Vec<[f32; 3]> = pixels.iter().map(|&[x, y]| unproject_to_plane(&camera, x, y)).collect();
+    for p in &positions {
+        assert!(p[0] > 9.0e5 && p[2] > 9.0e5, "{p:?}");
+    }
+    let triangles = vec![[0, 1, 2]];
+    let store = random_store(3, &triangles, vec![r(64)], 1234);
+    let scene = Scene { positions, triangles, camera, store };
+    let failures = compare_all_fixed("offset 1e6 R=64", &scene, 3);
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// One R = 4096 face covering the whole 256×256 image (vertices far outside the viewport).
+#[test]
+fn r4096_face_fills_the_screen() {
+    let scene = square_scene(
+        &[[-300.0, 420.0], [560.0, 400.0], [120.0, -500.0]],
+        vec![[0, 1, 2]],
+        vec![r(4096)],
+        [0.0, 0.0, 0.0],
+        31337,
+    );
+    let mut failures = Vec::new();
+    for format in ColorFormat::ALL {
+        let packed = scene.packed(format);
+        let mesh = upload(&packed, None);
+        for (mode, cpu_filter, level) in [
+            (FilterMode::Nearest, Filter::Nearest, 0),
+            (FilterMode::Linear, Filter::Linear, 0),
+            (FilterMode::MipLevel(3), Filter::Linear, 3),
+            (FilterMode::NearestMipLevel(7), Filter::Nearest, 7),
+            (FilterMode::MipLevel(12), Filter::Linear, 12),
+        ] {
+            let name = format!("fill R=4096 {} {}", format.name(), filter_name(mode));
+            let stats = compare(
+                &name,
+                &scene,
+                &mesh,
+                mode,
+                |face, bary| sample(&packed, face, bary, cpu_filter, level),
+                |face, bary| cpu_filter == Filter::Nearest && near_cell_boundary(&packed, face, bary, level),
+            );
+            if stats.over_limit > 0 || stats.coverage_errors > 0 || stats.compared < u64::from(SIZE * SIZE) * 9 / 10 {
+                failures.push(format!("{name}: {stats:?}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+fn model(relative: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/models").join(relative)
+}
+
+/// Mean per-channel difference (8-bit steps) over pixels covered in both images, and the
+/// number of pixels covered in exactly one.
+fn image_difference(a: &RgbaImage, b: &RgbaImage, background: [u8; 4]) -> (f64, u64, u64) {
+    let (mut sum, mut both, mut one) = (0u64, 0u64, 0u64);
+    for (pa, pb) in a.pixels().zip(b.pixels()) {
+        match (pa.0 != background, pb.0 != background) {
+            (true, true) => {
+                both += 1;
+                sum += (0..3).map(|c| u64::from(pa.0[c].abs_diff(pb.0[c]))).sum::<u64>();
+            }
+            (false, false) => {}
+            _ => one += 1,
+        }
+    }
+    (sum as f64 / (both.max(1) * 3) as f64, both, one)
+}
+
+/// Mesh colors (texture baked at R = 16, trilinear) and the UV baseline (hardware
+/// trilinear) draw the Duck alike: same silhouette, small mean colour difference.
+#[test]
+fn mesh_colors_and_the_uv_baseline_look_alike() {
+    use meshpaint::render::{BaselineMesh, default_camera};
+    let gpu = gpu();
+    let path = model("Duck/Duck.glb");
+    let document = meshpaint::document::Document::open(&path, r(16)).unwrap();
+    let packed = document.pack(ColorFormat::Rgba8Srgb).unwrap();
+    let mesh = upload(&packed, None);
+    let scene = meshpaint::import::import_gltf(&path).unwrap();
+    let welded = meshpaint::weld::weld_scene(&scene);
+    let (material, texture) =
+        scene.materials.iter().find_map(|m| Some((m, scene.textures.get(m.base_color_texture? as usize)?))).unwrap();
+    let baseline = BaselineMesh::new(
+        &gpu.ctx,
+        &gpu.renderer,
+        &welded.positions_world,
+        &welded.triangles,
+        &welded.corner_uvs,
+        texture,
+        material.base_color_factor,
+    )
+    .unwrap();
+    let mut settings = RenderSettings::new(default_camera(&document.positions, 30.0, 20.0, None));
+    settings.background = [0.0; 4];
+    for shading in [Shading::Unlit, Shading::Lit] {
+        settings.shading = shading;
+        let ours = gpu.renderer.render_image(&gpu.ctx, DrawItem::MeshColors(&mesh), &settings, SIZE, SIZE).unwrap();
+        let theirs = gpu.renderer.render_image(&gpu.ctx, DrawItem::Baseline(&baseline), &settings, SIZE, SIZE).unwrap();
+        let (mean, both, one) = image_difference(&ours, &theirs, [0; 4]);
+        eprintln!(
+            "Duck R=16 vs UV baseline ({shading:?}): mean {mean:.3} steps over {both} px, {one} px differ in coverage"
+        );
+        if mean > 4.0 || both < 10_000 || one > both / 200 {
+            let dir = output_dir();
+            ours.save(dir.join(format!("duck_equivalence_{shading:?}.actual.png"))).unwrap();
+            theirs.save(dir.join(format!("duck_equivalence_{shading:?}.expected.png"))).unwrap();
+            panic!("mesh colors and the UV baseline differ: mean {mean} steps, {both} px, {one} coverage");
+        }
+    }
+}
+
+const BIN: &str = env!("CARGO_BIN_EXE_meshpaint");
+
+fn run_cli(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(BIN).args(args).output().unwrap()
+}
+
+fn temp_png(name: &str) -> PathBuf {
+    output_dir().join(format!("cli-{}-{name}.png", std::process::id()))
+}
+
+#[test]
+fn cli_render_writes_pngs_of_the_requested_size() {
+    let cases: [(&str, Vec<&str>); 5] = [
+        ("default", vec![]),
+        ("nearest", vec!["--filter", "nearest", "--shading", "unlit", "--resolution", "4", "--wireframe"]),
+        ("mip", vec!["--filter", "mip", "--level", "2", "--heatmap", "--yaw", "-45", "--pitch", "-10"]),
+        ("linear", vec!["--filter", "linear", "--distance", "5"]),
+        ("baseline", vec!["--baseline-uv", "--wireframe"]),
+    ];
+    let file = model("BoxTextured/BoxTextured.glb");
+    for (name, extra) in cases {
+        let out = temp_png(name);
+        let mut args = vec!["render", file.to_str().unwrap(), "-o", out.to_str().unwrap(), "--width", "96"];
+        args.extend(["--height", "64"]);
+        args.extend(extra);
+        let output = run_cli(&args);
+        assert!(output.status.success(), "{name}: {}", String::from_utf8_lossy(&output.stderr));
+        let image = image::open(&out).unwrap().to_rgba8();
+        assert_eq!(image.dimensions(), (96, 64), "{name}");
+        let background = *image.get_pixel(0, 0);
+        assert!(image.pixels().any(|p| *p != background), "{name}: the box is visible");
+        std::fs::remove_file(&out).unwrap();
+    }
+}
+
+#[test]
+fn cli_render_refuses_bad_requests_with_a_message() {
+    let textured = model("BoxTextured/BoxTextured.glb");
+    let untextured = model("Suzanne/monkey.glb");
+    let out = temp_png("refused");
+    let out = out.to_str().unwrap();
+    let cases: [(Vec<&str>, &str); 5] = [
+        (vec![textured.to_str().unwrap(), "--filter", "mip"], "--level"),
+        (vec![textured.to_str().unwrap(), "--filter", "trilinear", "--level", "1"], "--level"),
+        (vec![textured.to_str().unwrap(), "--resolution", "3"], "resolution"),
+        (vec![textured.to_str().unwrap(), "--width", "0"], "render size"),
+        (vec![untextured.to_str().unwrap(), "--baseline-uv"], "base-colour texture"),
+    ];
+    for (args, expected) in cases {
+        let mut full = vec!["render", "-o", out];
+        full.extend(args.iter().copied());
+        let output = run_cli(&full);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{args:?} should fail");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
+fn atlas_layout_wraps_rows_and_refuses_what_does_not_fit() {
+    use meshpaint::render::{AtlasLayout, RenderError};
+    let atlas = AtlasLayout::new(1000, 61, 16384).unwrap();
+    assert_eq!((atlas.width, atlas.height), (61, 17));
+    assert_eq!(atlas.texel(0), (0, 0));
+    assert_eq!(atlas.texel(60), (60, 0));
+    assert_eq!(atlas.texel(61), (0, 1));
+    assert_eq!(atlas.texel(999), (999 % 61, 999 / 61));
+    assert_eq!(AtlasLayout::new(0, 16384, 16384).unwrap().height, 1, "an empty buffer still gets one row");
+    // 2^28 samples (MAX_SAMPLES) fill a 16384² atlas exactly; one more does not fit.
+    let full = AtlasLayout::new(meshpaint::packed::MAX_SAMPLES, 16384, 16384).unwrap();
+    assert_eq!(full.height, 16384);
+    assert!(matches!(
+        AtlasLayout::new(meshpaint::packed::MAX_SAMPLES + 1, 16384, 16384),
+        Err(RenderError::AtlasTooLarge { .. })
+    ));
+    assert!(matches!(AtlasLayout::new(10, 0, 16384), Err(RenderError::InvalidAtlasWidth { .. })));
+    assert!(matches!(AtlasLayout::new(10, 20000, 16384), Err(RenderError::InvalidAtlasWidth { .. })));
+}
+
+/// A mesh whose atlas would need more rows than the device allows is refused with an
+/// error, not a panic or a truncated upload.
+#[test]
+fn uploads_that_do_not_fit_are_errors() {
+    let gpu = gpu();
+    let packed = big_triangle(64, 3).packed(ColorFormat::Rgba8Srgb);
+    let error = GpuMesh::upload(&gpu.ctx, &gpu.renderer, &packed, &MeshUploadOptions { atlas_width: Some(0) });
+    assert!(error.is_err());
+    let mut broken = packed.clone();
+    broken.indices[0][1] = 99;
+    assert!(GpuMesh::upload(&gpu.ctx, &gpu.renderer, &broken, &MeshUploadOptions::default()).is_err());
+    let mut broken = packed.clone();
+    broken.face_records.clear();
+    assert!(GpuMesh::upload(&gpu.ctx, &gpu.renderer, &broken, &MeshUploadOptions::default()).is_err());
+}
+
+/// No adapter is an error (the renderer never silently skips): the Metal backend does not
+/// exist on this platform.
+#[test]
+fn no_adapter_is_an_error() {
+    let file = model("BoxTextured/BoxTextured.glb");
+    let out = temp_png("no-adapter");
+    let output = std::process::Command::new(BIN)
+        .args(["render", file.to_str().unwrap(), "-o", out.to_str().unwrap(), "--width", "8", "--height", "8"])
+        .env("WGPU_BACKEND", "metal")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if cfg!(target_os = "macos") {
+        return;
+    }
+    assert!(!output.status.success(), "{stderr}");
+    assert!(stderr.contains("no GPU adapter"), "{stderr}");
+}
