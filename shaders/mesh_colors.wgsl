@@ -3,12 +3,23 @@
 // The vertex stage draws 3·F vertices without a vertex buffer: face = vertex_index / 3,
 // corner = vertex_index % 3, positions pulled from the index and position storage
 // buffers (positions are relative to the render origin, see src/render/mesh_gpu.rs).
+// It also reads the face record and decodes everything per face the fragment stage
+// needs into flat varyings, so a fragment reads no storage buffer: its only memory
+// accesses are the atlas texels of its samples.
 //
 // The fragment stage mirrors the CPU reference exactly — keep in sync with:
 //   src/layout.rs   `sanitize_barycentric`, `linear_samples_uv`, `nearest_sample`,
 //                   `edge_storage_offset`, `edge_level_offset`, `interior_level_offset`
 //   src/sampler.rs  `packed_sample_index`, `sample`
-// Same f32 operations in the same order, same clamping, same sub-triangle choice.
+// Same f32 operations in the same order, same clamping, same sub-triangle choice; the
+// integer addressing is the same arithmetic rearranged (branch-free, u32 wrapping, exact).
+//
+// Performance notes (software rasterisers such as lavapipe run fragments as SIMD lanes
+// and execute both sides of every `if` under a mask): the filter and level mode are
+// pipeline-overridable constants (`FILTER_KIND`, `LEVEL_MODE`), one pipeline each, so a
+// fragment runs only its own filter's code; lattice-point classification uses `select`
+// instead of branches; level offsets are computed once per face (fixed level, in the
+// vertex stage) or once per fragment and level (automatic level), never per sample.
 //
 // The colour buffer lives in a 2D "colour atlas" texture of width `atlas_width`: sample
 // `index` is texel (index % W, index / W). Rgba8 sRGB samples are decoded to linear by
@@ -24,9 +35,11 @@ struct FrameUniforms {
     wire_color: vec4<f32>,
     // Multiplies the base colour (the baseline's glTF baseColorFactor; 1 for mesh colors).
     tint: vec4<f32>,
-    // 0 = nearest, 1 = linear.
+    // 0 = nearest, 1 = linear. The mesh-colors pipeline is chosen by it: the shader reads
+    // the override FILTER_KIND, which the renderer sets to the same value.
     filter_kind: u32,
-    // 0 = fixed level `level`, 1 = automatic level from screen-space derivatives.
+    // 0 = fixed level `level`, 1 = automatic level from screen-space derivatives (chosen
+    // by pipeline, as filter_kind: the shader reads the override LEVEL_MODE).
     level_mode: u32,
     // Fixed MIP level (clamped per face to log2 R_f).
     level: u32,
@@ -48,6 +61,12 @@ struct FrameUniforms {
     _pad1: u32,
 }
 
+// Pipeline constants, set by the renderer from `FilterMode::uniform_fields` (keep in sync
+// with `MeshPipelineKey` in src/render/renderer.rs): 0 = nearest, 1 = linear.
+override FILTER_KIND: u32 = 1u;
+// 0 = fixed level `u.level`, 1 = automatic level (trilinear).
+override LEVEL_MODE: u32 = 1u;
+
 const FLAG_LIT: u32 = 1u;
 const FLAG_WIREFRAME: u32 = 2u;
 const FLAG_HEATMAP: u32 = 4u;
@@ -66,11 +85,45 @@ const MAX_LOG2_RESOLUTION: u32 = 12u;
 @group(0) @binding(3) var<storage, read> face_records: array<vec4<u32>>;
 @group(0) @binding(4) var atlas: texture_2d<f32>;
 
+// Per-face addressing at one MIP level: the colour-buffer index of every lattice point
+// (i, j) of resolution `r` follows from these (see `sample_index`).
+struct LevelData {
+    // Resolution at this level, R_f >> level.
+    r: u32,
+    // Colour index of corner c's vertex sample at this level.
+    vertex: vec3<u32>,
+    // Face edge k: the sample at position p (1..r-1 from the edge's start corner) is
+    // edge_start[k] + p · edge_step[k] (u32 wrapping; edge_step is −stride when the face
+    // walks the edge against its canonical direction).
+    edge_start: vec3<u32>,
+    edge_step: vec3<u32>,
+    // Colour index of interior offset 0 at this level.
+    interior: u32,
+}
+
+// Per-face data that does not depend on the level (automatic level of detail).
+struct FaceData {
+    log2_f: u32,
+    // Vertex id · vertex_levels of each corner.
+    vertex_base: vec3<u32>,
+    edge_base: vec3<u32>,
+    // log2 R_e of each face edge, clamped to [log2 R_f, MAX_LOG2_RESOLUTION].
+    edge_log2: vec3<u32>,
+    // Whether face edge k runs against its canonical direction (lower → higher vertex id).
+    reversed: vec3<bool>,
+    interior_base: u32,
+}
+
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) bary: vec3<f32>,
-    @location(1) @interpolate(flat) face: u32,
-    @location(2) @interpolate(flat) normal: vec3<f32>,
+    @location(1) @interpolate(flat) normal: vec3<f32>,
+    // LEVEL_MODE 0: `LevelData` at the face's fixed level; 1: `FaceData` (see pack_*).
+    @location(2) @interpolate(flat) face0: vec4<u32>,
+    @location(3) @interpolate(flat) face1: vec4<u32>,
+    @location(4) @interpolate(flat) face2: vec4<u32>,
+    // Heat-map colour (linear RGB) and log2 R_f of the face.
+    @location(5) @interpolate(flat) heat: vec3<f32>,
 }
 
 fn face_corners(face: u32) -> vec3<u32> {
@@ -89,6 +142,115 @@ fn is_finite(x: f32) -> bool {
 
 fn is_nan(x: f32) -> bool {
     return (bitcast<u32>(x) & 0x7fffffffu) > 0x7f800000u;
+}
+
+// layout::edge_level_offset: 2R − 2(R >> level) − level.
+fn edge_level_offset(log2_r: u32, level: u32) -> u32 {
+    return 2u * (1u << log2_r) - 2u * (1u << (log2_r - level)) - level;
+}
+
+// layout::interior_level_offset (thesis eq. 3.4b, closed form), m = log2 R, l = level.
+fn interior_level_offset(m: u32, l: u32) -> u32 {
+    let squares = ((1u << (2u * m + 1u)) - (1u << (2u * (m - l) + 1u))) / 3u;
+    let linear = 3u * ((1u << m) - (1u << (m - l)));
+    return squares + l - linear;
+}
+
+// Decodes the face record and corners of `face` (sampler::packed_sample_index's inputs).
+fn face_data(face: u32, corners: vec3<u32>) -> FaceData {
+    let record = face_records[min(face, max(u.face_count, 1u) - 1u)];
+    var f: FaceData;
+    f.log2_f = min(record.x >> LOG2_SHIFT, MAX_LOG2_RESOLUTION);
+    f.vertex_base = corners * u.vertex_levels;
+    let edges = record.yzw;
+    f.edge_base = edges & vec3<u32>(BASE_MASK);
+    // A valid record never has R_e < R_f; a corrupt one reads something in range.
+    f.edge_log2 = clamp(edges >> vec3<u32>(LOG2_SHIFT), vec3<u32>(f.log2_f), vec3<u32>(MAX_LOG2_RESOLUTION));
+    f.reversed = corners > corners.yzx;
+    f.interior_base = record.x & BASE_MASK;
+    return f;
+}
+
+// The addressing of face `f` at `level` (<= log2 R_f), sampler::packed_sample_index with
+// everything that does not depend on (i, j) folded into start values.
+fn level_data(f: FaceData, level: u32) -> LevelData {
+    var d: LevelData;
+    d.r = 1u << (f.log2_f - level);
+    d.vertex = f.vertex_base + vec3<u32>(min(level, max(u.vertex_levels, 1u) - 1u));
+    for (var k = 0u; k < 3u; k++) {
+        let log2_e = f.edge_log2[k];
+        let stride = 1u << (log2_e - f.log2_f);
+        let r_edge_level = 1u << (log2_e - level);
+        let start = f.edge_base[k] + edge_level_offset(log2_e, level);
+        // Storage offset p·stride − 1 forwards, r_edge_level − 1 − p·stride reversed.
+        d.edge_start[k] = select(start - 1u, start + r_edge_level - 1u, f.reversed[k]);
+        d.edge_step[k] = select(stride, 0u - stride, f.reversed[k]);
+    }
+    d.interior = f.interior_base + interior_level_offset(f.log2_f, level);
+    return d;
+}
+
+// Flat-varying encodings of LevelData and FaceData (three vec4<u32>).
+fn pack_level(d: LevelData) -> array<vec4<u32>, 3> {
+    return array<vec4<u32>, 3>(
+        vec4<u32>(d.r, d.vertex),
+        vec4<u32>(d.edge_start, d.interior),
+        vec4<u32>(d.edge_step, 0u),
+    );
+}
+
+fn unpack_level(a: vec4<u32>, b: vec4<u32>, c: vec4<u32>) -> LevelData {
+    var d: LevelData;
+    d.r = a.x;
+    d.vertex = a.yzw;
+    d.edge_start = b.xyz;
+    d.interior = b.w;
+    d.edge_step = c.xyz;
+    return d;
+}
+
+fn pack_face(f: FaceData) -> array<vec4<u32>, 3> {
+    let bits = f.log2_f | (f.edge_log2.x << 4u) | (f.edge_log2.y << 8u) | (f.edge_log2.z << 12u)
+        | (select(0u, 1u, f.reversed.x) << 16u) | (select(0u, 1u, f.reversed.y) << 17u)
+        | (select(0u, 1u, f.reversed.z) << 18u);
+    return array<vec4<u32>, 3>(
+        vec4<u32>(bits, f.vertex_base),
+        vec4<u32>(f.edge_base, f.interior_base),
+        vec4<u32>(0u),
+    );
+}
+
+fn unpack_face(a: vec4<u32>, b: vec4<u32>) -> FaceData {
+    var f: FaceData;
+    f.log2_f = a.x & 15u;
+    f.edge_log2 = (vec3<u32>(a.x) >> vec3<u32>(4u, 8u, 12u)) & vec3<u32>(15u);
+    f.reversed = ((vec3<u32>(a.x) >> vec3<u32>(16u, 17u, 18u)) & vec3<u32>(1u)) != vec3<u32>(0u);
+    f.vertex_base = a.yzw;
+    f.edge_base = b.xyz;
+    f.interior_base = b.w;
+    return f;
+}
+
+fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
+    return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
+}
+
+// Resolution heat map: a ramp over log2 R = 0..12 (dark blue, blue, cyan, green, yellow,
+// orange, magenta at 0, 2, 4, …, 12).
+fn heat_color(log2_r: u32) -> vec3<f32> {
+    var stops = array<vec3<f32>, 7>(
+        vec3<f32>(0.10, 0.10, 0.45),
+        vec3<f32>(0.15, 0.40, 0.95),
+        vec3<f32>(0.00, 0.85, 0.90),
+        vec3<f32>(0.20, 0.85, 0.25),
+        vec3<f32>(0.98, 0.90, 0.15),
+        vec3<f32>(0.98, 0.45, 0.08),
+        vec3<f32>(0.90, 0.15, 0.70),
+    );
+    let t = f32(min(log2_r, 12u)) * 0.5;
+    let k = min(u32(floor(t)), 5u);
+    let c = mix(stops[k], stops[k + 1u], t - f32(k));
+    return srgb_to_linear(c);
 }
 
 @vertex
@@ -116,28 +278,31 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
     if len > 0.0 && is_finite(len) {
         normal = n / len;
     }
+    let f = face_data(face, c);
+    var packed: array<vec4<u32>, 3>;
+    if LEVEL_MODE == 1u {
+        packed = pack_face(f);
+    } else {
+        packed = pack_level(level_data(f, min(u.level, f.log2_f)));
+    }
     var out: VertexOut;
     out.clip = u.clip_from_world * vec4<f32>(p, 1.0);
     out.bary = bary;
-    out.face = face;
     out.normal = normal;
+    out.face0 = packed[0];
+    out.face1 = packed[1];
+    out.face2 = packed[2];
+    out.heat = heat_color(f.log2_f);
     return out;
 }
 
 // layout::sanitize_barycentric: negatives and non-finite become 0, the rest is
 // renormalised; all-zero input becomes corner 0.
 fn sanitize_barycentric(b: vec3<f32>) -> vec3<f32> {
-    var clean = vec3<f32>(0.0);
-    for (var k = 0u; k < 3u; k++) {
-        if is_finite(b[k]) && b[k] > 0.0 {
-            clean[k] = b[k];
-        }
-    }
+    let finite = (bitcast<vec3<u32>>(b) & vec3<u32>(0x7f800000u)) != vec3<u32>(0x7f800000u);
+    let clean = select(vec3<f32>(0.0), b, finite & (b > vec3<f32>(0.0)));
     let sum = clean.x + clean.y + clean.z;
-    if !(is_finite(sum) && sum > 0.0) {
-        return vec3<f32>(1.0, 0.0, 0.0);
-    }
-    return clean / sum;
+    return select(vec3<f32>(1.0, 0.0, 0.0), clean / sum, is_finite(sum) && sum > 0.0);
 }
 
 // Three lattice samples (i, j) with weights (layout::linear_samples_uv).
@@ -150,14 +315,8 @@ struct Samples {
 // layout::linear_samples_uv: the sub-triangle containing (u, v) in lattice units of
 // resolution `res`, clamped onto the lattice, weights clamped and renormalised.
 fn linear_samples_uv(res: u32, u_in: f32, v_in: f32) -> Samples {
-    var uu = u_in;
-    var vv = v_in;
-    if is_nan(uu) {
-        uu = 0.0;
-    }
-    if is_nan(vv) {
-        vv = 0.0;
-    }
+    let uu = select(u_in, 0.0, is_nan(u_in));
+    let vv = select(v_in, 0.0, is_nan(v_in));
     let max_index = f32(res - 1u);
     let i = u32(clamp(floor(uu), 0.0, max_index));
     let j = u32(clamp(floor(vv), 0.0, f32(res - 1u - i)));
@@ -165,186 +324,102 @@ fn linear_samples_uv(res: u32, u_in: f32, v_in: f32) -> Samples {
     let fv = vv - f32(j);
     let upper = fu + fv > 1.0 && i + j + 2u <= res;
     var s: Samples;
-    if upper {
-        s.i = vec3<u32>(i + 1u, i + 1u, i);
-        s.j = vec3<u32>(j + 1u, j, j + 1u);
-        s.w = vec3<f32>(fu + fv - 1.0, 1.0 - fv, 1.0 - fu);
-    } else {
-        s.i = vec3<u32>(i, i + 1u, i);
-        s.j = vec3<u32>(j, j, j + 1u);
-        s.w = vec3<f32>(1.0 - fu - fv, fu, fv);
-    }
-    s.w = clamp(s.w, vec3<f32>(0.0), vec3<f32>(1.0));
-    let sum = s.w.x + s.w.y + s.w.z;
-    if sum > 0.0 {
-        s.w = s.w / sum;
-    } else {
-        s.w.x = 1.0;
-    }
+    s.i = select(vec3<u32>(i, i + 1u, i), vec3<u32>(i + 1u, i + 1u, i), upper);
+    s.j = select(vec3<u32>(j, j, j + 1u), vec3<u32>(j + 1u, j, j + 1u), upper);
+    let w = select(vec3<f32>(1.0 - fu - fv, fu, fv), vec3<f32>(fu + fv - 1.0, 1.0 - fv, 1.0 - fu), upper);
+    let clamped = clamp(w, vec3<f32>(0.0), vec3<f32>(1.0));
+    let sum = clamped.x + clamped.y + clamped.z;
+    s.w = select(vec3<f32>(1.0, clamped.y, clamped.z), clamped / sum, sum > 0.0);
     return s;
 }
 
-// layout::edge_level_offset: 2R − 2(R >> level) − level.
-fn edge_level_offset(log2_r: u32, level: u32) -> u32 {
-    return 2u * (1u << log2_r) - 2u * (1u << (log2_r - level)) - level;
+// sampler::packed_sample_index for lattice point (i, j) (inside the lattice of d.r):
+// vertices first, then face edges 0, 1, 2, then the interior (thesis eq. 3.2), as
+// layout::classify_sample — written as selects, later ones taking precedence.
+fn sample_index(d: LevelData, i: u32, j: u32) -> u32 {
+    let r = d.r;
+    var index = d.interior + (i - 1u) * (2u * r - 2u - i) / 2u + (j - 1u);
+    index = select(index, d.edge_start.z + (r - j) * d.edge_step.z, i == 0u);
+    index = select(index, d.edge_start.y + j * d.edge_step.y, i + j == r);
+    index = select(index, d.edge_start.x + i * d.edge_step.x, j == 0u);
+    // i + j <= r, so i == r means (r, 0) and j == r means (0, r).
+    index = select(index, d.vertex.z, j == r);
+    index = select(index, d.vertex.y, i == r);
+    index = select(index, d.vertex.x, (i | j) == 0u);
+    return index;
 }
 
-// layout::interior_level_offset (thesis eq. 3.4b, closed form), m = log2 R, l = level.
-fn interior_level_offset(m: u32, l: u32) -> u32 {
-    let squares = ((1u << (2u * m + 1u)) - (1u << (2u * (m - l) + 1u))) / 3u;
-    let linear = 3u * ((1u << m) - (1u << (m - l)));
-    return squares + l - linear;
-}
-
-// Everything a face's lookups need, read once per fragment.
-struct FaceInfo {
-    record: vec4<u32>,
-    corners: vec3<u32>,
-    log2_f: u32,
-}
-
-// sampler::packed_sample_index: colour-buffer index of lattice point (i, j) of the face
-// at `level` (already clamped to log2 R_f).
-fn sample_index(f: FaceInfo, level: u32, i: u32, j: u32) -> u32 {
-    let r = 1u << (f.log2_f - level);
-    // Vertices.
-    var corner = 3u;
-    if i == 0u && j == 0u {
-        corner = 0u;
-    } else if i == r && j == 0u {
-        corner = 1u;
-    } else if i == 0u && j == r {
-        corner = 2u;
-    }
-    if corner < 3u {
-        let vertex = f.corners[corner];
-        return vertex * u.vertex_levels + min(level, max(u.vertex_levels, 1u) - 1u);
-    }
-    // Edges: face edge k and position along it from its start corner.
-    var k = 3u;
-    var position = 0u;
-    if j == 0u {
-        k = 0u;
-        position = i;
-    } else if i + j == r {
-        k = 1u;
-        position = j;
-    } else if i == 0u {
-        k = 2u;
-        position = r - j;
-    }
-    if k < 3u {
-        let word = f.record[k + 1u];
-        let base = word & BASE_MASK;
-        // A valid record never has R_e < R_f; a corrupt one reads something in range.
-        let log2_e = clamp(word >> LOG2_SHIFT, f.log2_f, MAX_LOG2_RESOLUTION);
-        let stride_log2 = log2_e - f.log2_f;
-        let r_edge_level = 1u << (log2_e - level);
-        let p = position << stride_log2;
-        let reversed = f.corners[k] > f.corners[(k + 1u) % 3u];
-        var in_level = p - 1u;
-        if reversed {
-            in_level = r_edge_level - 1u - p;
-        }
-        return base + edge_level_offset(log2_e, level) + in_level;
-    }
-    // Interior (thesis eq. 3.2), row by row.
-    let base = f.record.x & BASE_MASK;
-    let interior = (i - 1u) * (2u * r - 2u - i) / 2u + (j - 1u);
-    return base + interior_level_offset(f.log2_f, level) + interior;
+// Texel of colour index `index` (clamped below sample_count): (index % W, index / W),
+// computed without an integer division (which SIMD rasterisers run lane by lane).
+// Exact for index < 2^28 and W <= 2^14: a float estimate of the quotient is off by at
+// most ~50, one float step on the (exact, small) remainder brings it within one, and a
+// final compare fixes that.
+fn atlas_texel(index: u32) -> vec2<u32> {
+    let idx = min(index, max(u.sample_count, 1u) - 1u);
+    let w = max(u.atlas_width, 1u);
+    let inv_w = 1.0 / f32(w);
+    let q0 = u32(f32(idx) * inv_w);
+    let r0 = i32(idx - q0 * w);
+    let q1 = u32(i32(q0) + i32(floor(f32(r0) * inv_w)));
+    let r1 = idx - q1 * w;
+    let carry = r1 >= w;
+    return vec2<u32>(select(r1, r1 - w, carry), select(q1, q1 + 1u, carry));
 }
 
 fn load_sample(index: u32) -> vec4<f32> {
-    let idx = min(index, max(u.sample_count, 1u) - 1u);
-    let w = max(u.atlas_width, 1u);
-    return textureLoad(atlas, vec2<u32>(idx % w, idx / w), 0);
+    return textureLoad(atlas, atlas_texel(index), 0);
 }
 
-// sampler::sample at one level with the uniform's filter.
-fn sample_level(f: FaceInfo, bary: vec3<f32>, level_in: u32) -> vec4<f32> {
-    let level = min(level_in, f.log2_f);
-    let r = 1u << (f.log2_f - level);
-    let res = f32(r);
-    let s = linear_samples_uv(r, res * bary.y, res * bary.z);
-    if u.filter_kind == 0u {
+// sampler::sample at one level with the pipeline's filter; `bary` is sanitised.
+fn sample_level(d: LevelData, bary: vec3<f32>) -> vec4<f32> {
+    let res = f32(d.r);
+    let s = linear_samples_uv(d.r, res * bary.y, res * bary.z);
+    if FILTER_KIND == 0u {
         // Nearest: the highest weight, the first one on ties.
-        var best = 0u;
-        if s.w.y > s.w[best] {
-            best = 1u;
-        }
-        if s.w.z > s.w[best] {
-            best = 2u;
-        }
-        return load_sample(sample_index(f, level, s.i[best], s.j[best]));
+        let pick1 = s.w.y > s.w.x;
+        let best_w = select(s.w.x, s.w.y, pick1);
+        let pick2 = s.w.z > best_w;
+        let i = select(select(s.i.x, s.i.y, pick1), s.i.z, pick2);
+        let j = select(select(s.j.x, s.j.y, pick1), s.j.z, pick2);
+        return load_sample(sample_index(d, i, j));
     }
     var out = vec4<f32>(0.0);
-    for (var k = 0u; k < 3u; k++) {
-        out += s.w[k] * load_sample(sample_index(f, level, s.i[k], s.j[k]));
-    }
+    out += s.w.x * load_sample(sample_index(d, s.i.x, s.j.x));
+    out += s.w.y * load_sample(sample_index(d, s.i.y, s.j.y));
+    out += s.w.z * load_sample(sample_index(d, s.i.z, s.j.z));
     return out;
-}
-
-fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
-    return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
-}
-
-// Resolution heat map: a ramp over log2 R = 0..12 (dark blue, blue, cyan, green, yellow,
-// orange, magenta at 0, 2, 4, …, 12).
-fn heat_color(log2_r: u32) -> vec3<f32> {
-    var stops = array<vec3<f32>, 7>(
-        vec3<f32>(0.10, 0.10, 0.45),
-        vec3<f32>(0.15, 0.40, 0.95),
-        vec3<f32>(0.00, 0.85, 0.90),
-        vec3<f32>(0.20, 0.85, 0.25),
-        vec3<f32>(0.98, 0.90, 0.15),
-        vec3<f32>(0.98, 0.45, 0.08),
-        vec3<f32>(0.90, 0.15, 0.70),
-    );
-    let t = f32(min(log2_r, 12u)) * 0.5;
-    let k = min(u32(floor(t)), 5u);
-    let c = mix(stops[k], stops[k + 1u], t - f32(k));
-    return srgb_to_linear(c);
 }
 
 @fragment
 fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    // Derivatives first, in uniform control flow: lattice-coordinate footprint (per unit
-    // resolution) and barycentric widths for the wireframe.
-    let duv_dx = dpdx(in.bary.yz);
-    let duv_dy = dpdy(in.bary.yz);
+    // Derivatives first, in uniform control flow: barycentric widths for the wireframe.
     let bary_width = fwidth(in.bary);
-
-    let face = min(in.face, max(u.face_count, 1u) - 1u);
-    var f: FaceInfo;
-    f.record = face_records[face];
-    f.corners = face_corners(face);
-    f.log2_f = min(f.record.x >> LOG2_SHIFT, MAX_LOG2_RESOLUTION);
     let bary = sanitize_barycentric(in.bary);
 
     var color: vec4<f32>;
-    if u.level_mode == 1u {
+    if LEVEL_MODE == 1u {
         // Automatic level: u = R_f·w1, v = R_f·w2; lod = log2 of the larger footprint.
+        let duv_dx = dpdx(in.bary.yz);
+        let duv_dy = dpdy(in.bary.yz);
+        let f = unpack_face(in.face0, in.face1);
         let res_f = f32(1u << f.log2_f);
         let footprint = max(length(duv_dx * res_f), length(duv_dy * res_f));
         var lod = log2(footprint);
-        if is_nan(lod) {
-            lod = 0.0;
-        }
+        lod = select(lod, 0.0, is_nan(lod));
         lod = clamp(lod, 0.0, f32(f.log2_f));
         let l0 = u32(floor(lod));
         let t = lod - f32(l0);
-        color = sample_level(f, bary, l0);
-        if t > 0.0 {
-            color = mix(color, sample_level(f, bary, min(l0 + 1u, f.log2_f)), t);
-        }
+        let c0 = sample_level(level_data(f, l0), bary);
+        let c1 = sample_level(level_data(f, min(l0 + 1u, f.log2_f)), bary);
+        color = select(c0, mix(c0, c1, t), t > 0.0);
     } else {
-        color = sample_level(f, bary, u.level);
+        color = sample_level(unpack_level(in.face0, in.face1, in.face2), bary);
     }
 
     var rgb = color.rgb * u.tint.rgb;
     let alpha = color.a * u.tint.a;
     if (u.flags & FLAG_HEATMAP) != 0u {
-        rgb = heat_color(f.log2_f);
+        rgb = in.heat;
     }
     if (u.flags & FLAG_LIT) != 0u {
         let n = select(-in.normal, in.normal, front_facing);

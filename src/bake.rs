@@ -69,9 +69,7 @@ impl MipLevel {
                 continue;
             }
             let texel = self.texel(x0 + dx, y0 + dy);
-            for c in 0..4 {
-                out[c] += weight * texel[c];
-            }
+            add_scaled(&mut out, weight, texel);
         }
         out
     }
@@ -174,9 +172,7 @@ fn downsample(level: &MipLevel) -> MipLevel {
             let mut sum = [0.0; 4];
             for &(sx, weight) in weights {
                 let texel = level.texels[y * w as usize + sx];
-                for c in 0..4 {
-                    sum[c] += weight * texel[c];
-                }
+                add_scaled(&mut sum, weight, texel);
             }
             rows[y * nw as usize + x] = sum;
         }
@@ -188,14 +184,19 @@ fn downsample(level: &MipLevel) -> MipLevel {
             let mut sum = [0.0; 4];
             for &(sy, weight) in weights {
                 let texel = rows[sy * nw as usize + x];
-                for c in 0..4 {
-                    sum[c] += weight * texel[c];
-                }
+                add_scaled(&mut sum, weight, texel);
             }
             texels[y * nw as usize + x] = sum;
         }
     }
     MipLevel { width: nw, height: nh, texels }
+}
+
+/// `sum += weight · color` per channel.
+fn add_scaled(sum: &mut Rgba, weight: f32, color: Rgba) {
+    for (s, c) in sum.iter_mut().zip(color) {
+        *s += weight * c;
+    }
 }
 
 /// What a face's material needs at bake time.

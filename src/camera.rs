@@ -62,6 +62,8 @@ pub struct OrbitCamera {
 impl OrbitCamera {
     /// Default vertical field of view.
     pub const DEFAULT_FOV_Y_DEGREES: f64 = 40.0;
+    /// The closest [`OrbitCamera::zoom`] gets, as a fraction of the scene radius.
+    pub const MIN_DISTANCE_FRACTION: f64 = 1e-3;
 
     /// A camera that frames `sphere` from `yaw`/`pitch` (degrees), the whole sphere in view.
     pub fn framing(sphere: BoundingSphere, yaw_degrees: f64, pitch_degrees: f64) -> Self {
@@ -142,6 +144,71 @@ impl OrbitCamera {
         Some(((ndc.x + 1.0) * 0.5 * f64::from(width), (1.0 - ndc.y) * 0.5 * f64::from(height)))
     }
 
+    /// Turns the eye around the target: `delta_yaw` degrees around +Y, `delta_pitch` degrees
+    /// up (the pitch stays within ±89°, the yaw within (−180°, 180°]).
+    pub fn orbit(&mut self, delta_yaw_degrees: f64, delta_pitch_degrees: f64) {
+        let yaw = (self.yaw_degrees + delta_yaw_degrees).rem_euclid(360.0);
+        self.yaw_degrees = if yaw > 180.0 { yaw - 360.0 } else { yaw };
+        self.pitch_degrees = (self.pitch_degrees + delta_pitch_degrees).clamp(-89.0, 89.0);
+    }
+
+    /// Unit vectors pointing right and up on screen, world space.
+    pub fn right_up(&self) -> (DVec3, DVec3) {
+        let towards_eye = self.eye_direction();
+        let right = DVec3::Y.cross(towards_eye).normalize_or(DVec3::X);
+        let up = towards_eye.cross(right).normalize_or(DVec3::Y);
+        (right, up)
+    }
+
+    /// World units per pixel at the target's depth, in an image `height` pixels tall.
+    pub fn world_per_pixel(&self, height: f64) -> f64 {
+        2.0 * self.distance * (self.fov_y_degrees.to_radians() * 0.5).tan() / height.max(1.0)
+    }
+
+    /// Moves target and eye together so that the scene follows a pointer moved by
+    /// `(dx, dy)` pixels (x right, y down) in an image `height` pixels tall.
+    pub fn pan_pixels(&mut self, dx: f64, dy: f64, height: f64) {
+        let (right, up) = self.right_up();
+        let scale = self.world_per_pixel(height);
+        let target = DVec3::from_array(self.target) - right * (dx * scale) + up * (dy * scale);
+        if target.is_finite() {
+            self.target = target.to_array();
+        }
+    }
+
+    /// Multiplies the eye distance by `factor` (below 1 zooms in). The distance never drops
+    /// below [`OrbitCamera::MIN_DISTANCE_FRACTION`] of the scene radius, so the target
+    /// always stays beyond the near plane.
+    pub fn zoom(&mut self, factor: f64) {
+        if !(factor.is_finite() && factor > 0.0) {
+            return;
+        }
+        let min = self.scene_radius.max(1e-12) * Self::MIN_DISTANCE_FRACTION;
+        self.distance = (self.distance * factor).max(min);
+    }
+
+    /// Looks at `point` from `distance` (clamped as in [`OrbitCamera::zoom`]), keeping the
+    /// viewing direction.
+    pub fn look_at_point(&mut self, point: DVec3, distance: f64) {
+        if !point.is_finite() || !(distance.is_finite() && distance > 0.0) {
+            return;
+        }
+        self.target = point.to_array();
+        self.distance = distance;
+        self.zoom(1.0);
+    }
+
+    /// Widens the depth range so that `sphere` (the scene) lies between the near and far
+    /// planes wherever the target went (after a pan or [`OrbitCamera::look_at_point`]):
+    /// the scene lies within `radius + |target − centre|` of the target.
+    pub fn fit_depth_to(&mut self, sphere: BoundingSphere) {
+        let offset = (DVec3::from_array(self.target) - DVec3::from_array(sphere.center)).length();
+        let radius = sphere.radius + if offset.is_finite() { offset } else { 0.0 };
+        if radius.is_finite() && radius > 0.0 {
+            self.scene_radius = radius;
+        }
+    }
+
     /// Target as `f32` (for shaders that take the render origin).
     pub fn target_f32(&self) -> Vec3 {
         DVec3::from_array(self.target).as_vec3()
@@ -172,5 +239,40 @@ mod tests {
             assert!(near > 0.0 && near < camera.distance - radius);
             assert!(far > camera.distance + radius);
         }
+    }
+
+    #[test]
+    fn orbit_wraps_yaw_and_clamps_pitch() {
+        let mut camera = OrbitCamera::framing(BoundingSphere { center: [0.0; 3], radius: 1.0 }, 170.0, 80.0);
+        camera.orbit(20.0, 30.0);
+        assert!((camera.yaw_degrees - -170.0).abs() < 1e-9, "{}", camera.yaw_degrees);
+        assert_eq!(camera.pitch_degrees, 89.0);
+    }
+
+    #[test]
+    fn pan_moves_the_target_with_the_pointer() {
+        let sphere = BoundingSphere { center: [1e6, 2.0, -3.0], radius: 0.5 };
+        let mut camera = OrbitCamera::framing(sphere, 30.0, 20.0);
+        let point = DVec3::from_array(sphere.center);
+        let (x0, y0) = camera.project(point, 800, 600).unwrap();
+        camera.pan_pixels(40.0, -25.0, 600.0);
+        let (x1, y1) = camera.project(point, 800, 600).unwrap();
+        assert!((x1 - x0 - 40.0).abs() < 1e-3 && (y1 - y0 + 25.0).abs() < 1e-3, "{x0},{y0} → {x1},{y1}");
+    }
+
+    #[test]
+    fn zoom_stops_before_the_near_plane_and_depth_follows_the_target() {
+        let sphere = BoundingSphere { center: [0.0; 3], radius: 2.0 };
+        let mut camera = OrbitCamera::framing(sphere, 0.0, 0.0);
+        camera.zoom(1e-9);
+        assert!((camera.distance - 2.0 * OrbitCamera::MIN_DISTANCE_FRACTION).abs() < 1e-12);
+        assert!(camera.near_far().0 < camera.distance);
+        // Panned far off the scene: after fitting, the whole sphere is between near and far.
+        let mut camera = OrbitCamera::framing(sphere, 0.0, 0.0);
+        camera.pan_pixels(5000.0, 0.0, 600.0);
+        camera.fit_depth_to(sphere);
+        let (near, far) = camera.near_far();
+        let centre_depth = (camera.eye() - DVec3::ZERO).length();
+        assert!(near < centre_depth - sphere.radius && far > centre_depth + sphere.radius);
     }
 }

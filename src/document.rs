@@ -15,6 +15,7 @@ use crate::layout::Resolution;
 use crate::packed::PackedMesh;
 use crate::packed_file::{self, PackedFileError};
 use crate::packer::{self, PackError};
+use crate::scene::Scene;
 use crate::store::ColorStore;
 use crate::topology::{Topology, TopologyError};
 use crate::weld::weld_scene;
@@ -122,6 +123,33 @@ fn fill_with_position_colors(store: &mut ColorStore, positions: &[[f32; 3]]) {
     });
 }
 
+/// Colours every sample with the vertex colours (COLOR_0) interpolated across its owner
+/// face — exact at the vertices, and exactly what a glTF viewer shows between them. With a
+/// base colour already baked, multiplies it (glTF: COLOR_0 scales the base colour).
+fn apply_vertex_colors(store: &mut ColorStore, vertex_colors: &[[f32; 4]], multiply: bool) {
+    let corners = store.topology().face_vertices.clone();
+    let current = store.clone();
+    store.fill_with(|site| {
+        let face = corners[site.face as usize];
+        let w = site.barycentric;
+        let color = |k: usize| vertex_colors.get(face[k] as usize).copied().unwrap_or([1.0; 4]);
+        let (c0, c1, c2) = (color(0), color(1), color(2));
+        // A weight of exactly 1 returns that corner's colour bit for bit.
+        let interpolated: Rgba = match w {
+            [1.0, _, _] => c0,
+            [_, 1.0, _] => c1,
+            [_, _, 1.0] => c2,
+            _ => std::array::from_fn(|c| w[0] * c0[c] + w[1] * c1[c] + w[2] * c2[c]),
+        };
+        if multiply {
+            let base = current.get(site.sample).unwrap_or([1.0; 4]);
+            std::array::from_fn(|c| base[c] * interpolated[c])
+        } else {
+            interpolated
+        }
+    });
+}
+
 impl Document {
     /// Opens `path`: a packed file (by magic) or glTF at uniform `gltf_resolution`.
     ///
@@ -141,15 +169,25 @@ impl Document {
             let packed = packed_file::read_file(path)?;
             return Self::from_packed(&packed).map_err(|source| DocumentError::Pack { path: path.to_owned(), source });
         }
-        let scene = import_gltf(path)?;
+        Self::from_scene(import_gltf(path)?, gltf_resolution, path)
+    }
+
+    /// A document from a glTF scene already in memory (e.g. a model embedded in the binary and
+    /// read with [`crate::import::import_gltf_slice`]) at uniform `gltf_resolution`, coloured
+    /// as [`Document::open`] colours glTF files; `name` stands for the file in errors.
+    pub fn from_scene(scene: Scene, gltf_resolution: Resolution, name: &Path) -> Result<Self, DocumentError> {
         let welded = weld_scene(&scene);
         let topology = Topology::build(welded.positions_world.len() as u32, &welded.triangles)
-            .map_err(|source| DocumentError::Topology { path: path.to_owned(), source })?;
+            .map_err(|source| DocumentError::Topology { path: name.to_owned(), source })?;
         let mut store = ColorStore::uniform(topology, gltf_resolution, [1.0; 4]);
-        if crate::bake::has_base_color(&welded, &scene) {
+        let has_base_color = crate::bake::has_base_color(&welded, &scene);
+        if has_base_color {
             crate::bake::bake_texture(&mut store, &welded, &scene);
-        } else {
+        } else if welded.vertex_colors.is_empty() {
             fill_with_position_colors(&mut store, &welded.positions_world);
+        }
+        if !welded.vertex_colors.is_empty() {
+            apply_vertex_colors(&mut store, &welded.vertex_colors, has_base_color);
         }
         store.take_dirty();
         Ok(Document {

@@ -301,12 +301,12 @@ fn lattice_position(corners: &[[f32; 3]; 3], r: Resolution, i: u32, j: u32) -> [
 
 /// The tessellated mesh as a binary glTF (see the module documentation).
 pub fn export_tessellated_glb(positions: &[[f32; 3]], store: &ColorStore) -> Result<Vec<u8>, ExportError> {
-    let tessellation = tessellate(positions, store)?;
-    tessellation_to_glb(&tessellation)
+    tessellation_to_glb(tessellate(positions, store)?)
 }
 
-/// Encodes a tessellation as a binary glTF.
-pub fn tessellation_to_glb(tessellation: &Tessellation) -> Result<Vec<u8>, ExportError> {
+/// Encodes a tessellation as a binary glTF. The tessellation is consumed so that its
+/// memory is released before the file's bytes are assembled.
+pub fn tessellation_to_glb(tessellation: Tessellation) -> Result<Vec<u8>, ExportError> {
     let vertices = tessellation.positions.len();
     let triangles = tessellation.triangles.len();
     check_limits(vertices as u64, triangles as u64)?;
@@ -348,9 +348,10 @@ pub fn tessellation_to_glb(tessellation: &Tessellation) -> Result<Vec<u8>, Expor
             bin.extend_from_slice(&index.to_le_bytes());
         }
     }
+    drop(tessellation);
     let buffer_length = bin.len();
     // The BIN chunk is padded to 4 bytes here (not left to the GLB writer).
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
 
@@ -506,13 +507,10 @@ pub fn write_tessellated_glb(
     store: &ColorStore,
 ) -> Result<ExportSummary, ExportError> {
     let tessellation = tessellate(positions, store)?;
-    let bytes = tessellation_to_glb(&tessellation)?;
+    let (vertices, triangles) = (tessellation.positions.len() as u64, tessellation.triangles.len() as u64);
+    let bytes = tessellation_to_glb(tessellation)?;
     write_atomically(path, &bytes)?;
-    Ok(ExportSummary {
-        vertices: tessellation.positions.len() as u64,
-        triangles: tessellation.triangles.len() as u64,
-        bytes: bytes.len() as u64,
-    })
+    Ok(ExportSummary { vertices, triangles, bytes: bytes.len() as u64 })
 }
 
 /// Writes `bytes` to `path` through a synced temporary file in the same directory.

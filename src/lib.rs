@@ -32,6 +32,7 @@
 //! | [`render`] | **GPU**: wgpu context, packed buffers on the GPU, sampling pipelines, readback |
 //! | [`bench`] | the measurements behind `meshpaint bench` (time and size, as JSON) |
 //! | [`packed_file`] | the packed file format (docs/FORMAT.md): writer and hostile-input-proof reader |
+//! | [`app`] | **GPU + UI**: the desktop editor (winit, egui, wgpu): window, panels, input, background jobs |
 //!
 //! ## Data flow
 //!
@@ -46,8 +47,9 @@
 //! paint:  cursor → ray → BVH → brush → store → dirty ranges → GPU upload
 //! ```
 //!
-//! The binary (`src/main.rs`) is the only place where everything meets.
+//! The binary (`src/main.rs`) and the editor ([`app`]) are the only places where everything meets.
 
+pub mod app;
 pub mod bake;
 pub mod bench;
 pub mod camera;

@@ -14,11 +14,15 @@ use meshpaint::packed_file;
 use meshpaint::stats::MeshStats;
 
 /// Paint colour directly on 3D triangle meshes with mesh colors (no UV map).
+///
+/// With no subcommand, opens the editor: on FILE, or on the built-in Duck.
 #[derive(Debug, Parser)]
-#[command(name = "meshpaint", version, about)]
+#[command(name = "meshpaint", version, about, args_conflicts_with_subcommands = true)]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
+    /// A .glb / .gltf or packed file to open in the editor (default: the built-in Duck).
+    file: Option<PathBuf>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -89,6 +93,23 @@ enum BenchCommand {
         #[arg(long, default_value_t = 5)]
         runs: usize,
     },
+    /// Frame time of the UV baseline and each mesh-colors filter mode (interleaved), GPU memory.
+    Render {
+        /// A .glb / .gltf file or a packed file.
+        file: PathBuf,
+        /// Uniform face resolution R for glTF input.
+        #[arg(long, short = 'r', default_value_t = 8)]
+        resolution: u64,
+        /// Image width.
+        #[arg(long, default_value_t = 1280)]
+        width: u32,
+        /// Image height.
+        #[arg(long, default_value_t = 720)]
+        height: u32,
+        /// Frames per mode.
+        #[arg(long, default_value_t = 20)]
+        frames: usize,
+    },
 }
 
 fn parse_format(name: &str) -> Result<ColorFormat, String> {
@@ -108,7 +129,10 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: Cli) -> Result<()> {
-    match cli.command {
+    let Some(command) = cli.command else {
+        return meshpaint::app::run(meshpaint::app::AppOptions { file: cli.file });
+    };
+    match command {
         Command::Info { file, resolution, json } => info(&file, resolution, json),
         Command::Pack { file, resolution, format, output } => pack(&file, resolution, format, &output),
         Command::Bench { what } => bench(what),
@@ -217,6 +241,15 @@ fn bench(what: BenchCommand) -> Result<()> {
                 "threads": 1,
                 "results": results,
             });
+            println!("{report}");
+            Ok(())
+        }
+        BenchCommand::Render { file, resolution, width, height, frames } => {
+            let document = open(&file, resolution)?;
+            let result = meshpaint::render::bench_render(&file, &document, width, height, frames)?;
+            let mut report = result.to_json();
+            report["file"] = file.display().to_string().into();
+            report["resolution"] = resolution.into();
             println!("{report}");
             Ok(())
         }

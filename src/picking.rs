@@ -502,7 +502,8 @@ fn watertight_intersect(corners: [DVec3; 3], origin: DVec3, direction: DVec3) ->
     }
     let t_scaled = u * az + v * bz + w * cz;
     let t = plane_distance(corners, origin, direction).unwrap_or(t_scaled / det);
-    if !(t >= 0.0) || !t.is_finite() {
+    // NaN fails this test too.
+    if !(t.is_finite() && t >= 0.0) {
         return None;
     }
     Some(ExactHit { t, barycentric: [u / det, v / det, w / det] })

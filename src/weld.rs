@@ -27,12 +27,17 @@ pub struct WeldedMesh {
     pub triangle_materials: Vec<Option<u32>>,
     /// Triangles dropped because two or more welded corners were the same vertex.
     pub degenerate_triangles_dropped: u64,
+    /// COLOR_0 of each welded vertex (linear RGBA; the first glTF vertex welded into it
+    /// decides), or empty when no mesh of the scene has vertex colours.
+    pub vertex_colors: Vec<[f32; 4]>,
 }
 
 /// One source mesh welded in its local space (shared by all of its instances).
 struct LocalWeld {
     /// Local positions of the welded vertices that kept triangles use.
     positions_local: Vec<Vec3>,
+    /// For each of those, the first source vertex welded into it.
+    source_vertex: Vec<u32>,
     /// Kept triangles as local welded ids, with the index of the source triangle.
     triangles: Vec<([u32; 3], usize)>,
     /// Source triangles dropped as degenerate.
@@ -44,12 +49,14 @@ fn weld_local(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> LocalWeld {
     let mut id_of_key: HashMap<[u32; 3], u32> = HashMap::with_capacity(positions.len());
     let mut welded_of_source = Vec::with_capacity(positions.len());
     let mut welded_positions: Vec<Vec3> = Vec::new();
-    for position in positions {
+    let mut first_source: Vec<u32> = Vec::new();
+    for (source, position) in positions.iter().enumerate() {
         let key = position.map(f32::to_bits);
         let next = welded_positions.len() as u32;
         let id = *id_of_key.entry(key).or_insert(next);
         if id == next {
             welded_positions.push(Vec3::from_array(*position));
+            first_source.push(source as u32);
         }
         welded_of_source.push(id);
     }
@@ -73,17 +80,19 @@ fn weld_local(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> LocalWeld {
     // Compact: only vertices used by kept triangles, numbered in first-use order.
     let mut compact_of_welded = vec![u32::MAX; welded_positions.len()];
     let mut positions_local = Vec::new();
+    let mut source_vertex = Vec::new();
     for (corners, _) in &mut kept {
         for corner in corners.iter_mut() {
             let slot = &mut compact_of_welded[*corner as usize];
             if *slot == u32::MAX {
                 *slot = positions_local.len() as u32;
                 positions_local.push(welded_positions[*corner as usize]);
+                source_vertex.push(first_source[*corner as usize]);
             }
             *corner = *slot;
         }
     }
-    LocalWeld { positions_local, triangles: kept, dropped }
+    LocalWeld { positions_local, source_vertex, triangles: kept, dropped }
 }
 
 /// Welds every instance of `scene` and concatenates them into one mesh.
@@ -91,6 +100,7 @@ pub fn weld_scene(scene: &Scene) -> WeldedMesh {
     let locals: Vec<LocalWeld> =
         scene.meshes.iter().map(|mesh| weld_local(&mesh.positions_local, &mesh.triangles)).collect();
     let mut out = WeldedMesh::default();
+    let any_colors = scene.meshes.iter().any(|mesh| !mesh.colors.is_empty());
     for instance in &scene.instances {
         let (Some(mesh), Some(local)) = (scene.meshes.get(instance.mesh as usize), locals.get(instance.mesh as usize))
         else {
@@ -99,6 +109,11 @@ pub fn weld_scene(scene: &Scene) -> WeldedMesh {
         let world_from_local: Mat4 = instance.world_from_local;
         let normal_world_from_local = Mat3::from_mat4(world_from_local).inverse().transpose();
         let base = out.positions_world.len() as u32;
+        if any_colors {
+            out.vertex_colors.extend(
+                local.source_vertex.iter().map(|&v| mesh.colors.get(v as usize).copied().unwrap_or([1.0; 4])),
+            );
+        }
         out.positions_world
             .extend(local.positions_local.iter().map(|&p| world_from_local.transform_point3(p).to_array()));
         for &(corners, source_triangle) in &local.triangles {

@@ -50,7 +50,7 @@ fn quad(corner_uvs: [[[f32; 2]; 3]; 2]) -> WeldedMesh {
         corner_uvs: corner_uvs.to_vec(),
         corner_normals_world: vec![[[0.0, 0.0, 1.0]; 3]; 2],
         triangle_materials: vec![Some(0), Some(0)],
-        degenerate_triangles_dropped: 0,
+        ..WeldedMesh::default()
     }
 }
 
@@ -404,4 +404,25 @@ fn document_open_bakes_textured_models() {
     store.for_each_site(|site| same &= document.store.get(site.sample) == store.get(site.sample));
     assert!(same, "the opened Duck is the baked Duck");
     assert!(document.store.clone().take_dirty().is_empty(), "opening leaves nothing dirty");
+
+    // Cubes: factor-only materials, one colour per face.
+    let path = asset("Cubes/Cubes.glb");
+    let document = Document::open(&path, r(2)).unwrap();
+    let scene = meshpaint::import::import_gltf(&path).unwrap();
+    let mesh = weld_scene(&scene);
+    document.store.for_each_site(|site| {
+        let material = mesh.triangle_materials[site.face as usize].unwrap();
+        let factor = scene.materials[material as usize].base_color_factor;
+        assert_eq!(document.store.get(site.sample), Some(factor), "{site:?}");
+    });
+
+    // Suzanne has no material: the position colour field stays.
+    let path = asset("Suzanne/monkey.glb");
+    let document = Document::open(&path, r(2)).unwrap();
+    let (min, size) = meshpaint::document::bounds(&document.positions);
+    for v in 0..document.positions.len() as u32 {
+        let expected = meshpaint::document::position_color(document.positions[v as usize], min, size);
+        let got = document.store.vertex_color(v).unwrap();
+        assert!((0..4).all(|c| (got[c] - expected[c]).abs() < 1e-6), "vertex {v}: {got:?} vs {expected:?}");
+    }
 }

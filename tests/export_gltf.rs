@@ -424,6 +424,9 @@ fn well_shaped(corners: [[f32; 3]; 3]) -> bool {
     area2 > 1e-3 * longest * longest
 }
 
+/// An exported triangle in lattice coordinates `(u, v)`, with its glTF vertices.
+type LatticeTriangle = ([(f64, f64); 3], [u32; 3]);
+
 /// The exported triangles of one face in lattice coordinates (recovered from geometry,
 /// rounded to the lattice and checked to be lattice points), with their vertices.
 fn face_triangles(
@@ -431,7 +434,7 @@ fn face_triangles(
     range: std::ops::Range<usize>,
     corners: [[f32; 3]; 3],
     res: u32,
-) -> Vec<([(f64, f64); 3], [u32; 3])> {
+) -> Vec<LatticeTriangle> {
     mesh.triangles[range]
         .iter()
         .map(|triangle| {
@@ -469,7 +472,7 @@ fn check_linear_filter(case: &Painted, points: usize, seed: u64) {
     }
     let mut rng = Rng(seed);
     let mut checked = 0;
-    let mut cache: HashMap<u32, Vec<([(f64, f64); 3], [u32; 3])>> = HashMap::new();
+    let mut cache: HashMap<u32, Vec<LatticeTriangle>> = HashMap::new();
     while checked < points {
         let face = rng.below(u64::from(topology.face_count())) as u32;
         let res = store.face_resolution(face).unwrap().get();
@@ -747,7 +750,7 @@ fn triangle_glb(primitives: &[Option<ColorAttribute>]) -> Vec<u8> {
     let mut bin = Vec::new();
     let (mut views, mut accessors, mut json_primitives) = (Vec::new(), Vec::new(), Vec::new());
     let mut add_view = |bin: &mut Vec<u8>, bytes: &[u8]| {
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         views.push(json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()}));
@@ -769,7 +772,7 @@ fn triangle_glb(primitives: &[Option<ColorAttribute>]) -> Vec<u8> {
         }
         json_primitives.push(json!({"attributes": attributes}));
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let root = json!({
@@ -783,7 +786,7 @@ fn triangle_glb(primitives: &[Option<ColorAttribute>]) -> Vec<u8> {
         "scene": 0,
     });
     let mut json_bytes = serde_json::to_vec(&root).unwrap();
-    while json_bytes.len() % 4 != 0 {
+    while !json_bytes.len().is_multiple_of(4) {
         json_bytes.push(b' ');
     }
     let mut glb = Vec::new();
@@ -897,4 +900,34 @@ fn bad_color_0_accessors_are_refused() {
             assert!(error.contains("COLOR_0"), "{error}");
         }
     }
+}
+
+#[test]
+fn exported_glb_reopens_in_meshpaint_with_the_sample_colours_at_its_vertices() {
+    use meshpaint::document::Document;
+    use meshpaint::layout::Resolution;
+    let source = Document::open(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Duck/Duck.glb"),
+        Resolution::new(4).unwrap(),
+    )
+    .unwrap();
+    let tessellation = meshpaint::export_gltf::tessellate(&source.positions, &source.store).unwrap();
+    let path = std::env::temp_dir().join(format!("meshpaint-reopen-{}.glb", std::process::id()));
+    meshpaint::export_gltf::write_tessellated_glb(&path, &source.positions, &source.store).unwrap();
+    let reopened = Document::open(&path, Resolution::ONE).unwrap();
+    std::fs::remove_file(&path).ok();
+    // The exporter writes one vertex per sample; welding keeps them apart (distinct positions).
+    assert_eq!(reopened.positions.len(), tessellation.positions.len());
+    let color_at: std::collections::HashMap<[u32; 3], [f32; 4]> = tessellation
+        .positions
+        .iter()
+        .zip(&tessellation.colors)
+        .map(|(p, c)| (p.map(f32::to_bits), *c))
+        .collect();
+    for (v, p) in reopened.positions.iter().enumerate() {
+        let expected = color_at[&p.map(f32::to_bits)];
+        assert_eq!(reopened.store.vertex_color(v as u32), Some(expected), "vertex {v}");
+    }
+    // Sampling the reopened mesh at R = 1 with the linear filter is what the source shows.
+    assert_eq!(reopened.store.topology().face_count() as usize, tessellation.triangles.len());
 }

@@ -29,12 +29,14 @@
 //! (render, copy, read back into an [`image::RgbaImage`]).
 
 mod baseline;
+mod bench;
 mod context;
 mod headless;
 mod mesh_gpu;
 mod renderer;
 mod uniforms;
 
+pub use bench::{BenchRenderError, ModeTiming, RenderBench, bench_render};
 pub use baseline::{BaselineMesh, BaselineVertex, mip_chain_linear};
 pub use context::{GpuContext, backends_from_env};
 pub use headless::{RenderFileError, RenderRequest, RenderedFile, default_camera, render_file};

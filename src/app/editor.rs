@@ -1,0 +1,645 @@
+//! The editor's state and its per-frame UI: everything between the window shell
+//! ([`super::window`]) and the library.
+//!
+//! The editor holds the open document (the [`crate::document::Document`] with its colour
+//! store side by side with its [`crate::render::GpuMesh`]), the camera, the view settings,
+//! the mode, the job runner and the status line. [`Editor::ui`] draws one frame of panels
+//! and the 3D view's area; input is handled in one place, [`super::input`]. It needs no
+//! window, so `tests/app_ui.rs` drives it with egui_kittest.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use glam::DVec3;
+
+use crate::camera::OrbitCamera;
+use crate::color::ColorFormat;
+use crate::layout::Resolution;
+use crate::render::{FilterMode, Overlays, RenderSettings, Shading};
+
+use super::file_dialog::{DialogOutcome, DialogPurpose, FileDialog};
+use super::jobs::{Finished, Jobs, Waker};
+use super::loaded::{self, Gpu, OpenDocument, Source, Written};
+
+/// Camera yaw of a newly opened document, degrees (as `meshpaint render`).
+pub const DEFAULT_YAW_DEGREES: f64 = 30.0;
+/// Camera pitch of a newly opened document, degrees (as `meshpaint render`).
+pub const DEFAULT_PITCH_DEGREES: f64 = 20.0;
+/// Uniform resolution given to glTF files when they are opened, unless changed in the UI.
+pub const DEFAULT_IMPORT_RESOLUTION: u64 = 8;
+
+/// What the editor is doing with the pointer in the 3D view. Paint mode (Tab) slots in
+/// here: its tools get the pointer in [`super::input::viewport_input`], edit the document's
+/// store and upload dirty samples to its GPU mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Mode {
+    /// Look at the mesh: navigation only.
+    #[default]
+    View,
+}
+
+impl Mode {
+    /// Name for the status line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::View => "View",
+        }
+    }
+}
+
+/// How bad a status message is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Severity {
+    /// Progress and results.
+    Info,
+    /// Something worked, with caveats.
+    Warning,
+    /// Something failed; nothing was changed.
+    Error,
+}
+
+/// The status line's message.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Status {
+    /// The message.
+    pub text: String,
+    /// Its severity.
+    pub severity: Severity,
+}
+
+/// Everything that decides how the 3D view looks, besides the camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewSettings {
+    /// Mesh-colors reconstruction filter.
+    pub filter: FilterMode,
+    /// Lit or unlit.
+    pub shading: Shading,
+    /// Wireframe and resolution heat map.
+    pub overlays: Overlays,
+    /// Redraw every frame (to measure fps) instead of only when something changes.
+    pub continuous_redraw: bool,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        ViewSettings {
+            filter: FilterMode::Trilinear,
+            shading: Shading::Lit,
+            overlays: Overlays::default(),
+            continuous_redraw: false,
+        }
+    }
+}
+
+/// Every command the UI offers: shortcuts and menus map to these
+/// ([`super::input::SHORTCUTS`]), and [`Editor::perform`] carries them out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Action {
+    /// Show the Open dialog.
+    Open,
+    /// Save the project (packed file); asks for a name the first time.
+    Save,
+    /// Save under a new name.
+    SaveAs,
+    /// Export a tessellated vertex-colour .glb.
+    ExportGltf,
+    /// Export the packed buffers in a chosen colour format.
+    ExportPacked,
+    /// Frame the whole mesh.
+    FrameAll,
+    /// Centre on the surface point under the cursor and move halfway towards it.
+    FrameUnderCursor,
+    /// Look from the front (+Z).
+    ViewFront,
+    /// Look from the back (−Z).
+    ViewBack,
+    /// Look from the right (+X).
+    ViewRight,
+    /// Look from the left (−X).
+    ViewLeft,
+    /// Look from above.
+    ViewTop,
+    /// Look from below.
+    ViewBottom,
+    /// Toggle the wireframe overlay.
+    ToggleWireframe,
+    /// Toggle the resolution heat map.
+    ToggleHeatmap,
+    /// Toggle lit / unlit shading.
+    ToggleShading,
+    /// Cycle the filter: nearest, linear, trilinear.
+    CycleFilter,
+    /// Show or hide the shortcut help window.
+    ToggleHelp,
+    /// Close the application.
+    Quit,
+}
+
+/// What a job produced.
+#[derive(Debug)]
+pub enum JobOutput {
+    /// A document was opened.
+    Loaded(Box<OpenDocument>),
+    /// A file was written.
+    Written(Written, WriteKind),
+}
+
+/// Which kind of file a write job produced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WriteKind {
+    /// The project (packed file) was saved.
+    Save,
+    /// Packed buffers were exported.
+    ExportPacked,
+    /// A .glb was exported.
+    ExportGltf,
+}
+
+/// The 3D view's area this frame, as the last [`Editor::ui`] laid it out.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewportInfo {
+    /// The area in points.
+    pub rect: egui::Rect,
+    /// Physical pixels per point.
+    pub pixels_per_point: f32,
+}
+
+impl ViewportInfo {
+    /// The area's size in physical pixels (at least 1×1).
+    pub fn size_px(&self) -> [u32; 2] {
+        let w = (self.rect.width() * self.pixels_per_point).round().max(1.0) as u32;
+        let h = (self.rect.height() * self.pixels_per_point).round().max(1.0) as u32;
+        [w, h]
+    }
+
+    /// The area's top-left corner in physical pixels.
+    pub fn min_px(&self) -> [i32; 2] {
+        [(self.rect.min.x * self.pixels_per_point).round() as i32, (self.rect.min.y * self.pixels_per_point).round() as i32]
+    }
+}
+
+/// Frame timing for the scene panel.
+#[derive(Debug, Clone, Default)]
+pub struct FrameStats {
+    /// Frames drawn in the current one-second window.
+    frames: u32,
+    window_start: Option<Instant>,
+    /// Frames per second over the last full second of redrawing.
+    pub fps: f32,
+    /// CPU time of the last frame (UI, 3D and egui recording, submit), milliseconds.
+    pub frame_ms: f32,
+}
+
+impl FrameStats {
+    /// Records one drawn frame that took `cpu_time`.
+    pub fn record(&mut self, cpu_time: Duration) {
+        let now = Instant::now();
+        self.frame_ms = cpu_time.as_secs_f32() * 1000.0;
+        let start = *self.window_start.get_or_insert(now);
+        self.frames += 1;
+        let elapsed = now.duration_since(start).as_secs_f32();
+        if elapsed >= 1.0 {
+            self.fps = self.frames as f32 / elapsed;
+            self.frames = 0;
+            self.window_start = Some(now);
+        }
+    }
+}
+
+/// The editor.
+pub struct Editor {
+    /// GPU objects shared with jobs (`None` in UI tests without a GPU).
+    pub gpu: Option<Arc<Gpu>>,
+    /// The open document, if any.
+    pub document: Option<OpenDocument>,
+    /// The camera of the 3D view.
+    pub camera: OrbitCamera,
+    /// Filter, shading, overlays.
+    pub view: ViewSettings,
+    /// The interaction mode.
+    pub mode: Mode,
+    /// The status line.
+    pub status: Status,
+    /// Background work.
+    pub jobs: Jobs<JobOutput>,
+    /// The open file dialog, if any.
+    pub dialog: Option<FileDialog>,
+    /// Whether the shortcut help window is shown.
+    pub show_help: bool,
+    /// Resolution given to glTF files opened next.
+    pub import_resolution: Resolution,
+    /// The 3D view's area (set by [`Editor::ui`]).
+    pub viewport: ViewportInfo,
+    /// The egui texture showing the 3D view (registered by the window shell).
+    pub viewport_texture: Option<egui::TextureId>,
+    /// GPU memory of the 3D view's render targets (set by the window shell).
+    pub viewport_gpu_bytes: u64,
+    /// Frame timing (recorded by the window shell).
+    pub frame_stats: FrameStats,
+    /// Counts changes of what the GPU mesh shows (a new document; later, paint uploads):
+    /// the window shell redraws the 3D view only when this, the size or the settings change.
+    pub scene_generation: u64,
+    /// The pointer over the 3D view (points), if it is there.
+    pub viewport_pointer: Option<egui::Pos2>,
+    /// Set when the user asked to quit.
+    pub quit_requested: bool,
+    /// A load error to report once the built-in scene has replaced a failed start-up file.
+    fallback_error: Option<String>,
+    /// Where file dialogs start.
+    last_directory: PathBuf,
+}
+
+impl std::fmt::Debug for Editor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Editor")
+            .field("document", &self.document.as_ref().map(|d| &d.title))
+            .field("mode", &self.mode)
+            .field("status", &self.status)
+            .field("jobs", &self.jobs)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Editor {
+    /// An editor with no document. `waker` is called from worker threads to request a
+    /// repaint (progress, completion).
+    pub fn new(gpu: Option<Arc<Gpu>>, waker: Waker) -> Self {
+        let sphere = crate::camera::BoundingSphere { center: [0.0; 3], radius: 1.0 };
+        Editor {
+            gpu,
+            document: None,
+            camera: OrbitCamera::framing(sphere, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES),
+            view: ViewSettings::default(),
+            mode: Mode::default(),
+            status: Status { text: "Welcome to meshpaint. F1 lists the shortcuts.".into(), severity: Severity::Info },
+            jobs: Jobs::new(waker),
+            dialog: None,
+            show_help: false,
+            import_resolution: Resolution::new(DEFAULT_IMPORT_RESOLUTION).unwrap_or(Resolution::ONE),
+            viewport: ViewportInfo { rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1.0, 1.0)), pixels_per_point: 1.0 },
+            viewport_texture: None,
+            viewport_gpu_bytes: 0,
+            frame_stats: FrameStats::default(),
+            scene_generation: 0,
+            viewport_pointer: None,
+            quit_requested: false,
+            fallback_error: None,
+            last_directory: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+        }
+    }
+
+    /// Sets the status line.
+    pub fn set_status(&mut self, severity: Severity, text: impl Into<String>) {
+        let text = text.into();
+        match severity {
+            Severity::Info => log::info!("{text}"),
+            Severity::Warning => log::warn!("{text}"),
+            Severity::Error => log::error!("{text}"),
+        }
+        self.status = Status { text, severity };
+    }
+
+    /// The render settings of the 3D view.
+    pub fn render_settings(&self) -> RenderSettings {
+        let mut settings = RenderSettings::new(self.camera);
+        settings.filter = self.view.filter;
+        settings.shading = self.view.shading;
+        settings.overlays = self.view.overlays;
+        settings
+    }
+
+    /// Opens `source` on a worker thread; the current document stays until the new one
+    /// is ready, and stays for good if opening fails.
+    pub fn open(&mut self, source: Source) {
+        let resolution = self.import_resolution;
+        let gpu = self.gpu.clone();
+        let name = source.name();
+        if let Source::File(path) = &source
+            && let Some(parent) = path.parent().filter(|p| p.is_dir())
+        {
+            self.last_directory = parent.to_owned();
+        }
+        let label = format!("Opening {name}");
+        let started = self.jobs.start(label.clone(), move |job| {
+            loaded::load(&source, resolution, gpu.as_deref(), job)
+                .map(|document| JobOutput::Loaded(Box::new(document)))
+                .map_err(|error| error_text(&error))
+        });
+        match started {
+            Ok(()) => self.set_status(Severity::Info, format!("{label}…")),
+            Err(message) => self.set_status(Severity::Error, message),
+        }
+    }
+
+    /// Saves the project to `path` as a packed file in `format`.
+    pub fn save_to(&mut self, path: PathBuf, format: ColorFormat) {
+        self.write(path, format, WriteKind::Save);
+    }
+
+    /// Starts a write job (save or export).
+    fn write(&mut self, path: PathBuf, format: ColorFormat, kind: WriteKind) {
+        let Some(open) = &self.document else {
+            self.set_status(Severity::Error, "Nothing to save: no document is open.");
+            return;
+        };
+        let document = Arc::clone(&open.document);
+        if let Some(parent) = path.parent().filter(|p| p.is_dir()) {
+            self.last_directory = parent.to_owned();
+        }
+        let label = match kind {
+            WriteKind::Save => format!("Saving {}", path.display()),
+            WriteKind::ExportPacked => format!("Exporting packed buffers to {}", path.display()),
+            WriteKind::ExportGltf => format!("Exporting glTF to {}", path.display()),
+        };
+        let started = self.jobs.start(label.clone(), move |job| {
+            let written = match kind {
+                WriteKind::Save | WriteKind::ExportPacked => loaded::write_packed(&document, format, &path, job),
+                WriteKind::ExportGltf => loaded::write_gltf(&document, &path, job),
+            };
+            written.map(|written| JobOutput::Written(written, kind)).map_err(|error| error_text(&error))
+        });
+        match started {
+            Ok(()) => self.set_status(Severity::Info, format!("{label}…")),
+            Err(message) => self.set_status(Severity::Error, message),
+        }
+    }
+
+    /// Applies a finished job, if any (called every frame).
+    pub fn poll_jobs(&mut self) {
+        if let Some((label, finished)) = self.jobs.poll() {
+            self.finish_job(label, finished);
+        }
+    }
+
+    /// Waits up to `timeout` for the running job and applies it (tests, scripted runs).
+    pub fn wait_for_job(&mut self, timeout: Duration) -> bool {
+        match self.jobs.wait(timeout) {
+            Some((label, finished)) => {
+                self.finish_job(label, finished);
+                true
+            }
+            None => !self.jobs.is_busy(),
+        }
+    }
+
+    fn finish_job(&mut self, label: String, finished: Finished<JobOutput>) {
+        match finished {
+            Finished::Done { value: JobOutput::Loaded(document), elapsed } => {
+                let document = *document;
+                let mut text = format!(
+                    "Opened {}: {} triangles, {} samples ({:.2} s)",
+                    document.title,
+                    thousands(u64::from(document.triangles())),
+                    thousands(document.samples),
+                    elapsed.as_secs_f64()
+                );
+                let notes = &document.document.warnings;
+                match notes.as_slice() {
+                    [] => {}
+                    [note] => text.push_str(&format!("; note: {note}")),
+                    [first, ..] => text.push_str(&format!("; {} notes, first: {first}", notes.len())),
+                }
+                for note in notes {
+                    log::info!("{}: {note}", document.title);
+                }
+                self.camera = OrbitCamera::framing(document.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES);
+                self.document = Some(document);
+                self.scene_generation += 1;
+                self.frame_all();
+                match self.fallback_error.take() {
+                    Some(error) => self.set_status(Severity::Error, format!("{error} — showing the built-in Duck instead")),
+                    None => self.set_status(Severity::Info, text),
+                }
+            }
+            Finished::Done { value: JobOutput::Written(written, kind), elapsed } => {
+                if let (Some(repack), Some(open)) = (written.repack, self.document.as_mut()) {
+                    open.last_repack = repack;
+                }
+                if kind == WriteKind::Save
+                    && let Some(open) = self.document.as_mut()
+                {
+                    // Save now writes here, in this format.
+                    open.project_path = Some(written.path.clone());
+                    open.title = written
+                        .path
+                        .file_name()
+                        .map_or_else(|| written.path.display().to_string(), |n| n.to_string_lossy().into_owned());
+                    if let Some(format) = written.format {
+                        open.format = format;
+                    }
+                }
+                let verb = match kind {
+                    WriteKind::Save => "Saved",
+                    WriteKind::ExportPacked | WriteKind::ExportGltf => "Exported",
+                };
+                self.set_status(
+                    Severity::Info,
+                    format!("{verb} {}: {} ({:.2} s)", written.path.display(), written.summary, elapsed.as_secs_f64()),
+                );
+            }
+            Finished::Failed(message) => {
+                let is_open = label.starts_with("Opening");
+                if is_open && self.document.is_none() && !label.ends_with(loaded::DEFAULT_SCENE_NAME) {
+                    // Nothing was open (a bad file on the command line): show the Duck.
+                    self.fallback_error = Some(format!("Could not open: {message}"));
+                    self.set_status(Severity::Error, format!("Could not open: {message}"));
+                    self.open(Source::BuiltIn);
+                    return;
+                }
+                let kept = match &self.document {
+                    Some(open) => format!(" (still showing {})", open.title),
+                    None => String::new(),
+                };
+                let what = if is_open { "Could not open" } else { "Failed" };
+                self.set_status(Severity::Error, format!("{what}: {message}{kept}"));
+            }
+        }
+    }
+
+    /// Carries out `action`.
+    pub fn perform(&mut self, action: Action) {
+        match action {
+            Action::Open => self.open_dialog(DialogPurpose::Open),
+            Action::Save => match self.document.as_ref().and_then(|d| Some((d.project_path.clone()?, d.format))) {
+                Some((path, format)) => self.save_to(path, format),
+                None => self.open_dialog(DialogPurpose::SaveAs),
+            },
+            Action::SaveAs => self.open_dialog(DialogPurpose::SaveAs),
+            Action::ExportGltf => self.open_dialog(DialogPurpose::ExportGltf),
+            Action::ExportPacked => self.open_dialog(DialogPurpose::ExportPacked),
+            Action::FrameAll => self.frame_all(),
+            Action::FrameUnderCursor => {
+                if let Some(pos) = self.viewport_pointer {
+                    self.frame_under(pos);
+                }
+            }
+            Action::ViewFront => self.set_view_angles(0.0, 0.0),
+            Action::ViewBack => self.set_view_angles(180.0, 0.0),
+            Action::ViewRight => self.set_view_angles(90.0, 0.0),
+            Action::ViewLeft => self.set_view_angles(-90.0, 0.0),
+            Action::ViewTop => self.set_view_angles(0.0, 89.0),
+            Action::ViewBottom => self.set_view_angles(0.0, -89.0),
+            Action::ToggleWireframe => self.view.overlays.wireframe = !self.view.overlays.wireframe,
+            Action::ToggleHeatmap => self.view.overlays.heatmap = !self.view.overlays.heatmap,
+            Action::ToggleShading => {
+                self.view.shading = match self.view.shading {
+                    Shading::Lit => Shading::Unlit,
+                    Shading::Unlit => Shading::Lit,
+                }
+            }
+            Action::CycleFilter => {
+                self.view.filter = match self.view.filter {
+                    FilterMode::Nearest | FilterMode::NearestMipLevel(_) => FilterMode::Linear,
+                    FilterMode::Linear | FilterMode::MipLevel(_) => FilterMode::Trilinear,
+                    FilterMode::Trilinear => FilterMode::Nearest,
+                }
+            }
+            Action::ToggleHelp => self.show_help = !self.show_help,
+            Action::Quit => self.quit_requested = true,
+        }
+    }
+
+    /// Shows the file dialog for `purpose` (refused while a job runs).
+    pub fn open_dialog(&mut self, purpose: DialogPurpose) {
+        if self.jobs.is_busy() && purpose != DialogPurpose::Open {
+            self.set_status(Severity::Warning, "Busy: wait for the running job to finish.");
+            return;
+        }
+        if purpose != DialogPurpose::Open && self.document.is_none() {
+            self.set_status(Severity::Error, "Nothing to save or export: no document is open.");
+            return;
+        }
+        let stem = self
+            .document
+            .as_ref()
+            .and_then(|d| d.path.as_deref().and_then(Path::file_stem).map(|s| s.to_string_lossy().into_owned()))
+            .unwrap_or_else(|| "duck".to_owned());
+        let file_name = match purpose {
+            DialogPurpose::Open => String::new(),
+            DialogPurpose::SaveAs | DialogPurpose::ExportPacked => format!("{stem}.mpk"),
+            DialogPurpose::ExportGltf => format!("{stem}_meshcolors.glb"),
+        };
+        let format = self.document.as_ref().map_or_else(ColorFormat::default, |d| d.format);
+        self.dialog = Some(FileDialog::new(purpose, self.last_directory.clone(), file_name, format));
+    }
+
+    /// Handles the dialog's decision.
+    pub(crate) fn dialog_ui(&mut self, ctx: &egui::Context) {
+        let Some(dialog) = self.dialog.as_mut() else {
+            return;
+        };
+        let purpose = dialog.purpose;
+        match dialog.file_dialog_ui(ctx) {
+            DialogOutcome::Pending => {}
+            DialogOutcome::Cancelled => self.dialog = None,
+            DialogOutcome::Chosen(path, format) => {
+                self.dialog = None;
+                match purpose {
+                    DialogPurpose::Open => self.open(Source::File(path)),
+                    DialogPurpose::SaveAs => self.write(path, format, WriteKind::Save),
+                    DialogPurpose::ExportPacked => self.write(path, format, WriteKind::ExportPacked),
+                    DialogPurpose::ExportGltf => self.write(path, format, WriteKind::ExportGltf),
+                }
+            }
+        }
+    }
+
+    /// Frames the whole mesh, keeping the viewing angles; the sphere fits the narrower of
+    /// the two fields of view.
+    pub fn frame_all(&mut self) {
+        let Some(open) = &self.document else {
+            return;
+        };
+        let (yaw, pitch) = (self.camera.yaw_degrees, self.camera.pitch_degrees);
+        let mut camera = OrbitCamera::framing(open.bounds, yaw, pitch);
+        let [w, h] = self.viewport.size_px();
+        let aspect = f64::from(w) / f64::from(h.max(1));
+        if aspect < 1.0 {
+            let half_y = (camera.fov_y_degrees.to_radians() * 0.5).tan();
+            let half_x = (half_y * aspect).atan();
+            camera.distance = open.bounds.radius / half_x.sin() * 1.1;
+        }
+        self.camera = camera;
+    }
+
+    /// Looks at the mesh from `yaw`/`pitch`, framing it.
+    pub fn set_view_angles(&mut self, yaw: f64, pitch: f64) {
+        self.camera.yaw_degrees = yaw;
+        self.camera.pitch_degrees = pitch;
+        self.frame_all();
+    }
+
+    /// Centres the view on the surface point under `pos` (points, window coordinates) and
+    /// halves the distance to it. Reports a miss on the status line.
+    pub fn frame_under(&mut self, pos: egui::Pos2) {
+        let Some(hit) = self.pick(pos) else {
+            self.set_status(Severity::Info, "Nothing under the cursor to frame.");
+            return;
+        };
+        let distance = (self.camera.eye() - hit).length() * 0.5;
+        self.camera.look_at_point(hit, distance);
+        if let Some(open) = &self.document {
+            self.camera.fit_depth_to(open.bounds);
+        }
+    }
+
+    /// The surface point under `pos` (points, window coordinates), if the ray hits the mesh.
+    pub fn pick(&self, pos: egui::Pos2) -> Option<DVec3> {
+        let open = self.document.as_ref()?;
+        let rect = self.viewport.rect;
+        if !rect.contains(pos) {
+            return None;
+        }
+        let ppp = f64::from(self.viewport.pixels_per_point);
+        let [w, h] = self.viewport.size_px();
+        let x = f64::from(pos.x - rect.min.x) * ppp;
+        let y = f64::from(pos.y - rect.min.y) * ppp;
+        let (origin, direction) = self.camera.ray_through_pixel(x, y, w, h);
+        let hit = open.bvh.cast(origin, direction, f64::INFINITY)?;
+        Some(DVec3::from_array(hit.position_world))
+    }
+
+    /// GPU memory in use: the mesh's buffers and atlas plus the view's render targets.
+    pub fn gpu_bytes(&self) -> u64 {
+        let mesh = self.document.as_ref().and_then(|d| d.gpu_mesh.as_ref()).map_or(0, |m| m.gpu_bytes());
+        mesh + self.viewport_gpu_bytes
+    }
+
+    /// The window title.
+    pub fn window_title(&self) -> String {
+        match &self.document {
+            Some(open) => format!("{} — meshpaint", open.title),
+            None => "meshpaint".to_owned(),
+        }
+    }
+}
+
+
+/// The error and its causes on one line, skipping causes the message already quotes.
+pub fn error_text(error: &anyhow::Error) -> String {
+    let mut message = String::new();
+    for cause in error.chain() {
+        let text = cause.to_string();
+        if !message.contains(&text) {
+            if !message.is_empty() {
+                message.push_str(": ");
+            }
+            message.push_str(&text);
+        }
+    }
+    message
+}
+
+/// `1234567` → `1,234,567`.
+pub fn thousands(value: u64) -> String {
+    let digits = value.to_string();
+    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}

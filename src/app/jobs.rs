@@ -1,0 +1,175 @@
+//! Long operations (import, conversion, export) on a worker thread, with progress.
+//!
+//! One job runs at a time. The UI thread starts it with [`Jobs::start`], polls it once per
+//! frame with [`Jobs::poll`] and draws its [`Progress`]; the worker reports progress and
+//! wakes the UI through a callback (the window's repaint request), so a finished job is
+//! noticed at once without redrawing continuously. A panic inside a job becomes an error
+//! message, never a crash.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::mpsc::{self, Receiver, TryRecvError};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// A callback that wakes the UI thread (a repaint request); called from the worker.
+pub type Waker = Arc<dyn Fn() + Send + Sync>;
+
+/// Progress of a running job: a fraction in `[0, 1]` and the name of the current stage.
+#[derive(Debug, Default)]
+pub struct Progress {
+    fraction_bits: AtomicU32,
+    stage: Mutex<String>,
+}
+
+impl Progress {
+    /// Enters `stage` at `fraction` of the whole job.
+    pub fn set(&self, fraction: f32, stage: &str) {
+        self.fraction_bits.store(fraction.clamp(0.0, 1.0).to_bits(), Ordering::Relaxed);
+        if let Ok(mut current) = self.stage.lock() {
+            stage.clone_into(&mut current);
+        }
+    }
+
+    /// The fraction done, `[0, 1]`.
+    pub fn fraction(&self) -> f32 {
+        f32::from_bits(self.fraction_bits.load(Ordering::Relaxed))
+    }
+
+    /// The current stage, e.g. "importing".
+    pub fn stage(&self) -> String {
+        self.stage.lock().map(|stage| stage.clone()).unwrap_or_default()
+    }
+}
+
+/// What a job hands to its body: progress reporting that also wakes the UI.
+#[derive(Clone)]
+pub struct JobContext {
+    progress: Arc<Progress>,
+    waker: Waker,
+}
+
+impl JobContext {
+    /// Reports entering `stage` at `fraction` and wakes the UI to show it.
+    pub fn progress(&self, fraction: f32, stage: &str) {
+        self.progress.set(fraction, stage);
+        (self.waker)();
+    }
+}
+
+/// A job that is running.
+struct Running<T> {
+    label: String,
+    started: Instant,
+    progress: Arc<Progress>,
+    receiver: Receiver<Result<T, String>>,
+}
+
+/// What [`Jobs::poll`] found.
+#[derive(Debug)]
+pub enum Finished<T> {
+    /// The job returned `Ok`.
+    Done {
+        /// Its result.
+        value: T,
+        /// How long it ran.
+        elapsed: Duration,
+    },
+    /// The job failed (or panicked) with this message.
+    Failed(String),
+}
+
+/// The job runner: at most one job at a time.
+pub struct Jobs<T> {
+    running: Option<Running<T>>,
+    waker: Waker,
+}
+
+impl<T> std::fmt::Debug for Jobs<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Jobs").field("running", &self.running.as_ref().map(|job| &job.label)).finish()
+    }
+}
+
+impl<T: Send + 'static> Jobs<T> {
+    /// A runner whose workers call `waker` on progress and completion.
+    pub fn new(waker: Waker) -> Self {
+        Jobs { running: None, waker }
+    }
+
+    /// Whether a job is running.
+    pub fn is_busy(&self) -> bool {
+        self.running.is_some()
+    }
+
+    /// The running job's label, progress fraction, stage and age.
+    pub fn status(&self) -> Option<(&str, f32, String, Duration)> {
+        let job = self.running.as_ref()?;
+        Some((&job.label, job.progress.fraction(), job.progress.stage(), job.started.elapsed()))
+    }
+
+    /// Starts `work` on a worker thread under `label`; refused (returns the label back as
+    /// an error message) while another job runs.
+    pub fn start(
+        &mut self,
+        label: impl Into<String>,
+        work: impl FnOnce(&JobContext) -> Result<T, String> + Send + 'static,
+    ) -> Result<(), String> {
+        let label = label.into();
+        if let Some(running) = &self.running {
+            return Err(format!("cannot start “{label}”: “{}” is still running", running.label));
+        }
+        let progress = Arc::new(Progress::default());
+        progress.set(0.0, "starting");
+        let (sender, receiver) = mpsc::channel();
+        let context = JobContext { progress: Arc::clone(&progress), waker: Arc::clone(&self.waker) };
+        let spawned = std::thread::Builder::new().name(format!("job: {label}")).spawn(move || {
+            let outcome = catch_unwind(AssertUnwindSafe(|| work(&context))).unwrap_or_else(|payload| {
+                let message = payload
+                    .downcast_ref::<&str>()
+                    .map(|text| (*text).to_owned())
+                    .or_else(|| payload.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "unknown panic".to_owned());
+                Err(format!("internal error: {message}"))
+            });
+            // The receiver is gone only when the app is closing.
+            let _ = sender.send(outcome);
+            (context.waker)();
+        });
+        if let Err(error) = spawned {
+            return Err(format!("cannot start a worker thread for “{label}”: {error}"));
+        }
+        self.running = Some(Running { label, started: Instant::now(), progress, receiver });
+        Ok(())
+    }
+
+    /// The running job's outcome if it has finished (the runner is then free again).
+    pub fn poll(&mut self) -> Option<(String, Finished<T>)> {
+        let job = self.running.as_ref()?;
+        let outcome = match job.receiver.try_recv() {
+            Ok(Ok(value)) => Finished::Done { value, elapsed: job.started.elapsed() },
+            Ok(Err(message)) => Finished::Failed(message),
+            Err(TryRecvError::Empty) => return None,
+            Err(TryRecvError::Disconnected) => Finished::Failed("the worker thread stopped without an answer".into()),
+        };
+        let job = self.running.take()?;
+        Some((job.label, outcome))
+    }
+
+    /// Blocks until the running job finishes (tests and shutdown), at most `timeout`.
+    pub fn wait(&mut self, timeout: Duration) -> Option<(String, Finished<T>)> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if self.running.is_none() {
+                return None;
+            }
+            if let Some(finished) = self.poll() {
+                return Some(finished);
+            }
+            if Instant::now() >= deadline {
+                return None;
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+}

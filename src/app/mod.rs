@@ -1,0 +1,25 @@
+//! The desktop editor: a window with the 3D view behind egui panels.
+//!
+//! `meshpaint` with no argument opens the built-in Duck, `meshpaint FILE` opens FILE.
+//! This module is the shell where the library, egui, winit and wgpu meet:
+//!
+//! | file | role |
+//! |---|---|
+//! | [`window`] | winit event loop, surface, egui-winit / egui-wgpu, offscreen 3D view, redraw scheduling |
+//! | [`editor`] | editor state: document, camera, view settings, mode, status, jobs; [`Action`]s |
+//! | [`panels`] | the `*_ui` functions: menu bar, file / view / scene panels, status line, help |
+//! | [`input`] | all input: shortcuts ([`input::SHORTCUTS`]) and 3D-view navigation |
+//! | [`loaded`] | the open document (store and GPU mesh side by side); open, save, export work |
+//! | [`jobs`] | one background job at a time with progress; panics become messages |
+//! | [`file_dialog`] | an egui file browser (works under Xvfb, keyboard-drivable) |
+
+pub mod editor;
+pub mod file_dialog;
+pub mod input;
+pub mod jobs;
+pub mod loaded;
+pub mod panels;
+pub mod window;
+
+pub use editor::{Action, Editor, Mode, Severity};
+pub use window::{AppOptions, run};

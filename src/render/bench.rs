@@ -1,0 +1,251 @@
+//! `meshpaint bench render`: frame time of the UV-texture baseline and of every mesh-colors
+//! filter mode on the same mesh, view and image size, interleaved in one run, as ratios to
+//! the baseline; plus the GPU memory each path holds.
+//!
+//! A frame is one render pass into an offscreen target, submitted and waited for
+//! (`poll(wait)`), so on lavapipe it measures the rasteriser's whole work. Modes are
+//! interleaved round by round so that machine noise hits all of them alike; the median
+//! frame of each mode is reported with the best.
+//!
+//! The baseline needs UVs and a texture. A mesh without them (e.g. Bunny) gets a synthetic
+//! baseline: a planar projection of its bounding box onto a procedural texture with as many
+//! texels as the mesh-colors buffer has level-0 samples (at least 256²), so both paths hold
+//! a comparable signal; the report says which baseline was used.
+
+use std::time::Instant;
+
+use crate::camera::OrbitCamera;
+use crate::color::ColorFormat;
+use crate::document::{Document, bounds};
+use crate::import::import_gltf;
+use crate::scene::Texture;
+use crate::weld::weld_scene;
+
+use super::{
+    BaselineMesh, DrawItem, FilterMode, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderError,
+    RenderSettings, RenderTarget, Renderer, Shading, default_camera,
+};
+
+/// One measured path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModeTiming {
+    /// `baseline-uv`, `nearest`, `linear`, `mip-1`, `trilinear`.
+    pub name: String,
+    /// Median frame time, seconds.
+    pub median_seconds: f64,
+    /// Fastest frame, seconds.
+    pub best_seconds: f64,
+    /// Bytes of GPU buffers and textures this path needs.
+    pub gpu_bytes: u64,
+}
+
+/// The whole render benchmark.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderBench {
+    /// Adapter description.
+    pub adapter: String,
+    /// Image size.
+    pub width: u32,
+    /// Image size.
+    pub height: u32,
+    /// Frames per mode.
+    pub frames: usize,
+    /// Triangles drawn.
+    pub triangles: u32,
+    /// Which baseline was drawn (`gltf texture` or `synthetic planar`).
+    pub baseline: String,
+    /// Baseline first, then each filter mode.
+    pub modes: Vec<ModeTiming>,
+}
+
+impl RenderBench {
+    /// As JSON, with each mode's ratio to the baseline.
+    pub fn to_json(&self) -> serde_json::Value {
+        let baseline = self.modes.first().map_or(f64::NAN, |m| m.median_seconds);
+        let modes: Vec<serde_json::Value> = self
+            .modes
+            .iter()
+            .map(|m| {
+                serde_json::json!({
+                    "mode": m.name,
+                    "median_ms": m.median_seconds * 1e3,
+                    "best_ms": m.best_seconds * 1e3,
+                    "ratio_to_baseline": m.median_seconds / baseline,
+                    "gpu_bytes": m.gpu_bytes,
+                })
+            })
+            .collect();
+        serde_json::json!({
+            "bench": "render",
+            "adapter": self.adapter,
+            "width": self.width,
+            "height": self.height,
+            "frames_per_mode": self.frames,
+            "triangles": self.triangles,
+            "baseline": self.baseline,
+            "modes": modes,
+        })
+    }
+}
+
+/// A procedural RGBA8 texture (smooth colour waves with fine detail), `size × size`.
+fn synthetic_texture(size: u32) -> Texture {
+    let mut rgba8_srgb = Vec::with_capacity((size * size * 4) as usize);
+    for y in 0..size {
+        for x in 0..size {
+            let (u, v) = (x as f32 / size as f32, y as f32 / size as f32);
+            let wave = |a: f32, b: f32| (127.5 + 127.5 * (a * 40.0 + b * 23.0).sin()) as u8;
+            rgba8_srgb.extend_from_slice(&[wave(u, v), wave(v, 0.7 * u), wave(u + v, 0.3), 255]);
+        }
+    }
+    Texture { width: size, height: size, rgba8_srgb }
+}
+
+/// Runs the benchmark on `document` (opened from `path`, which is re-imported for its UVs).
+pub fn bench_render(
+    path: &std::path::Path,
+    document: &Document,
+    width: u32,
+    height: u32,
+    frames: usize,
+) -> Result<RenderBench, BenchRenderError> {
+    let ctx = GpuContext::new_headless()?;
+    let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT)?;
+    let packed = document.pack(ColorFormat::Rgba8Srgb)?;
+    let mesh = GpuMesh::upload(&ctx, &renderer, &packed, &MeshUploadOptions::default())?;
+
+    // Baseline: the file's own UVs and texture when it has them.
+    let scene = import_gltf(path).ok();
+    let textured = scene.as_ref().and_then(|scene| {
+        scene.materials.iter().find_map(|material| {
+            let texture = scene.textures.get(material.base_color_texture? as usize)?;
+            Some((weld_scene(scene), texture.clone(), material.base_color_factor))
+        })
+    });
+    let (baseline_name, baseline) = match textured {
+        Some((welded, texture, factor)) => (
+            "gltf texture".to_owned(),
+            BaselineMesh::new(
+                &ctx,
+                &renderer,
+                &welded.positions_world,
+                &welded.triangles,
+                &welded.corner_uvs,
+                &texture,
+                factor,
+            )?,
+        ),
+        None => {
+            let (min, size) = bounds(&document.positions);
+            let corner_uvs: Vec<[[f32; 2]; 3]> = document
+                .store
+                .topology()
+                .face_vertices
+                .iter()
+                .map(|face| {
+                    face.map(|v| {
+                        let p = document.positions[v as usize];
+                        let uv = |a: usize| if size[a] > 0.0 { (p[a] - min[a]) / size[a] } else { 0.0 };
+                        [uv(0), uv(1)]
+                    })
+                })
+                .collect();
+            let texels = (document.store.sample_count() as f64).sqrt().ceil().max(256.0) as u32;
+            let side = texels.next_power_of_two().min(ctx.limits().max_texture_dimension_2d);
+            (
+                format!("synthetic planar {side}x{side}"),
+                BaselineMesh::new(
+                    &ctx,
+                    &renderer,
+                    &document.positions,
+                    &document.store.topology().face_vertices,
+                    &corner_uvs,
+                    &synthetic_texture(side),
+                    [1.0; 4],
+                )?,
+            )
+        }
+    };
+
+    let camera: OrbitCamera = default_camera(&document.positions, 30.0, 20.0, None);
+    let color = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("bench colour"),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: OFFSCREEN_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let depth = Renderer::create_depth_texture(&ctx, width, height);
+    let color_view = color.create_view(&wgpu::TextureViewDescriptor::default());
+    let depth_view = depth.create_view(&wgpu::TextureViewDescriptor::default());
+    let target = RenderTarget { color: &color_view, depth: &depth_view, width, height };
+
+    let filters = [
+        ("nearest", FilterMode::Nearest),
+        ("linear", FilterMode::Linear),
+        ("mip-1", FilterMode::MipLevel(1)),
+        ("trilinear", FilterMode::Trilinear),
+    ];
+    let paths = 1 + filters.len();
+    let mut times: Vec<Vec<f64>> = vec![Vec::with_capacity(frames); paths];
+    let frame = |item: DrawItem<'_>, filter: FilterMode| -> f64 {
+        let mut settings = RenderSettings::new(camera);
+        settings.filter = filter;
+        settings.shading = Shading::Unlit;
+        let start = Instant::now();
+        let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        renderer.draw(&ctx, &mut encoder, &target, item, &settings);
+        ctx.queue.submit([encoder.finish()]);
+        // A failed wait leaves the timing as measured so far; the report still compares.
+        let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+        start.elapsed().as_secs_f64()
+    };
+    // One warm-up frame per path (pipeline and cache warm-up), then interleaved rounds.
+    frame(DrawItem::Baseline(&baseline), FilterMode::Linear);
+    for (_, filter) in filters {
+        frame(DrawItem::MeshColors(&mesh), filter);
+    }
+    for _ in 0..frames.max(1) {
+        times[0].push(frame(DrawItem::Baseline(&baseline), FilterMode::Linear));
+        for (k, (_, filter)) in filters.iter().enumerate() {
+            times[k + 1].push(frame(DrawItem::MeshColors(&mesh), *filter));
+        }
+    }
+    let summarise = |name: &str, mut samples: Vec<f64>, gpu_bytes: u64| {
+        samples.sort_by(f64::total_cmp);
+        ModeTiming {
+            name: name.to_owned(),
+            median_seconds: samples[samples.len() / 2],
+            best_seconds: samples[0],
+            gpu_bytes,
+        }
+    };
+    let mut times = times.into_iter();
+    let mut modes = vec![summarise("baseline-uv", times.next().unwrap_or_default(), baseline.gpu_bytes())];
+    for ((name, _), samples) in filters.iter().zip(times) {
+        modes.push(summarise(name, samples, mesh.gpu_bytes()));
+    }
+    Ok(RenderBench {
+        adapter: ctx.describe(),
+        width,
+        height,
+        frames: frames.max(1),
+        triangles: mesh.face_count,
+        baseline: baseline_name,
+        modes,
+    })
+}
+
+/// Errors of the render benchmark.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchRenderError {
+    /// The GPU side failed.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// Packing the document failed.
+    #[error(transparent)]
+    Pack(#[from] crate::packer::PackError),
+}
