@@ -351,9 +351,10 @@ fn sample_index(d: LevelData, i: u32, j: u32) -> u32 {
 
 // Texel of colour index `index` (clamped below sample_count): (index % W, index / W),
 // computed without an integer division (which SIMD rasterisers run lane by lane).
-// Exact for index < 2^28 and W <= 2^14: a float estimate of the quotient is off by at
-// most ~50, one float step on the (exact, small) remainder brings it within one, and a
-// final compare fixes that.
+// Exact while the quotient (the atlas row) is below 2^16 and W <= 2^16, even with a
+// reciprocal good to only 2^-10: the float estimate of the quotient is then off by at
+// most 64, one float step on the exact remainder brings it within one, and the final
+// compares fix that.
 fn atlas_texel(index: u32) -> vec2<u32> {
     let idx = min(index, max(u.sample_count, 1u) - 1u);
     let w = max(u.atlas_width, 1u);
@@ -361,9 +362,12 @@ fn atlas_texel(index: u32) -> vec2<u32> {
     let q0 = u32(f32(idx) * inv_w);
     let r0 = i32(idx - q0 * w);
     let q1 = u32(i32(q0) + i32(floor(f32(r0) * inv_w)));
-    let r1 = idx - q1 * w;
-    let carry = r1 >= w;
-    return vec2<u32>(select(r1, r1 - w, carry), select(q1, q1 + 1u, carry));
+    let r1 = i32(idx - q1 * w);
+    let below = r1 < 0;
+    let above = r1 >= i32(w);
+    let x = select(select(r1, r1 - i32(w), above), r1 + i32(w), below);
+    let y = select(select(q1, q1 + 1u, above), q1 - 1u, below);
+    return vec2<u32>(u32(x), y);
 }
 
 fn load_sample(index: u32) -> vec4<f32> {
@@ -392,15 +396,17 @@ fn sample_level(d: LevelData, bary: vec3<f32>) -> vec4<f32> {
 
 @fragment
 fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    // Derivatives first, in uniform control flow: barycentric widths for the wireframe.
+    // Derivatives first, in uniform control flow: lattice-coordinate footprint (per unit
+    // resolution; unused, hence compiled out, at a fixed level) and barycentric widths for
+    // the wireframe.
+    let duv_dx = dpdx(in.bary.yz);
+    let duv_dy = dpdy(in.bary.yz);
     let bary_width = fwidth(in.bary);
     let bary = sanitize_barycentric(in.bary);
 
     var color: vec4<f32>;
     if LEVEL_MODE == 1u {
         // Automatic level: u = R_f·w1, v = R_f·w2; lod = log2 of the larger footprint.
-        let duv_dx = dpdx(in.bary.yz);
-        let duv_dy = dpdy(in.bary.yz);
         let f = unpack_face(in.face0, in.face1);
         let res_f = f32(1u << f.log2_f);
         let footprint = max(length(duv_dx * res_f), length(duv_dy * res_f));

@@ -23,6 +23,7 @@
 //! | [`resample`] | exact-inverse 2× refinement / reduction used when a face's resolution changes |
 //! | [`packed`] | the linear GPU layout: 16-byte face records and the colour buffer with MIP chains |
 //! | [`packer`] | store → packed (MIP chains, eq. 2.5/2.6) and packed → store |
+//! | [`paint_layout`] | the paint-mode GPU layout: level 0 in blocks with slack; dirty ranges and patched records |
 //! | [`sampler`] | the CPU reference sampler (nearest, linear, MIP level) on the store and on packed buffers |
 //! | [`document`] | open glTF or packed files into a store; pack for export |
 //! | [`export_gltf`] | store → .glb tessellated at each face's resolution, one vertex (COLOR_0) per sample |
@@ -61,6 +62,7 @@ pub mod layout;
 pub mod packed;
 pub mod packed_file;
 pub mod packer;
+pub mod paint_layout;
 pub mod picking;
 pub mod render;
 pub mod resample;

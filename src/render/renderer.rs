@@ -149,8 +149,28 @@ pub struct Renderer {
     color_format: wgpu::TextureFormat,
     mesh_layout: wgpu::BindGroupLayout,
     baseline_layout: wgpu::BindGroupLayout,
-    mesh_pipeline: wgpu::RenderPipeline,
+    /// One mesh-colors pipeline per `(filter_kind, level_mode)`, see [`mesh_pipeline_index`].
+    mesh_pipelines: Vec<wgpu::RenderPipeline>,
     baseline_pipeline: wgpu::RenderPipeline,
+}
+
+/// The `(filter_kind, level_mode)` combinations the mesh-colors shader is specialised for,
+/// as its pipeline-overridable constants `FILTER_KIND` and `LEVEL_MODE` (keep in sync with
+/// shaders/mesh_colors.wgsl). Each gets its own pipeline so that a fragment executes only
+/// the code of its filter: software rasterisers (lavapipe) run both sides of every branch.
+const MESH_PIPELINE_KEYS: [(u32, u32); 4] = [
+    (FrameUniforms::FILTER_NEAREST, FrameUniforms::LEVEL_FIXED),
+    (FrameUniforms::FILTER_LINEAR, FrameUniforms::LEVEL_FIXED),
+    (FrameUniforms::FILTER_NEAREST, FrameUniforms::LEVEL_AUTO),
+    (FrameUniforms::FILTER_LINEAR, FrameUniforms::LEVEL_AUTO),
+];
+
+/// Index in [`MESH_PIPELINE_KEYS`] of the pipeline for the uniforms' filter and level mode
+/// (unknown values fall back to linear / automatic, as the shader's defaults).
+fn mesh_pipeline_index(filter_kind: u32, level_mode: u32) -> usize {
+    let filter = usize::from(filter_kind != FrameUniforms::FILTER_NEAREST);
+    let level = usize::from(level_mode != FrameUniforms::LEVEL_FIXED);
+    2 * level + filter
 }
 
 fn layout_entry(binding: u32, visibility: wgpu::ShaderStages, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
@@ -191,14 +211,16 @@ impl Renderer {
 
     fn build(ctx: &GpuContext, color_format: wgpu::TextureFormat) -> Self {
         let device = &ctx.device;
-        let vertex_fragment = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        // Geometry and face records are read by the vertex stage only (it passes everything
+        // per face to the fragment stage as flat varyings); fragments read only the atlas.
+        let vertex = wgpu::ShaderStages::VERTEX;
         let mesh_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mesh colors layout"),
             entries: &[
                 uniform_entry(0),
-                storage_entry(1, vertex_fragment),
-                storage_entry(2, vertex_fragment),
-                storage_entry(3, wgpu::ShaderStages::FRAGMENT),
+                storage_entry(1, vertex),
+                storage_entry(2, vertex),
+                storage_entry(3, vertex),
                 layout_entry(
                     4,
                     wgpu::ShaderStages::FRAGMENT,
@@ -230,31 +252,48 @@ impl Renderer {
                 ),
             ],
         });
-        let mesh_pipeline = Self::pipeline(ctx, "mesh colors", MESH_COLORS_WGSL, &mesh_layout, &[], color_format);
+        let mesh_module = Self::module(ctx, "mesh colors", MESH_COLORS_WGSL);
+        let mesh_pipelines = MESH_PIPELINE_KEYS
+            .iter()
+            .enumerate()
+            .map(|(index, &(filter_kind, level_mode))| {
+                debug_assert_eq!(mesh_pipeline_index(filter_kind, level_mode), index);
+                let constants = [("FILTER_KIND", f64::from(filter_kind)), ("LEVEL_MODE", f64::from(level_mode))];
+                let label = format!("mesh colors (filter {filter_kind}, level mode {level_mode})");
+                Self::pipeline(ctx, &label, &mesh_module, &constants, &mesh_layout, &[], color_format)
+            })
+            .collect();
+        let baseline_module = Self::module(ctx, "uv baseline", UV_BASELINE_WGSL);
         let baseline_pipeline = Self::pipeline(
             ctx,
             "uv baseline",
-            UV_BASELINE_WGSL,
+            &baseline_module,
+            &[],
             &baseline_layout,
             &[Some(BaselineVertex::LAYOUT)],
             color_format,
         );
-        Renderer { color_format, mesh_layout, baseline_layout, mesh_pipeline, baseline_pipeline }
+        Renderer { color_format, mesh_layout, baseline_layout, mesh_pipelines, baseline_pipeline }
+    }
+
+    fn module(ctx: &GpuContext, label: &str, source: &str) -> wgpu::ShaderModule {
+        ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        })
     }
 
     fn pipeline(
         ctx: &GpuContext,
         label: &str,
-        source: &str,
+        module: &wgpu::ShaderModule,
+        constants: &[(&str, f64)],
         bind_group_layout: &wgpu::BindGroupLayout,
         buffers: &[Option<wgpu::VertexBufferLayout<'_>>],
         color_format: wgpu::TextureFormat,
     ) -> wgpu::RenderPipeline {
         let device = &ctx.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(label),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
+        let compilation_options = wgpu::PipelineCompilationOptions { constants, ..Default::default() };
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(label),
             bind_group_layouts: &[Some(bind_group_layout)],
@@ -264,9 +303,9 @@ impl Renderer {
             label: Some(label),
             layout: Some(&layout),
             vertex: wgpu::VertexState {
-                module: &module,
+                module,
                 entry_point: Some("vs_main"),
-                compilation_options: wgpu::PipelineCompilationOptions::default(),
+                compilation_options: compilation_options.clone(),
                 buffers,
             },
             primitive: wgpu::PrimitiveState {
@@ -284,9 +323,9 @@ impl Renderer {
             }),
             multisample: wgpu::MultisampleState::default(),
             fragment: Some(wgpu::FragmentState {
-                module: &module,
+                module,
                 entry_point: Some("fs_main"),
-                compilation_options: wgpu::PipelineCompilationOptions::default(),
+                compilation_options,
                 targets: &[Some(wgpu::ColorTargetState {
                     format: color_format,
                     blend: None,
@@ -377,7 +416,8 @@ impl Renderer {
         let uniforms = Self::uniforms(item, settings, target.width, target.height);
         let (uniform_buffer, bind_group, pipeline, vertex_count) = match item {
             DrawItem::MeshColors(mesh) => {
-                (&mesh.uniforms, &mesh.bind_group, &self.mesh_pipeline, mesh.face_count.saturating_mul(3))
+                let pipeline = &self.mesh_pipelines[mesh_pipeline_index(uniforms.filter_kind, uniforms.level_mode)];
+                (&mesh.uniforms, &mesh.bind_group, pipeline, mesh.face_count.saturating_mul(3))
             }
             DrawItem::Baseline(mesh) => (&mesh.uniforms, &mesh.bind_group, &self.baseline_pipeline, mesh.vertex_count),
         };

@@ -1,0 +1,289 @@
+//! The GPU layout used *while painting*: level 0 only, every edge and face interior in its
+//! own block with slack, so an edit uploads only what changed (see docs/PAINT_MODE.md).
+//!
+//! Outside paint mode the GPU holds the compact packed layout with MIP chains
+//! ([`crate::packer`]). Repacking that after every dab would upload the whole mesh, and a
+//! resolution change would shift every later chain. In paint mode the colour buffer instead
+//! holds
+//!
+//! - vertex `v` at index `v` (one level: `vertex_levels = 1`),
+//! - each edge's and each face interior's level-0 samples in a *block* whose capacity is
+//!   the sample count rounded up to a power of two (≥ 1 sample of slack to grow in place
+//!   for small changes, never less than needed),
+//!
+//! addressed by the same 16-byte face records the shaders already read (level 0 only, so
+//! the shader's level offsets are all zero). After a dab, [`PaintLayout::sync`] returns the
+//! dirty blocks as index ranges to re-encode and upload, plus the face records that changed.
+//! When an element's sample count outgrows its block (a raised resolution), it moves to a
+//! new block — taken from a free list of its size class or from the end of the buffer —
+//! and the records of every face that reads it are patched. Uploads are therefore
+//! proportional to the samples and records that changed. When the buffer's capacity is
+//! exhausted, `sync` says so and the caller re-uploads everything (`grown`); capacity
+//! doubles each time, so that is rare.
+
+use crate::color::{ColorFormat, Rgba};
+use crate::layout::Resolution;
+use crate::packed::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
+use crate::store::{ColorStore, DirtyElements};
+
+/// A block of the colour buffer: `base .. base + capacity`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Block {
+    /// First sample index.
+    pub base: u32,
+    /// Samples reserved (a power of two, or 0 for an element without samples).
+    pub capacity: u32,
+}
+
+/// What [`PaintLayout::sync`] asks the GPU to update.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct UploadPlan {
+    /// Sample index ranges `(first, count)` to re-encode from the store and upload,
+    /// sorted and merged where adjacent.
+    pub sample_ranges: Vec<(u32, u32)>,
+    /// Faces whose record changed, sorted.
+    pub faces: Vec<u32>,
+    /// The buffer outgrew its capacity: re-upload everything ([`PaintLayout::packed`]).
+    pub grown: bool,
+}
+
+impl UploadPlan {
+    /// Samples this plan uploads.
+    pub fn sample_count(&self) -> u64 {
+        self.sample_ranges.iter().map(|&(_, n)| u64::from(n)).sum()
+    }
+}
+
+/// Block allocation of a store's level-0 samples with slack.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaintLayout {
+    edge_blocks: Vec<Block>,
+    interior_blocks: Vec<Block>,
+    /// Free blocks per size class (`log2 capacity`).
+    free: Vec<Vec<u32>>,
+    /// First unallocated sample.
+    end: u64,
+    /// Samples the GPU buffer holds.
+    capacity: u64,
+    records: Vec<FaceRecord>,
+}
+
+fn block_capacity(samples: u32) -> u32 {
+    if samples == 0 { 0 } else { samples.next_power_of_two() }
+}
+
+impl PaintLayout {
+    /// Lays out every element of `store`, with the buffer's capacity at least `1.5×` the
+    /// space used (so early resolution raises allocate without re-uploading).
+    pub fn new(store: &ColorStore) -> Self {
+        let topology = store.topology();
+        let mut layout = PaintLayout {
+            edge_blocks: Vec::with_capacity(topology.edge_count() as usize),
+            interior_blocks: Vec::with_capacity(topology.face_count() as usize),
+            free: vec![Vec::new(); 32],
+            end: u64::from(topology.vertex_count),
+            capacity: 0,
+            records: Vec::new(),
+        };
+        for edge in 0..topology.edge_count() {
+            let block = layout.allocate(store.edge_samples(edge).len() as u32);
+            layout.edge_blocks.push(block);
+        }
+        for face in 0..topology.face_count() {
+            let block = layout.allocate(store.interior_samples(face).len() as u32);
+            layout.interior_blocks.push(block);
+        }
+        layout.capacity = (layout.end + layout.end / 2).clamp(1, MAX_SAMPLES);
+        layout.records = (0..topology.face_count()).map(|face| layout.record(store, face)).collect();
+        layout
+    }
+
+    fn allocate(&mut self, samples: u32) -> Block {
+        let capacity = block_capacity(samples);
+        if capacity == 0 {
+            return Block::default();
+        }
+        let class = capacity.trailing_zeros() as usize;
+        if let Some(base) = self.free.get_mut(class).and_then(Vec::pop) {
+            return Block { base, capacity };
+        }
+        let base = self.end.min(u64::from(u32::MAX)) as u32;
+        self.end += u64::from(capacity);
+        Block { base, capacity }
+    }
+
+    fn release(&mut self, block: Block) {
+        if block.capacity > 0
+            && let Some(list) = self.free.get_mut(block.capacity.trailing_zeros() as usize)
+        {
+            list.push(block.base);
+        }
+    }
+
+    fn record(&self, store: &ColorStore, face: u32) -> FaceRecord {
+        let topology = store.topology();
+        let r = store.face_resolution(face).unwrap_or(Resolution::ONE);
+        let edges = topology.face_edges[face as usize].map(|edge| {
+            let r_edge = store.edge_resolution(edge).unwrap_or(Resolution::ONE);
+            pack_word(self.edge_blocks[edge as usize].base, r_edge.log2())
+        });
+        FaceRecord { interior: pack_word(self.interior_blocks[face as usize].base, r.log2()), edges }
+    }
+
+    /// Samples the GPU buffer must hold (allocated blocks plus slack).
+    pub fn capacity(&self) -> u64 {
+        self.capacity
+    }
+
+    /// The face records (level 0, paint layout).
+    pub fn records(&self) -> &[FaceRecord] {
+        &self.records
+    }
+
+    /// Block of `edge`.
+    pub fn edge_block(&self, edge: u32) -> Option<Block> {
+        self.edge_blocks.get(edge as usize).copied()
+    }
+
+    /// Block of `face`'s interior.
+    pub fn interior_block(&self, face: u32) -> Option<Block> {
+        self.interior_blocks.get(face as usize).copied()
+    }
+
+    /// Brings the layout up to date with `dirty` (taken from the store after an edit) and
+    /// returns what to upload.
+    pub fn sync(&mut self, store: &ColorStore, dirty: &DirtyElements) -> UploadPlan {
+        let topology = store.topology();
+        let mut plan = UploadPlan::default();
+        let mut faces_to_patch: Vec<u32> = dirty.resized_faces.clone();
+        for &edge in &dirty.resized_edges {
+            let needed = store.edge_samples(edge).len() as u32;
+            let old = self.edge_blocks[edge as usize];
+            if block_capacity(needed) != old.capacity {
+                self.release(old);
+                self.edge_blocks[edge as usize] = self.allocate(needed);
+            }
+            faces_to_patch.extend(topology.faces_of_edge(edge).iter().map(|&(face, _)| face));
+        }
+        for &face in &dirty.resized_faces {
+            let needed = store.interior_samples(face).len() as u32;
+            let old = self.interior_blocks[face as usize];
+            if block_capacity(needed) != old.capacity {
+                self.release(old);
+                self.interior_blocks[face as usize] = self.allocate(needed);
+            }
+        }
+        faces_to_patch.sort_unstable();
+        faces_to_patch.dedup();
+        for &face in &faces_to_patch {
+            let record = self.record(store, face);
+            if self.records[face as usize] != record {
+                self.records[face as usize] = record;
+                plan.faces.push(face);
+            }
+        }
+        if self.end > self.capacity {
+            self.capacity = (self.end * 2).min(MAX_SAMPLES.max(self.end));
+            plan.grown = true;
+        }
+        let mut ranges: Vec<(u32, u32)> = Vec::new();
+        ranges.extend(dirty.vertices.iter().map(|&v| (v, 1)));
+        for &edge in &dirty.edges {
+            let len = store.edge_samples(edge).len() as u32;
+            if len > 0 {
+                ranges.push((self.edge_blocks[edge as usize].base, len));
+            }
+        }
+        for &face in &dirty.faces {
+            let len = store.interior_samples(face).len() as u32;
+            if len > 0 {
+                ranges.push((self.interior_blocks[face as usize].base, len));
+            }
+        }
+        ranges.sort_unstable();
+        for (first, count) in ranges {
+            match plan.sample_ranges.last_mut() {
+                Some((last_first, last_count)) if *last_first + *last_count == first => *last_count += count,
+                _ => plan.sample_ranges.push((first, count)),
+            }
+        }
+        plan
+    }
+
+    /// The level-0 colour of every slot in `range` (linear), read from the store; slack
+    /// slots are zero.
+    pub fn colors(&self, store: &ColorStore, first: u32, count: u32) -> Vec<Rgba> {
+        let mut out = vec![[0.0; 4]; count as usize];
+        let end = u64::from(first) + u64::from(count);
+        // Vertices first: they occupy 0..V.
+        let topology = store.topology();
+        for v in first..(end.min(u64::from(topology.vertex_count)) as u32) {
+            if let Some(color) = store.vertex_color(v) {
+                out[(v - first) as usize] = color;
+            }
+        }
+        let mut put = |base: u32, samples: &[Rgba]| {
+            for (k, &color) in samples.iter().enumerate() {
+                let index = u64::from(base) + k as u64;
+                if index >= u64::from(first) && index < end {
+                    out[(index - u64::from(first)) as usize] = color;
+                }
+            }
+        };
+        for (edge, block) in self.edge_blocks.iter().enumerate() {
+            if block.capacity > 0 && u64::from(block.base) < end && block.base + block.capacity > first {
+                put(block.base, store.edge_samples(edge as u32));
+            }
+        }
+        for (face, block) in self.interior_blocks.iter().enumerate() {
+            if block.capacity > 0 && u64::from(block.base) < end && block.base + block.capacity > first {
+                put(block.base, store.interior_samples(face as u32));
+            }
+        }
+        out
+    }
+
+    /// Encodes the samples of one upload range (fast path: walks the dirty elements only).
+    pub fn encode_range(&self, store: &ColorStore, dirty: &DirtyElements, first: u32, count: u32, format: ColorFormat) -> Vec<u8> {
+        let mut colors = vec![[0.0f32; 4]; count as usize];
+        let end = first + count;
+        let mut put = |base: u32, samples: &[Rgba]| {
+            if base >= first && base < end {
+                let start = (base - first) as usize;
+                for (slot, &c) in colors[start..].iter_mut().zip(samples) {
+                    *slot = c;
+                }
+            }
+        };
+        for &v in &dirty.vertices {
+            if let Some(color) = store.vertex_color(v) {
+                put(v, &[color]);
+            }
+        }
+        for &edge in &dirty.edges {
+            put(self.edge_blocks[edge as usize].base, store.edge_samples(edge));
+        }
+        for &face in &dirty.faces {
+            put(self.interior_blocks[face as usize].base, store.interior_samples(face));
+        }
+        let mut bytes = vec![0u8; colors.len() * format.bytes_per_sample()];
+        format.encode_slice(&colors, &mut bytes);
+        bytes
+    }
+
+    /// The whole paint-layout buffer as a [`PackedMesh`] (level 0, `vertex_levels = 1`,
+    /// `capacity` samples) for a full upload, in `format`.
+    pub fn packed(&self, store: &ColorStore, positions: &[[f32; 3]], format: ColorFormat) -> PackedMesh {
+        let colors = self.colors(store, 0, self.capacity.min(u64::from(u32::MAX)) as u32);
+        let mut bytes = vec![0u8; colors.len() * format.bytes_per_sample()];
+        format.encode_slice(&colors, &mut bytes);
+        PackedMesh {
+            positions: positions.to_vec(),
+            indices: store.topology().face_vertices.clone(),
+            vertex_levels: 1,
+            face_records: self.records.clone(),
+            format,
+            colors: bytes,
+        }
+    }
+}

@@ -1,0 +1,341 @@
+//! The real window under Xvfb: start `meshpaint Duck.glb`, drive it with xdotool (orbit,
+//! toggle the wireframe, export a .glb, open a broken file, quit) and check screenshots:
+//! the 3D view must match an offscreen render of the same camera within a tolerance, so a
+//! blank or misplaced view fails. Screenshots go to screenshots/app_*.png.
+//!
+//! Needs Xvfb, xdotool and ImageMagick (`bash .ci/run` installs them) and a Vulkan or GL
+//! adapter (lavapipe without a GPU). Missing tools fail the test; they never skip it.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use image::RgbImage;
+use meshpaint::app::editor::Editor;
+use meshpaint::app::loaded::Source;
+use meshpaint::render::{DrawItem, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, Renderer};
+
+fn crate_path(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
+}
+
+/// Child processes killed when the test ends, however it ends.
+struct Processes {
+    children: Vec<Child>,
+}
+
+impl Drop for Processes {
+    fn drop(&mut self) {
+        for child in self.children.iter_mut().rev() {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+    }
+}
+
+fn require_tool(name: &str) {
+    let found = std::env::var_os("PATH")
+        .map(|paths| std::env::split_paths(&paths).any(|dir| dir.join(name).is_file()))
+        .unwrap_or(false);
+    assert!(found, "{name} is missing: install xvfb, xdotool and imagemagick (bash .ci/run does)");
+}
+
+/// Starts Xvfb on a free display; returns the display name.
+fn start_xvfb(processes: &mut Processes) -> String {
+    let base = 100 + std::process::id() % 300;
+    for n in base..base + 40 {
+        if Path::new(&format!("/tmp/.X{n}-lock")).exists() || Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
+            continue;
+        }
+        let child = Command::new("Xvfb")
+            .args([&format!(":{n}"), "-screen", "0", "1280x800x24", "-nolisten", "tcp"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("cannot start Xvfb");
+        processes.children.push(child);
+        let started = Instant::now();
+        while started.elapsed() < Duration::from_secs(10) {
+            if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
+                return format!(":{n}");
+            }
+            if let Some(status) = processes.children.last_mut().and_then(|c| c.try_wait().ok().flatten()) {
+                eprintln!("Xvfb :{n} exited with {status}; trying the next display");
+                processes.children.pop();
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+    panic!("could not start Xvfb on any display");
+}
+
+fn xdotool(display: &str, args: &[&str]) -> String {
+    let output = Command::new("xdotool").args(args).env("DISPLAY", display).output().expect("cannot run xdotool");
+    assert!(output.status.success(), "xdotool {args:?}: {}", String::from_utf8_lossy(&output.stderr));
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+fn pause(seconds: f64) {
+    std::thread::sleep(Duration::from_secs_f64(seconds));
+}
+
+fn screenshot(display: &str, path: &Path) -> RgbImage {
+    let status = Command::new("import")
+        .args(["-window", "root"])
+        .arg(path)
+        .env("DISPLAY", display)
+        .status()
+        .expect("cannot run ImageMagick's import");
+    assert!(status.success(), "import failed");
+    image::open(path).expect("unreadable screenshot").to_rgb8()
+}
+
+/// The application's log so far.
+fn read_log(path: &Path) -> String {
+    let mut text = String::new();
+    if let Ok(mut file) = std::fs::File::open(path) {
+        let _ = file.read_to_string(&mut text);
+    }
+    text
+}
+
+/// Waits until the log contains `needle` (after `from` bytes); returns the log.
+fn wait_for_log(path: &Path, needle: &str, from: usize, timeout: Duration) -> String {
+    let started = Instant::now();
+    loop {
+        let log = read_log(path);
+        if log.get(from..).is_some_and(|tail| tail.contains(needle)) {
+            return log;
+        }
+        assert!(started.elapsed() < timeout, "no “{needle}” in the log after {timeout:?}:\n{log}");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+/// The last "3D view at X,Y size WxH px" of the log.
+fn view_rect(log: &str) -> (u32, u32, u32, u32) {
+    let line = log.lines().rev().find(|l| l.contains("3D view at ")).expect("the app logged no 3D view");
+    let rest = &line[line.find("3D view at ").unwrap() + "3D view at ".len()..];
+    let mut parts = rest.split(|c: char| !c.is_ascii_digit()).filter(|s| !s.is_empty());
+    let mut next = || parts.next().unwrap().parse::<u32>().unwrap();
+    (next(), next(), next(), next())
+}
+
+fn crop(image: &RgbImage, (x, y, w, h): (u32, u32, u32, u32)) -> RgbImage {
+    image::imageops::crop_imm(image, x, y, w, h).to_image()
+}
+
+/// The background's sRGB bytes.
+fn background() -> [u8; 3] {
+    let [r, g, b, _] = meshpaint::render::RenderSettings::DEFAULT_BACKGROUND.map(meshpaint::color::encode_srgb8);
+    [r, g, b]
+}
+
+fn is_background(pixel: &image::Rgb<u8>) -> bool {
+    let bg = background();
+    (0..3).all(|c| pixel[c].abs_diff(bg[c]) <= 3)
+}
+
+/// Blank-or-misplaced checks on the 3D view: background at the corners, mesh in the
+/// middle, a plausible share of mesh pixels around the centre. Returns the mesh share.
+fn check_view_not_blank(view: &RgbImage, name: &str) -> f64 {
+    let (w, h) = view.dimensions();
+    for (cx, cy) in [(4, 4), (w - 5, 4), (w - 5, h / 2)] {
+        assert!(is_background(view.get_pixel(cx, cy)), "{name}: corner ({cx},{cy}) is not background");
+    }
+    let mut mesh = 0u64;
+    let (mut sx, mut sy) = (0f64, 0f64);
+    for (x, y, pixel) in view.enumerate_pixels() {
+        if y < h - 30 && !is_background(pixel) {
+            mesh += 1;
+            sx += f64::from(x);
+            sy += f64::from(y);
+        }
+    }
+    let share = mesh as f64 / f64::from(w * (h - 30));
+    assert!(share > 0.08 && share < 0.8, "{name}: the mesh covers {:.1}% of the view", share * 100.0);
+    let (mx, my) = (sx / mesh as f64 / f64::from(w), sy / mesh as f64 / f64::from(h));
+    assert!((mx - 0.5).abs() < 0.15 && (my - 0.5).abs() < 0.15, "{name}: mesh centroid at ({mx:.2}, {my:.2})");
+    let center = view.get_pixel(w / 2, h / 2);
+    assert!(!is_background(center), "{name}: no mesh at the centre of the view");
+    share
+}
+
+/// Share of dark pixels among the mesh pixels (wireframe lines are dark).
+fn dark_share(view: &RgbImage) -> f64 {
+    let (mut mesh, mut dark) = (0u64, 0u64);
+    for (_, y, pixel) in view.enumerate_pixels() {
+        if y + 30 < view.height() && !is_background(pixel) {
+            mesh += 1;
+            let luma = 0.3 * f64::from(pixel[0]) + 0.59 * f64::from(pixel[1]) + 0.11 * f64::from(pixel[2]);
+            if luma < 90.0 {
+                dark += 1;
+            }
+        }
+    }
+    dark as f64 / mesh.max(1) as f64
+}
+
+/// The 3D view as the editor would draw it at `size`, rendered offscreen.
+fn reference_view(file: &Path, size: (u32, u32)) -> RgbImage {
+    let mut editor = Editor::new(None, Arc::new(|| {}));
+    editor.open(Source::File(file.to_owned()));
+    assert!(editor.wait_for_job(Duration::from_secs(60)));
+    editor.viewport.rect = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(size.0 as f32, size.1 as f32));
+    editor.viewport.pixels_per_point = 1.0;
+    editor.frame_all();
+    let open = editor.document.as_ref().expect("the reference document did not open");
+    let packed = open.document.pack(open.format).unwrap();
+    let ctx = GpuContext::new_headless().expect("no GPU adapter (install mesa-vulkan-drivers)");
+    let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT).unwrap();
+    let mesh = GpuMesh::upload(&ctx, &renderer, &packed, &MeshUploadOptions::default()).unwrap();
+    let image = renderer.render_image(&ctx, DrawItem::MeshColors(&mesh), &editor.render_settings(), size.0, size.1).unwrap();
+    image::DynamicImage::ImageRgba8(image).to_rgb8()
+}
+
+/// Mean absolute difference per channel, and the share of pixels off by more than 24,
+/// over the view without its bottom 30 rows (the hint text).
+fn compare(a: &RgbImage, b: &RgbImage) -> (f64, f64) {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let (w, h) = a.dimensions();
+    let (mut sum, mut off, mut n) = (0u64, 0u64, 0u64);
+    for y in 0..h.saturating_sub(30) {
+        for x in 0..w {
+            let (p, q) = (a.get_pixel(x, y), b.get_pixel(x, y));
+            let d: Vec<u8> = (0..3).map(|c| p[c].abs_diff(q[c])).collect();
+            sum += d.iter().map(|&v| u64::from(v)).sum::<u64>();
+            if d.iter().any(|&v| v > 24) {
+                off += 1;
+            }
+            n += 1;
+        }
+    }
+    (sum as f64 / (3 * n) as f64, off as f64 / n as f64)
+}
+
+#[test]
+fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
+    for tool in ["Xvfb", "xdotool", "import"] {
+        require_tool(tool);
+    }
+    let dir = std::env::temp_dir().join(format!("meshpaint_app_window_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log_path = dir.join("app.log");
+    let mut processes = Processes { children: Vec::new() };
+    let display = start_xvfb(&mut processes);
+
+    let asset = crate_path("assets/models/Duck/Duck.glb");
+    let app = Command::new(env!("CARGO_BIN_EXE_meshpaint"))
+        .arg(&asset)
+        .env("DISPLAY", &display)
+        .env("RUST_LOG", "meshpaint=info")
+        .env("XDG_RUNTIME_DIR", &dir)
+        .current_dir(&dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&log_path).unwrap())
+        .spawn()
+        .expect("cannot start meshpaint");
+    processes.children.push(app);
+
+    let log = wait_for_log(&log_path, "Opened Duck.glb", 0, Duration::from_secs(120));
+    let window = xdotool(&display, &["search", "--sync", "--name", "meshpaint"]);
+    let window = window.lines().next().expect("no meshpaint window").trim().to_owned();
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    pause(3.0);
+    let rect = view_rect(&read_log(&log_path));
+    assert!(rect.2 > 400 && rect.3 > 300, "3D view too small: {rect:?}\n{log}");
+
+    // 1. The default view: not blank, and the same image as an offscreen render.
+    let shots = crate_path("screenshots");
+    std::fs::create_dir_all(&shots).unwrap();
+    let first = screenshot(&display, &shots.join("app_duck.png"));
+    let view = crop(&first, rect);
+    check_view_not_blank(&view, "default view");
+    let reference = reference_view(&asset, (rect.2, rect.3));
+    let (mean, off) = compare(&view, &reference);
+    assert!(mean < 2.0 && off < 0.02, "the 3D view differs from the offscreen render: mean {mean:.2}, {:.1}% off", off * 100.0);
+
+    // 2. Orbit with the middle button, toggle the wireframe with W.
+    let (cx, cy) = (rect.0 + rect.2 / 2, rect.1 + rect.3 / 2);
+    xdotool(&display, &["mousemove", &cx.to_string(), &cy.to_string()]);
+    pause(0.3);
+    xdotool(&display, &["mousedown", "2"]);
+    pause(0.3);
+    for step in 1..=4 {
+        xdotool(&display, &["mousemove", &(cx + 40 * step).to_string(), &(cy + 12 * step).to_string()]);
+        pause(0.3);
+    }
+    xdotool(&display, &["mouseup", "2"]);
+    pause(0.5);
+    xdotool(&display, &["key", "w"]);
+    pause(3.0);
+    let second = screenshot(&display, &shots.join("app_duck_orbit_wireframe.png"));
+    let orbited = crop(&second, rect);
+    check_view_not_blank(&orbited, "orbited view");
+    let (moved, _) = compare(&orbited, &view);
+    assert!(moved > 3.0, "orbiting did not change the view (mean difference {moved:.2})");
+    let (before, after) = (dark_share(&view), dark_share(&orbited));
+    assert!(after > before + 0.05, "no wireframe: dark share {before:.3} → {after:.3}");
+
+    // 3. Export glTF through the dialog (Ctrl+E, type the path, Enter).
+    let exported = dir.join("exported duck.glb");
+    let from = read_log(&log_path).len();
+    xdotool(&display, &["key", "ctrl+e"]);
+    pause(1.5);
+    xdotool(&display, &["key", "ctrl+a"]);
+    pause(0.3);
+    xdotool(&display, &["type", "--delay", "30", &exported.display().to_string()]);
+    pause(0.5);
+    xdotool(&display, &["key", "Return"]);
+    wait_for_log(&log_path, "Exported", from, Duration::from_secs(120));
+    let bytes = std::fs::read(&exported).expect("no exported file");
+    assert_eq!(&bytes[..4], b"glTF");
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize, bytes.len());
+    let scene = meshpaint::import::import_gltf(&exported).expect("the exported .glb does not load");
+    assert_eq!(scene.instanced_triangle_count(), 4212 * 8 * 8, "R = 8: R² triangles per face");
+
+    // 4. Open a broken file (Ctrl+O): the error shows, the Duck stays, the app runs on.
+    let broken = crate_path("tests/fixtures/invalid/gltf-validator/glb/invalid_magic.glb");
+    let from = read_log(&log_path).len();
+    xdotool(&display, &["key", "ctrl+o"]);
+    pause(1.5);
+    xdotool(&display, &["type", "--delay", "30", &broken.display().to_string()]);
+    pause(0.5);
+    xdotool(&display, &["key", "Return"]);
+    wait_for_log(&log_path, "Could not open", from, Duration::from_secs(60));
+    pause(2.0);
+    let app = processes.children.last_mut().unwrap();
+    assert!(app.try_wait().unwrap().is_none(), "the app exited after a bad file");
+    let third = screenshot(&display, &dir.join("after_error.png"));
+    check_view_not_blank(&crop(&third, rect), "view after the bad file");
+    // The status line (bottom rows) shows the error in the error colour (red).
+    let red = (0..third.width())
+        .flat_map(|x| (third.height() - 22..third.height()).map(move |y| (x, y)))
+        .filter(|&(x, y)| {
+            let p = third.get_pixel(x, y);
+            p[0] > 150 && p[1] < 110 && p[2] < 110
+        })
+        .count();
+    assert!(red > 50, "no error text in the status line ({red} red pixels)");
+
+    // 5. Ctrl+Q quits cleanly.
+    xdotool(&display, &["key", "ctrl+q"]);
+    let started = Instant::now();
+    let status = loop {
+        if let Some(status) = processes.children.last_mut().unwrap().try_wait().unwrap() {
+            break status;
+        }
+        assert!(started.elapsed() < Duration::from_secs(20), "the app did not quit on Ctrl+Q");
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    processes.children.pop();
+    let log = read_log(&log_path);
+    assert!(status.success(), "exit status {status}:\n{log}");
+    assert!(!log.contains("panicked"), "{log}");
+    drop(processes);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,117 @@
+//! The paint-mode layout against the store: after any sequence of edits and resolution
+//! changes, a buffer updated only with the planned uploads samples exactly like the store,
+//! and each upload is proportional to what changed.
+
+use meshpaint::color::ColorFormat;
+use meshpaint::layout::{self, Resolution};
+use meshpaint::packed::PackedMesh;
+use meshpaint::paint_layout::PaintLayout;
+use meshpaint::sampler::MeshColorSource;
+use meshpaint::store::{ColorStore, SampleRef};
+use meshpaint::topology::Topology;
+
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn unit(&mut self) -> f32 {
+        (self.next() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+fn octahedron() -> (Vec<[f32; 3]>, Topology) {
+    let positions = vec![
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    let triangles = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+    (positions, Topology::build(6, &triangles).unwrap())
+}
+
+/// Every lattice point of every face reads the store's colour from the mirror buffer.
+fn assert_mirror_matches(mirror: &PackedMesh, store: &ColorStore) {
+    for face in 0..store.topology().face_count() {
+        let r = store.face_resolution(face).unwrap();
+        assert_eq!(mirror.face_resolution(face), Some(r));
+        for i in 0..=r.get() {
+            for j in 0..=r.get() - i {
+                let expected = ColorFormat::Rgba32F.quantize(store.face_sample(face, i, j).unwrap());
+                assert_eq!(mirror.lattice_color(face, 0, i, j), Some(expected), "face {face} ({i}, {j})");
+            }
+        }
+    }
+}
+
+#[test]
+fn partial_uploads_keep_the_gpu_buffer_equal_to_the_store() {
+    let (positions, topology) = octahedron();
+    let mut store = ColorStore::uniform(topology, Resolution::new(4).unwrap(), [0.5; 4]);
+    let format = ColorFormat::Rgba32F;
+    let mut layout = PaintLayout::new(&store);
+    let mut mirror = layout.packed(&store, &positions, format);
+    store.take_dirty();
+    assert_mirror_matches(&mirror, &store);
+    let mut rng = Rng(5);
+    let (mut grown, mut moved) = (0, 0);
+    for step in 0..300 {
+        if step % 5 == 0 {
+            let face = (rng.next() % 8) as u32;
+            let r = Resolution::from_log2((rng.next() % 7) as u32).unwrap();
+            store.set_face_resolution(face, r).unwrap();
+        } else {
+            // A "dab": a few samples of one face.
+            let face = (rng.next() % 8) as u32;
+            let r = store.face_resolution(face).unwrap();
+            for _ in 0..5 {
+                let i = (rng.next() % u64::from(r.get() + 1)) as u32;
+                let j = (rng.next() % u64::from(r.get() - i + 1)) as u32;
+                let sample = store.face_sample_ref(face, i, j).unwrap();
+                store.set(sample, [rng.unit(), rng.unit(), rng.unit(), 1.0]);
+            }
+        }
+        let dirty = store.take_dirty();
+        let plan = layout.sync(&store, &dirty);
+        if plan.grown {
+            grown += 1;
+            mirror = layout.packed(&store, &positions, format);
+        } else {
+            moved += plan.faces.len();
+            for &(first, count) in &plan.sample_ranges {
+                let bytes = layout.encode_range(&store, &dirty, first, count, format);
+                let start = first as usize * format.bytes_per_sample();
+                mirror.colors[start..start + bytes.len()].copy_from_slice(&bytes);
+            }
+            for &face in &plan.faces {
+                mirror.face_records[face as usize] = layout.records()[face as usize];
+            }
+        }
+        // Uploads are proportional to the change: never more than the dirty elements hold.
+        let dirty_samples: u64 = dirty.vertices.len() as u64
+            + dirty.edges.iter().map(|&e| store.edge_samples(e).len() as u64).sum::<u64>()
+            + dirty.faces.iter().map(|&f| store.interior_samples(f).len() as u64).sum::<u64>();
+        assert_eq!(plan.sample_count(), dirty_samples);
+        assert_mirror_matches(&mirror, &store);
+    }
+    assert!(grown > 0 && moved > 0, "the test must exercise growth ({grown}) and record patches ({moved})");
+}
+
+#[test]
+fn one_dab_uploads_only_the_painted_elements() {
+    let topology = Topology::build(4, &[[0, 1, 2], [1, 0, 3]]).unwrap();
+    let mut store = ColorStore::uniform(topology, Resolution::new(64).unwrap(), [0.0; 4]);
+    let mut layout = PaintLayout::new(&store);
+    store.take_dirty();
+    store.set(SampleRef::Interior { face: 1, offset: 10 }, [1.0; 4]);
+    let dirty = store.take_dirty();
+    let plan = layout.sync(&store, &dirty);
+    assert_eq!(plan.sample_count(), u64::from(layout::interior_sample_count(Resolution::new(64).unwrap())));
+    assert!(plan.faces.is_empty() && !plan.grown);
+}
