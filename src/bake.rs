@@ -209,15 +209,21 @@ struct FaceMaterial {
     longest_uv_edge_texels: f32,
 }
 
-/// Whether any face of `mesh` has a material with a base-colour texture or a non-white
-/// base-colour factor, i.e. whether [`bake_texture`] gives anything but white.
+/// Whether the materials of `mesh` carry a colour signal worth baking: a base-colour
+/// texture on any face, or base-colour factors that differ between faces (e.g. Cubes).
+/// One uniform factor over the whole mesh (Bunny's flat grey) is not a signal: such a mesh
+/// counts as texture-less and gets the position colour, so it shows visible variation.
 pub fn has_base_color(mesh: &WeldedMesh, scene: &Scene) -> bool {
-    mesh.triangle_materials.iter().flatten().any(|&m| {
-        scene
-            .materials
-            .get(m as usize)
-            .is_some_and(|material| material.base_color_texture.is_some() || material.base_color_factor != [1.0; 4])
-    })
+    let material = |m: &Option<u32>| m.and_then(|m| scene.materials.get(m as usize));
+    if mesh.triangle_materials.iter().any(|m| material(m).is_some_and(|m| m.base_color_texture.is_some())) {
+        return true;
+    }
+    let factor = |m: &Option<u32>| material(m).map_or([1.0; 4], |m| m.base_color_factor);
+    let mut factors = mesh.triangle_materials.iter().map(factor);
+    let Some(first) = factors.next() else {
+        return false;
+    };
+    factors.any(|f| f != first)
 }
 
 /// Sets every sample of `store` to the base colour of its owner face at the sample's

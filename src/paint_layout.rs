@@ -244,7 +244,14 @@ impl PaintLayout {
     }
 
     /// Encodes the samples of one upload range (fast path: walks the dirty elements only).
-    pub fn encode_range(&self, store: &ColorStore, dirty: &DirtyElements, first: u32, count: u32, format: ColorFormat) -> Vec<u8> {
+    pub fn encode_range(
+        &self,
+        store: &ColorStore,
+        dirty: &DirtyElements,
+        first: u32,
+        count: u32,
+        format: ColorFormat,
+    ) -> Vec<u8> {
         let mut colors = vec![[0.0f32; 4]; count as usize];
         let end = first + count;
         let mut put = |base: u32, samples: &[Rgba]| {

@@ -16,6 +16,8 @@
 //!   sometimes zero. Zero counts as inside, so a ray through a shared edge or vertex of a
 //!   closed mesh hits at least one of its faces, never neither. Both sides count.
 //!   Barycentric coordinates are `U, V, W` divided by their sum (our own, not obvhs').
+//!   `t` is then taken from the face's plane (normal from its two shortest edges), which
+//!   stays accurate on long slivers where Woop's `T / det` loses digits.
 //!   Among hits at the same `t` the lowest face id wins, so the answer does not depend on
 //!   the BVH's shape or preset.
 //! - [`MeshBvh::faces_in_sphere`] traverses the sphere's bounding box and keeps the faces
@@ -205,7 +207,7 @@ impl std::fmt::Debug for MeshBvh {
     }
 }
 
-/// Exact hit of one triangle: `t`, barycentrics, and the sign of the edge-function sum.
+/// Exact hit of one triangle: `t` and barycentrics.
 #[derive(Debug, Clone, Copy)]
 struct ExactHit {
     t: f64,

@@ -110,9 +110,8 @@ pub fn weld_scene(scene: &Scene) -> WeldedMesh {
         let normal_world_from_local = Mat3::from_mat4(world_from_local).inverse().transpose();
         let base = out.positions_world.len() as u32;
         if any_colors {
-            out.vertex_colors.extend(
-                local.source_vertex.iter().map(|&v| mesh.colors.get(v as usize).copied().unwrap_or([1.0; 4])),
-            );
+            out.vertex_colors
+                .extend(local.source_vertex.iter().map(|&v| mesh.colors.get(v as usize).copied().unwrap_or([1.0; 4])));
         }
         out.positions_world
             .extend(local.positions_local.iter().map(|&p| world_from_local.transform_point3(p).to_array()));

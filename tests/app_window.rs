@@ -102,13 +102,17 @@ fn read_log(path: &Path) -> String {
     text
 }
 
-/// Waits until the log contains `needle` (after `from` bytes); returns the log.
-fn wait_for_log(path: &Path, needle: &str, from: usize, timeout: Duration) -> String {
+/// Waits until the log contains `needle` (after `from` bytes); returns the log. Fails at
+/// once if the app exits.
+fn wait_for_log(path: &Path, needle: &str, from: usize, timeout: Duration, app: &mut Child) -> String {
     let started = Instant::now();
     loop {
         let log = read_log(path);
         if log.get(from..).is_some_and(|tail| tail.contains(needle)) {
             return log;
+        }
+        if let Ok(Some(status)) = app.try_wait() {
+            panic!("the app exited ({status}) while waiting for “{needle}”:\n{log}");
         }
         assert!(started.elapsed() < timeout, "no “{needle}” in the log after {timeout:?}:\n{log}");
         std::thread::sleep(Duration::from_millis(100));
@@ -192,7 +196,8 @@ fn reference_view(file: &Path, size: (u32, u32)) -> RgbImage {
     let ctx = GpuContext::new_headless().expect("no GPU adapter (install mesa-vulkan-drivers)");
     let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT).unwrap();
     let mesh = GpuMesh::upload(&ctx, &renderer, &packed, &MeshUploadOptions::default()).unwrap();
-    let image = renderer.render_image(&ctx, DrawItem::MeshColors(&mesh), &editor.render_settings(), size.0, size.1).unwrap();
+    let image =
+        renderer.render_image(&ctx, DrawItem::MeshColors(&mesh), &editor.render_settings(), size.0, size.1).unwrap();
     image::DynamicImage::ImageRgba8(image).to_rgb8()
 }
 
@@ -240,8 +245,14 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
         .spawn()
         .expect("cannot start meshpaint");
     processes.children.push(app);
+    // The app is the last child.
+    macro_rules! app {
+        () => {
+            processes.children.last_mut().unwrap()
+        };
+    }
 
-    let log = wait_for_log(&log_path, "Opened Duck.glb", 0, Duration::from_secs(120));
+    let log = wait_for_log(&log_path, "Opened Duck.glb", 0, Duration::from_secs(120), app!());
     let window = xdotool(&display, &["search", "--sync", "--name", "meshpaint"]);
     let window = window.lines().next().expect("no meshpaint window").trim().to_owned();
     xdotool(&display, &["windowfocus", "--sync", &window]);
@@ -257,7 +268,11 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     check_view_not_blank(&view, "default view");
     let reference = reference_view(&asset, (rect.2, rect.3));
     let (mean, off) = compare(&view, &reference);
-    assert!(mean < 2.0 && off < 0.02, "the 3D view differs from the offscreen render: mean {mean:.2}, {:.1}% off", off * 100.0);
+    assert!(
+        mean < 2.0 && off < 0.02,
+        "the 3D view differs from the offscreen render: mean {mean:.2}, {:.1}% off",
+        off * 100.0
+    );
 
     // 2. Orbit with the middle button, toggle the wireframe with W.
     let (cx, cy) = (rect.0 + rect.2 / 2, rect.1 + rect.3 / 2);
@@ -291,7 +306,7 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     xdotool(&display, &["type", "--delay", "30", &exported.display().to_string()]);
     pause(0.5);
     xdotool(&display, &["key", "Return"]);
-    wait_for_log(&log_path, "Exported", from, Duration::from_secs(120));
+    wait_for_log(&log_path, "Exported", from, Duration::from_secs(120), app!());
     let bytes = std::fs::read(&exported).expect("no exported file");
     assert_eq!(&bytes[..4], b"glTF");
     assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize, bytes.len());
@@ -306,10 +321,9 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     xdotool(&display, &["type", "--delay", "30", &broken.display().to_string()]);
     pause(0.5);
     xdotool(&display, &["key", "Return"]);
-    wait_for_log(&log_path, "Could not open", from, Duration::from_secs(60));
+    wait_for_log(&log_path, "Could not open", from, Duration::from_secs(60), app!());
     pause(2.0);
-    let app = processes.children.last_mut().unwrap();
-    assert!(app.try_wait().unwrap().is_none(), "the app exited after a bad file");
+    assert!(app!().try_wait().unwrap().is_none(), "the app exited after a bad file");
     let third = screenshot(&display, &dir.join("after_error.png"));
     check_view_not_blank(&crop(&third, rect), "view after the bad file");
     // The status line (bottom rows) shows the error in the error colour (red).
@@ -326,7 +340,7 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     xdotool(&display, &["key", "ctrl+q"]);
     let started = Instant::now();
     let status = loop {
-        if let Some(status) = processes.children.last_mut().unwrap().try_wait().unwrap() {
+        if let Some(status) = app!().try_wait().unwrap() {
             break status;
         }
         assert!(started.elapsed() < Duration::from_secs(20), "the app did not quit on Ctrl+Q");

@@ -265,6 +265,10 @@ fn factor_only_and_default_materials() {
         ..Scene::default()
     };
     assert!(!has_base_color(&mesh, &white));
+    // One uniform factor over the whole mesh (Bunny's flat grey) is not a signal either.
+    let mut uniform = mesh.clone();
+    uniform.triangle_materials = vec![Some(0), Some(0)];
+    assert!(!has_base_color(&uniform, &scene));
     // A texture index that does not exist falls back to the factor.
     let missing = Scene {
         materials: vec![Material { base_color_factor: [0.5; 4], base_color_texture: Some(7) }],

@@ -51,7 +51,8 @@ fn compare(packed: &PackedMesh, camera: OrbitCamera, filter: FilterMode) -> Comp
         FilterMode::NearestMipLevel(level) => (Filter::Nearest, level),
         FilterMode::Trilinear => panic!("trilinear needs screen derivatives; tested analytically in gpu_render"),
     };
-    let mut result = Comparison { compared: 0, skipped_near_edges: 0, coverage_mismatch: 0, max_steps: 0, mean_steps: 0.0 };
+    let mut result =
+        Comparison { compared: 0, skipped_near_edges: 0, coverage_mismatch: 0, max_steps: 0, mean_steps: 0.0 };
     let mut total_steps = 0u64;
     for y in (1..SIZE).step_by(3) {
         for x in (1..SIZE).step_by(3) {
@@ -75,7 +76,8 @@ fn compare(packed: &PackedMesh, camera: OrbitCamera, filter: FilterMode) -> Comp
                 // Within float noise of a nearest-cell boundary either cell is right.
                 let r = packed.face_records[hit.face as usize].resolution().unwrap();
                 let r = r.at_level(level.min(r.log2())).unwrap();
-                let mut weights: Vec<f32> = layout::linear_samples(r, hit.barycentric).iter().map(|s| s.weight).collect();
+                let mut weights: Vec<f32> =
+                    layout::linear_samples(r, hit.barycentric).iter().map(|s| s.weight).collect();
                 weights.sort_by(|a, b| b.total_cmp(a));
                 if weights[0] - weights[1] < 2e-2 {
                     result.skipped_near_edges += 1;
@@ -129,8 +131,7 @@ fn duck_textured_r16_every_filter_matches_the_cpu_reference() {
 #[test]
 fn mixed_resolutions_across_shared_edges_on_a_real_mesh() {
     // Suzanne (open eyes: boundary edges) with R from 1 to 64 by face id, and Duck at R = 1.
-    let mut document =
-        Document::open(&asset("assets/models/Suzanne/monkey.glb"), Resolution::new(8).unwrap()).unwrap();
+    let mut document = Document::open(&asset("assets/models/Suzanne/monkey.glb"), Resolution::new(8).unwrap()).unwrap();
     for face in 0..document.store.topology().face_count() {
         let r = Resolution::from_log2(face % 7).unwrap();
         document.store.set_face_resolution(face, r).unwrap();

@@ -175,7 +175,10 @@ impl ViewportInfo {
 
     /// The area's top-left corner in physical pixels.
     pub fn min_px(&self) -> [i32; 2] {
-        [(self.rect.min.x * self.pixels_per_point).round() as i32, (self.rect.min.y * self.pixels_per_point).round() as i32]
+        [
+            (self.rect.min.x * self.pixels_per_point).round() as i32,
+            (self.rect.min.y * self.pixels_per_point).round() as i32,
+        ]
     }
 }
 
@@ -277,7 +280,10 @@ impl Editor {
             dialog: None,
             show_help: false,
             import_resolution: Resolution::new(DEFAULT_IMPORT_RESOLUTION).unwrap_or(Resolution::ONE),
-            viewport: ViewportInfo { rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1.0, 1.0)), pixels_per_point: 1.0 },
+            viewport: ViewportInfo {
+                rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1.0, 1.0)),
+                pixels_per_point: 1.0,
+            },
             viewport_texture: None,
             viewport_gpu_bytes: 0,
             frame_stats: FrameStats::default(),
@@ -408,7 +414,9 @@ impl Editor {
                 self.scene_generation += 1;
                 self.frame_all();
                 match self.fallback_error.take() {
-                    Some(error) => self.set_status(Severity::Error, format!("{error} — showing the built-in Duck instead")),
+                    Some(error) => {
+                        self.set_status(Severity::Error, format!("{error} — showing the built-in Duck instead"))
+                    }
                     None => self.set_status(Severity::Info, text),
                 }
             }
@@ -614,7 +622,6 @@ impl Editor {
         }
     }
 }
-
 
 /// The error and its causes on one line, skipping causes the message already quotes.
 pub fn error_text(error: &anyhow::Error) -> String {

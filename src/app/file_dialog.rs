@@ -139,7 +139,8 @@ impl FileDialog {
                 self.entries.push(Entry { name, is_dir });
             }
         }
-        self.entries.sort_by(|a, b| b.is_dir.cmp(&a.is_dir).then_with(|| a.name.to_lowercase().cmp(&b.name.to_lowercase())));
+        self.entries
+            .sort_by(|a, b| b.is_dir.cmp(&a.is_dir).then_with(|| a.name.to_lowercase().cmp(&b.name.to_lowercase())));
     }
 
     /// Lists `directory` instead.

@@ -55,7 +55,13 @@ pub const SHORTCUTS: &[Shortcut] = &[
     shortcut(Modifiers::COMMAND, Key::Num3, "Ctrl+3", Action::ViewLeft, "View from the left"),
     shortcut(Modifiers::COMMAND, Key::Num7, "Ctrl+7", Action::ViewBottom, "View from below"),
     shortcut(Modifiers::NONE, Key::Home, "Home", Action::FrameAll, "Frame the whole mesh"),
-    shortcut(Modifiers::NONE, Key::F, "F", Action::FrameUnderCursor, "Centre on the point under the cursor, move closer"),
+    shortcut(
+        Modifiers::NONE,
+        Key::F,
+        "F",
+        Action::FrameUnderCursor,
+        "Centre on the point under the cursor, move closer",
+    ),
     shortcut(Modifiers::NONE, Key::Num1, "1", Action::ViewFront, "View from the front"),
     shortcut(Modifiers::NONE, Key::Num3, "3", Action::ViewRight, "View from the right"),
     shortcut(Modifiers::NONE, Key::Num7, "7", Action::ViewTop, "View from above"),
@@ -115,8 +121,8 @@ pub fn viewport_input(editor: &mut Editor, ui: &egui::Ui, response: &egui::Respo
     editor.viewport_pointer = response.hover_pos();
     let modifiers = ui.input(|i| i.modifiers);
     let height = f64::from(response.rect.height().max(1.0));
-    let navigating = response.dragged_by(PointerButton::Middle)
-        || (modifiers.alt && response.dragged_by(PointerButton::Primary));
+    let navigating =
+        response.dragged_by(PointerButton::Middle) || (modifiers.alt && response.dragged_by(PointerButton::Primary));
     let mut moved = false;
     if navigating {
         let delta = response.drag_delta();

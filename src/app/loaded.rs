@@ -30,14 +30,14 @@ pub const DEFAULT_SCENE_NAME: &str = "Duck (built-in)";
 #[derive(Debug)]
 pub struct Gpu {
     /// Device and queue.
-    pub ctx: GpuContext,
+    pub ctx: Arc<GpuContext>,
     /// Pipelines for the 3D view (offscreen target in [`OFFSCREEN_FORMAT`]).
     pub renderer: Renderer,
 }
 
 impl Gpu {
     /// Builds the renderer for `ctx`.
-    pub fn new(ctx: GpuContext) -> Result<Self> {
+    pub fn new(ctx: Arc<GpuContext>) -> Result<Self> {
         let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT).context("building the render pipelines")?;
         Ok(Gpu { ctx, renderer })
     }

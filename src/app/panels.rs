@@ -103,13 +103,17 @@ impl Editor {
             if ui.add_enabled(idle && has_document, egui::Button::new("Save")).on_hover_text("Ctrl+S").clicked() {
                 self.perform(Action::Save);
             }
-            if ui.add_enabled(idle && has_document, egui::Button::new("Save as…")).on_hover_text("Ctrl+Shift+S").clicked()
+            if ui
+                .add_enabled(idle && has_document, egui::Button::new("Save as…"))
+                .on_hover_text("Ctrl+Shift+S")
+                .clicked()
             {
                 self.perform(Action::SaveAs);
             }
         });
         ui.horizontal_wrapped(|ui| {
-            if ui.add_enabled(idle && has_document, egui::Button::new("Export glTF…")).on_hover_text("Ctrl+E").clicked() {
+            if ui.add_enabled(idle && has_document, egui::Button::new("Export glTF…")).on_hover_text("Ctrl+E").clicked()
+            {
                 self.perform(Action::ExportGltf);
             }
             if ui
@@ -233,12 +237,7 @@ impl Editor {
             ui.label(egui::RichText::new(self.mode.name()).strong());
             ui.separator();
             if let Some((label, fraction, stage, elapsed)) = self.jobs.status() {
-                ui.add(
-                    egui::ProgressBar::new(fraction)
-                        .desired_width(220.0)
-                        .show_percentage()
-                        .animate(true),
-                );
+                ui.add(egui::ProgressBar::new(fraction).desired_width(220.0).show_percentage().animate(true));
                 ui.label(format!("{label}: {stage} ({:.1} s)", elapsed.as_secs_f32()));
             } else {
                 let color = match self.status.severity {
@@ -250,8 +249,11 @@ impl Editor {
                     Severity::Error => "Error: ",
                     _ => "",
                 };
-                ui.add(egui::Label::new(egui::RichText::new(format!("{prefix}{}", self.status.text)).color(color)).truncate())
-                    .on_hover_text(&self.status.text);
+                ui.add(
+                    egui::Label::new(egui::RichText::new(format!("{prefix}{}", self.status.text)).color(color))
+                        .truncate(),
+                )
+                .on_hover_text(&self.status.text);
             }
         });
     }
@@ -267,22 +269,22 @@ impl Editor {
             .pivot(egui::Align2::CENTER_CENTER)
             .default_pos(center)
             .show(ctx, |ui| {
-            egui::Grid::new("pointer help").num_columns(2).spacing([16.0, 4.0]).striped(true).show(ui, |ui| {
-                for (gesture, what) in POINTER_HELP {
-                    ui.label(egui::RichText::new(*gesture).strong());
-                    ui.label(*what);
-                    ui.end_row();
-                }
+                egui::Grid::new("pointer help").num_columns(2).spacing([16.0, 4.0]).striped(true).show(ui, |ui| {
+                    for (gesture, what) in POINTER_HELP {
+                        ui.label(egui::RichText::new(*gesture).strong());
+                        ui.label(*what);
+                        ui.end_row();
+                    }
+                });
+                ui.separator();
+                egui::Grid::new("key help").num_columns(2).spacing([16.0, 4.0]).striped(true).show(ui, |ui| {
+                    for shortcut in SHORTCUTS {
+                        ui.label(egui::RichText::new(shortcut.keys).strong().monospace());
+                        ui.label(shortcut.description);
+                        ui.end_row();
+                    }
+                });
             });
-            ui.separator();
-            egui::Grid::new("key help").num_columns(2).spacing([16.0, 4.0]).striped(true).show(ui, |ui| {
-                for shortcut in SHORTCUTS {
-                    ui.label(egui::RichText::new(shortcut.keys).strong().monospace());
-                    ui.label(shortcut.description);
-                    ui.end_row();
-                }
-            });
-        });
         self.show_help = open && self.show_help;
     }
 

@@ -131,7 +131,10 @@ struct Running {
     window: Arc<Window>,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
-    gpu: Arc<Gpu>,
+    /// Device and queue (the window and egui need them even when the 3D view failed).
+    ctx: Arc<GpuContext>,
+    /// The 3D renderer (`None` when its pipelines could not be built: the UI still runs).
+    gpu: Option<Arc<Gpu>>,
     egui_ctx: egui::Context,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
@@ -155,7 +158,7 @@ impl Shell {
         descriptor.backends = crate::render::backends_from_env();
         let instance = wgpu::Instance::new(descriptor);
         let surface = instance.create_surface(Arc::clone(&window)).context("creating the window surface")?;
-        let ctx = pollster::block_on(GpuContext::with_instance(instance, Some(&surface)))?;
+        let ctx = Arc::new(pollster::block_on(GpuContext::with_instance(instance, Some(&surface)))?);
         log::info!("GPU: {}", ctx.describe());
         let caps = surface.get_capabilities(&ctx.adapter);
         let format = egui_wgpu::preferred_framebuffer_format(&caps.formats)
@@ -175,7 +178,10 @@ impl Shell {
         if size.width > 0 && size.height > 0 {
             surface.configure(&ctx.device, &config);
         }
-        let gpu = Arc::new(Gpu::new(ctx)?);
+        let (gpu, gpu_error) = match Gpu::new(Arc::clone(&ctx)) {
+            Ok(gpu) => (Some(Arc::new(gpu)), None),
+            Err(error) => (None, Some(super::editor::error_text(&error))),
+        };
 
         let egui_ctx = egui::Context::default();
         let proxy = self.proxy.clone();
@@ -183,7 +189,7 @@ impl Shell {
             // Fails only when the event loop is gone (closing).
             let _ = proxy.send_event(UserEvent::Repaint(info.delay));
         });
-        let max_texture_side = gpu.ctx.limits().max_texture_dimension_2d as usize;
+        let max_texture_side = ctx.limits().max_texture_dimension_2d as usize;
         let egui_state = egui_winit::State::new(
             egui_ctx.clone(),
             egui::ViewportId::ROOT,
@@ -192,21 +198,25 @@ impl Shell {
             window.theme(),
             Some(max_texture_side),
         );
-        let mut egui_renderer =
-            egui_wgpu::Renderer::new(&gpu.ctx.device, format, egui_wgpu::RendererOptions::default());
-        let view = ViewTarget::new(&gpu.ctx, &mut egui_renderer, [1, 1]);
+        let mut egui_renderer = egui_wgpu::Renderer::new(&ctx.device, format, egui_wgpu::RendererOptions::default());
+        let view = ViewTarget::new(&ctx, &mut egui_renderer, [1, 1]);
 
         let waker_ctx = egui_ctx.clone();
-        let mut editor = Editor::new(Some(Arc::clone(&gpu)), Arc::new(move || waker_ctx.request_repaint()));
+        let mut editor = Editor::new(gpu.clone(), Arc::new(move || waker_ctx.request_repaint()));
         editor.viewport_texture = Some(view.texture_id);
         editor.open(match &self.options.file {
             Some(path) => Source::File(path.clone()),
             None => Source::BuiltIn,
         });
+        if let Some(error) = gpu_error {
+            // The panels still work (open, save, export); only the 3D view is off.
+            editor.set_status(super::editor::Severity::Error, format!("The 3D view is off: {error}"));
+        }
         Ok(Running {
             window,
             surface,
             config,
+            ctx,
             gpu,
             egui_ctx,
             egui_state,
@@ -228,12 +238,12 @@ impl Running {
         }
         self.config.width = size.width;
         self.config.height = size.height;
-        self.surface.configure(&self.gpu.ctx.device, &self.config);
+        self.surface.configure(&self.ctx.device, &self.config);
     }
 
     /// Creates the surface again (after `Lost`).
     fn recreate_surface(&mut self) -> Result<()> {
-        self.surface = self.gpu.ctx.instance.create_surface(Arc::clone(&self.window)).context("re-creating the surface")?;
+        self.surface = self.ctx.instance.create_surface(Arc::clone(&self.window)).context("re-creating the surface")?;
         self.configure();
         Ok(())
     }
@@ -253,10 +263,9 @@ impl Running {
             event_loop.exit();
             return Ok(None);
         }
-        let repaint_delay =
-            full_output.viewport_output.get(&egui::ViewportId::ROOT).map(|output| output.repaint_delay);
+        let repaint_delay = full_output.viewport_output.get(&egui::ViewportId::ROOT).map(|output| output.repaint_delay);
 
-        let ctx = &self.gpu.ctx;
+        let ctx = &self.ctx;
         let mut textures = full_output.textures_delta;
         for (id, deltas) in textures.set.drain() {
             for delta in &deltas {
@@ -304,8 +313,8 @@ impl Running {
                 return Ok(false);
             }
         };
-        let gpu = Arc::clone(&self.gpu);
-        let ctx = &gpu.ctx;
+        let ctx = Arc::clone(&self.ctx);
+        let ctx = &*ctx;
         let viewport = self.editor.viewport;
         let view_size = viewport.size_px();
         self.view.resize(ctx, &mut self.egui_renderer, view_size);
@@ -331,7 +340,7 @@ impl Running {
         let settings = self.editor.render_settings();
         let view_key = (settings, self.view.size, self.editor.scene_generation);
         let mesh = self.editor.document.as_ref().and_then(|d| d.gpu_mesh.as_ref());
-        if let Some(mesh) = mesh.filter(|_| self.drawn_view != Some(view_key)) {
+        if let (Some(mesh), Some(gpu)) = (mesh.filter(|_| self.drawn_view != Some(view_key)), &self.gpu) {
             self.drawn_view = Some(view_key);
             let target = RenderTarget {
                 color: &self.view.srgb_view,
@@ -342,10 +351,8 @@ impl Running {
             gpu.renderer.draw(ctx, &mut encoder, &target, DrawItem::MeshColors(mesh), &settings);
         }
 
-        let screen = egui_wgpu::ScreenDescriptor {
-            size_in_pixels: [self.config.width, self.config.height],
-            pixels_per_point,
-        };
+        let screen =
+            egui_wgpu::ScreenDescriptor { size_in_pixels: [self.config.width, self.config.height], pixels_per_point };
         let user_buffers =
             self.egui_renderer.update_buffers(&ctx.device, &ctx.queue, &mut encoder, paint_jobs, &screen);
         let surface_view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());

@@ -29,11 +29,30 @@ impl GpuContext {
     /// A context for offscreen rendering: an instance over [`backends_from_env`], the first
     /// adapter that wgpu offers (CPU adapters such as lavapipe are accepted), and a device
     /// with the adapter's limits. Fails (never falls back silently) when no adapter exists.
+    ///
+    /// Without `WGPU_BACKEND`, Vulkan (lavapipe on a machine without a GPU) is tried first
+    /// and GL only when Vulkan offers no adapter: initialising EGL when it is not needed
+    /// costs time and prints warnings.
     pub fn new_headless() -> Result<Self, RenderError> {
-        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        descriptor.backends = backends_from_env();
-        let instance = wgpu::Instance::new(descriptor);
-        pollster::block_on(Self::with_instance(instance, None))
+        let from_env = wgpu::Backends::from_env();
+        let attempts = match from_env {
+            Some(backends) => vec![backends],
+            None => vec![wgpu::Backends::VULKAN, wgpu::Backends::GL],
+        };
+        let mut last_error = None;
+        for backends in attempts {
+            let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+            descriptor.backends = backends;
+            let instance = wgpu::Instance::new(descriptor);
+            match pollster::block_on(Self::with_instance(instance, None)) {
+                Ok(context) => return Ok(context),
+                Err(error) => last_error = Some(error),
+            }
+        }
+        Err(last_error.unwrap_or(RenderError::NoAdapter {
+            backends: format!("{:?}", backends_from_env()),
+            reason: "no backend to try".into(),
+        }))
     }
 
     /// A context on `instance`, with an adapter able to present to `surface` when given.

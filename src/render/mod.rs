@@ -36,8 +36,8 @@ mod mesh_gpu;
 mod renderer;
 mod uniforms;
 
-pub use bench::{BenchRenderError, ModeTiming, RenderBench, bench_render};
 pub use baseline::{BaselineMesh, BaselineVertex, mip_chain_linear};
+pub use bench::{BenchRenderError, ModeTiming, RenderBench, bench_render};
 pub use context::{GpuContext, backends_from_env};
 pub use headless::{RenderFileError, RenderRequest, RenderedFile, default_camera, render_file};
 pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshUploadOptions, atlas_texture_format, default_atlas_width};

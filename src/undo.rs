@@ -1,0 +1,663 @@
+//! Undo and redo, one step per stroke (or per fill, per "set resolution"), storing only
+//! what changed.
+//!
+//! # What a step holds
+//!
+//! A step is a sequence of changes, recorded in the order they happened:
+//!
+//! - **sample writes**: `(sample, old colour)` for every sample the step changed, the
+//!   *first* write in the step winning (later writes to the same sample add nothing), so a
+//!   step costs `changed samples × 28 bytes` however many dabs overlapped;
+//! - **resolution changes**: for a face whose resolution changes, its old resolution and the
+//!   old samples of the face's interior and of its three edges *before* the change (the
+//!   store resamples exactly these four elements, [`ColorStore::set_face_resolution`]).
+//!
+//! Undo walks the changes backwards: a resolution change is undone by setting the old
+//! resolution back and overwriting the four elements with the saved samples, so undo is
+//! bit-exact whatever the resampling filters do. While undoing, the current values of the
+//! same samples and faces are captured, which gives the redo step (the same walk again,
+//! forwards); redo after undo restores the state after the step bit for bit.
+//!
+//! # First-write tracking without hashing
+//!
+//! Whether a sample was already recorded in the open step is a bit in a per-element bitset:
+//! one bitset over all vertices, and one per touched edge or face interior, found through a
+//! dense element → slot table. The brush asks for an element's [`SampleLog`] once per element
+//! and records each write with a bit test and a push.
+//!
+//! # Memory
+//!
+//! [`UndoHistory::bytes_used`] counts the payload of every kept step (undo and redo). When a
+//! step is closed and the total exceeds the cap, the oldest undo steps are dropped first (a
+//! step larger than the cap on its own cannot be kept either). A new non-empty step clears
+//! the redo steps.
+//!
+//! The store must only change through recorded steps between [`UndoHistory::begin_step`]
+//! calls; a store that no longer matches a step makes undo fail with
+//! [`UndoError::Mismatch`] (and the history is cleared, since it cannot be trusted).
+
+use std::collections::VecDeque;
+
+use thiserror::Error;
+
+use crate::color::Rgba;
+use crate::layout::Resolution;
+use crate::store::{ColorStore, SampleRef, StoreError};
+
+/// The default memory cap of an [`UndoHistory`]: 512 MiB.
+pub const DEFAULT_CAP_BYTES: usize = 512 << 20;
+
+/// Bytes of one recorded sample write.
+pub const SAMPLE_RECORD_BYTES: usize = std::mem::size_of::<(SampleRef, Rgba)>();
+
+/// Errors of recording, undoing and redoing.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum UndoError {
+    /// [`UndoHistory::begin_step`] while a step is open.
+    #[error("an undo step is already open (end the stroke first)")]
+    StepOpen,
+    /// Undo or redo while a step is open.
+    #[error("cannot undo or redo during a stroke")]
+    Busy,
+    /// The store changed outside the history; the history was cleared.
+    #[error("the colours changed outside the undo history ({0}); the history was cleared")]
+    Mismatch(String),
+    /// The store refused a change.
+    #[error(transparent)]
+    Store(#[from] StoreError),
+}
+
+/// The saved state of one face and its three edges (see the module documentation).
+#[derive(Debug, Clone, PartialEq)]
+struct FaceState {
+    face: u32,
+    resolution: Resolution,
+    interior: Vec<Rgba>,
+    /// `(edge, resolution, samples)` of face edges 0, 1, 2.
+    edges: [(u32, Resolution, Vec<Rgba>); 3],
+}
+
+impl FaceState {
+    fn capture(store: &ColorStore, face: u32) -> Result<Self, UndoError> {
+        let no_face = || StoreError::NoSuchFace { face, face_count: store.topology().face_count() };
+        let resolution = store.face_resolution(face).ok_or_else(no_face)?;
+        let face_edges = *store.topology().face_edges.get(face as usize).ok_or_else(no_face)?;
+        let edge = |edge: u32| -> Result<(u32, Resolution, Vec<Rgba>), UndoError> {
+            let r = store.edge_resolution(edge).ok_or_else(no_face)?;
+            Ok((edge, r, store.edge_samples(edge).to_vec()))
+        };
+        Ok(FaceState {
+            face,
+            resolution,
+            interior: store.interior_samples(face).to_vec(),
+            edges: [edge(face_edges[0])?, edge(face_edges[1])?, edge(face_edges[2])?],
+        })
+    }
+
+    /// Puts the state back: resolution first (which resizes the elements), then samples.
+    fn restore(&self, store: &mut ColorStore) -> Result<(), UndoError> {
+        store.set_face_resolution(self.face, self.resolution)?;
+        for (edge, resolution, _) in &self.edges {
+            if store.edge_resolution(*edge) != Some(*resolution) {
+                return Err(UndoError::Mismatch(format!(
+                    "edge {edge} should be at resolution {resolution} after restoring face {}",
+                    self.face
+                )));
+            }
+        }
+        if store.interior_samples(self.face).len() != self.interior.len() {
+            return Err(UndoError::Mismatch(format!("face {} interior size", self.face)));
+        }
+        for (offset, &color) in (0u32..).zip(&self.interior) {
+            store.set(SampleRef::Interior { face: self.face, offset }, color);
+        }
+        for (edge, _, samples) in &self.edges {
+            for (offset, &color) in (0u32..).zip(samples) {
+                store.set(SampleRef::Edge { edge: *edge, offset }, color);
+            }
+        }
+        Ok(())
+    }
+
+    fn bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + (self.interior.len() + self.edges.iter().map(|(_, _, s)| s.len()).sum::<usize>())
+                * std::mem::size_of::<Rgba>()
+    }
+}
+
+/// One recorded change.
+#[derive(Debug, Clone, PartialEq)]
+enum Change {
+    /// Old colours of samples (each sample at most once).
+    Samples(Vec<(SampleRef, Rgba)>),
+    /// A face and its edges before a resolution change.
+    Resolution(Box<FaceState>),
+}
+
+impl Change {
+    fn bytes(&self) -> usize {
+        match self {
+            Change::Samples(list) => list.len() * SAMPLE_RECORD_BYTES,
+            Change::Resolution(state) => state.bytes(),
+        }
+    }
+}
+
+/// One undoable step.
+#[derive(Debug, Clone, PartialEq)]
+struct Step {
+    label: String,
+    changes: Vec<Change>,
+    bytes: usize,
+}
+
+impl Step {
+    fn is_empty(&self) -> bool {
+        self.changes.iter().all(|change| matches!(change, Change::Samples(list) if list.is_empty()))
+    }
+
+    fn recount(&mut self) {
+        self.bytes = self.changes.iter().map(Change::bytes).sum();
+    }
+
+    /// Applies the step backwards and returns the step that reverses it.
+    fn apply_backwards(&self, store: &mut ColorStore) -> Result<Step, UndoError> {
+        let mut inverse = Vec::with_capacity(self.changes.len());
+        for change in self.changes.iter().rev() {
+            match change {
+                Change::Samples(list) => {
+                    let mut current = Vec::with_capacity(list.len());
+                    for &(sample, old) in list {
+                        let now = store
+                            .get(sample)
+                            .ok_or_else(|| UndoError::Mismatch(format!("sample {sample:?} does not exist")))?;
+                        current.push((sample, now));
+                        store.set(sample, old);
+                    }
+                    inverse.push(Change::Samples(current));
+                }
+                Change::Resolution(state) => {
+                    let current = FaceState::capture(store, state.face)?;
+                    state.restore(store)?;
+                    inverse.push(Change::Resolution(Box::new(current)));
+                }
+            }
+        }
+        let mut step = Step { label: self.label.clone(), changes: inverse, bytes: 0 };
+        step.recount();
+        Ok(step)
+    }
+}
+
+/// What a closed step recorded.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StepSummary {
+    /// The step's label.
+    pub label: String,
+    /// Samples whose old colour was recorded.
+    pub samples: u64,
+    /// Faces whose resolution changed.
+    pub resolution_changes: u64,
+    /// Bytes the step takes.
+    pub bytes: usize,
+    /// Whether the step was kept (`false` when it was empty, or alone larger than the cap).
+    pub kept: bool,
+    /// Older steps dropped to stay within the cap.
+    pub dropped_steps: usize,
+}
+
+/// Slot marker: the element has no bitset in the open step.
+const NO_SLOT: u32 = u32::MAX;
+
+/// First-write bitsets of the open step.
+#[derive(Debug, Clone, Default)]
+struct SeenSamples {
+    vertex_bits: Vec<u64>,
+    edge_slot: Vec<u32>,
+    face_slot: Vec<u32>,
+    /// Bitsets; the first `used` are live, the rest are kept for reuse.
+    slots: Vec<Vec<u64>>,
+    used: usize,
+    touched_edges: Vec<u32>,
+    touched_faces: Vec<u32>,
+}
+
+impl SeenSamples {
+    fn fit(&mut self, store: &ColorStore) {
+        let topology = store.topology();
+        let words = (topology.vertex_count as usize).div_ceil(64);
+        if self.vertex_bits.len() != words {
+            self.vertex_bits = vec![0; words];
+        }
+        if self.edge_slot.len() != topology.edge_count() as usize {
+            self.edge_slot = vec![NO_SLOT; topology.edge_count() as usize];
+        }
+        if self.face_slot.len() != topology.face_count() as usize {
+            self.face_slot = vec![NO_SLOT; topology.face_count() as usize];
+        }
+    }
+
+    fn clear(&mut self) {
+        self.vertex_bits.fill(0);
+        for &edge in &self.touched_edges {
+            self.edge_slot[edge as usize] = NO_SLOT;
+        }
+        for &face in &self.touched_faces {
+            self.face_slot[face as usize] = NO_SLOT;
+        }
+        self.touched_edges.clear();
+        self.touched_faces.clear();
+        self.used = 0;
+    }
+
+    /// A zeroed bitset of `bits` bits; returns its slot.
+    fn new_slot(&mut self, bits: usize) -> u32 {
+        let words = bits.div_ceil(64);
+        if self.used == self.slots.len() {
+            self.slots.push(Vec::new());
+        }
+        let slot = &mut self.slots[self.used];
+        slot.clear();
+        slot.resize(words, 0);
+        self.used += 1;
+        (self.used - 1) as u32
+    }
+
+    /// The slot of an element (`table[id]`), created for `bits` bits when missing.
+    fn slot(&mut self, is_edge: bool, id: u32, bits: usize) -> usize {
+        let current = if is_edge { self.edge_slot[id as usize] } else { self.face_slot[id as usize] };
+        if current != NO_SLOT {
+            return current as usize;
+        }
+        let slot = self.new_slot(bits);
+        if is_edge {
+            self.edge_slot[id as usize] = slot;
+            self.touched_edges.push(id);
+        } else {
+            self.face_slot[id as usize] = slot;
+            self.touched_faces.push(id);
+        }
+        slot as usize
+    }
+
+    /// Forgets an element's bitset (its sample count is about to change).
+    fn forget(&mut self, is_edge: bool, id: u32) {
+        let table = if is_edge { &mut self.edge_slot } else { &mut self.face_slot };
+        if let Some(slot) = table.get_mut(id as usize) {
+            *slot = NO_SLOT;
+        }
+    }
+}
+
+/// Which element a [`SampleLog`] records for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LogElement {
+    Vertices,
+    Edge(u32),
+    Interior(u32),
+    /// No step is open: nothing is recorded.
+    Off,
+}
+
+/// Records first writes to the samples of one element (or to vertices) in the open step.
+/// Obtained from [`UndoHistory::vertex_log`], [`UndoHistory::edge_log`] or
+/// [`UndoHistory::interior_log`]; recording is a bit test and, the first time, a push.
+#[derive(Debug)]
+pub struct SampleLog<'a> {
+    element: LogElement,
+    bits: &'a mut [u64],
+    list: Option<&'a mut Vec<(SampleRef, Rgba)>>,
+}
+
+impl SampleLog<'_> {
+    /// A log that records nothing (no step is open).
+    fn off() -> Self {
+        SampleLog { element: LogElement::Off, bits: &mut [], list: None }
+    }
+
+    /// Records that sample `index` of the element (the vertex id for vertex logs, the
+    /// storage offset otherwise) had colour `old` before its first write in the step.
+    #[inline]
+    pub fn record(&mut self, index: u32, old: Rgba) {
+        let Some(list) = self.list.as_deref_mut() else {
+            return;
+        };
+        let (word, bit) = ((index / 64) as usize, 1u64 << (index % 64));
+        let Some(bits) = self.bits.get_mut(word) else {
+            return;
+        };
+        if *bits & bit != 0 {
+            return;
+        }
+        *bits |= bit;
+        let sample = match self.element {
+            LogElement::Vertices => SampleRef::Vertex(index),
+            LogElement::Edge(edge) => SampleRef::Edge { edge, offset: index },
+            LogElement::Interior(face) => SampleRef::Interior { face, offset: index },
+            LogElement::Off => return,
+        };
+        list.push((sample, old));
+    }
+
+    /// Whether writes are being recorded (a step is open).
+    pub fn is_recording(&self) -> bool {
+        self.list.is_some()
+    }
+}
+
+/// The open step's current block of sample writes (started after the last resolution
+/// change), or `None` without an open step.
+fn current_samples(open: &mut Option<Step>) -> Option<&mut Vec<(SampleRef, Rgba)>> {
+    let step = open.as_mut()?;
+    if !matches!(step.changes.last(), Some(Change::Samples(_))) {
+        step.changes.push(Change::Samples(Vec::new()));
+    }
+    match step.changes.last_mut() {
+        Some(Change::Samples(list)) => Some(list),
+        _ => None,
+    }
+}
+
+/// The undo and redo stacks with the open step being recorded.
+#[derive(Debug, Clone)]
+pub struct UndoHistory {
+    undo: VecDeque<Step>,
+    redo: Vec<Step>,
+    open: Option<Step>,
+    seen: SeenSamples,
+    cap_bytes: usize,
+    generation: u64,
+    dropped_steps: u64,
+}
+
+impl Default for UndoHistory {
+    fn default() -> Self {
+        Self::new(DEFAULT_CAP_BYTES)
+    }
+}
+
+impl UndoHistory {
+    /// An empty history keeping at most `cap_bytes` of undo data.
+    pub fn new(cap_bytes: usize) -> Self {
+        UndoHistory {
+            undo: VecDeque::new(),
+            redo: Vec::new(),
+            open: None,
+            seen: SeenSamples::default(),
+            cap_bytes,
+            generation: 0,
+            dropped_steps: 0,
+        }
+    }
+
+    /// The memory cap in bytes.
+    pub fn cap_bytes(&self) -> usize {
+        self.cap_bytes
+    }
+
+    /// Changes the memory cap; the oldest steps are dropped at once if needed.
+    pub fn set_cap_bytes(&mut self, cap_bytes: usize) {
+        self.cap_bytes = cap_bytes;
+        self.enforce_cap();
+    }
+
+    /// Bytes taken by the kept undo and redo steps (the open step not included).
+    pub fn bytes_used(&self) -> usize {
+        self.undo.iter().chain(&self.redo).map(|step| step.bytes).sum()
+    }
+
+    /// Bytes recorded so far in the open step (0 when none is open).
+    pub fn open_step_bytes(&self) -> usize {
+        self.open.as_ref().map_or(0, |step| step.changes.iter().map(Change::bytes).sum())
+    }
+
+    /// Number of steps that can be undone.
+    pub fn undo_len(&self) -> usize {
+        self.undo.len()
+    }
+
+    /// Number of steps that can be redone.
+    pub fn redo_len(&self) -> usize {
+        self.redo.len()
+    }
+
+    /// The label of the step [`UndoHistory::undo`] would undo.
+    pub fn undo_label(&self) -> Option<&str> {
+        self.undo.back().map(|step| step.label.as_str())
+    }
+
+    /// The label of the step [`UndoHistory::redo`] would redo.
+    pub fn redo_label(&self) -> Option<&str> {
+        self.redo.last().map(|step| step.label.as_str())
+    }
+
+    /// Steps dropped so far to stay within the cap.
+    pub fn dropped_steps(&self) -> u64 {
+        self.dropped_steps
+    }
+
+    /// A counter that changes whenever the colours change through the history (a step
+    /// closed, undone or redone): compare it to decide whether to autosave.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// Whether a step is open.
+    pub fn is_recording(&self) -> bool {
+        self.open.is_some()
+    }
+
+    /// Forgets every step (e.g. when another document is opened).
+    pub fn clear(&mut self) {
+        self.undo.clear();
+        self.redo.clear();
+        self.open = None;
+        self.seen.clear();
+    }
+
+    /// Opens a step labelled `label` for edits of `store`.
+    pub fn begin_step(&mut self, store: &ColorStore, label: &str) -> Result<(), UndoError> {
+        if self.open.is_some() {
+            return Err(UndoError::StepOpen);
+        }
+        self.seen.fit(store);
+        self.seen.clear();
+        self.open = Some(Step { label: label.to_owned(), changes: Vec::new(), bytes: 0 });
+        Ok(())
+    }
+
+    /// Closes the open step: keeps it when it changed anything (clearing redo), then drops the
+    /// oldest steps while over the cap. `None` when no step was open.
+    pub fn end_step(&mut self) -> Option<StepSummary> {
+        let mut step = self.open.take()?;
+        self.seen.clear();
+        step.changes.retain(|change| !matches!(change, Change::Samples(list) if list.is_empty()));
+        for change in &mut step.changes {
+            if let Change::Samples(list) = change {
+                list.shrink_to_fit();
+            }
+        }
+        step.recount();
+        let samples = step
+            .changes
+            .iter()
+            .map(|change| match change {
+                Change::Samples(list) => list.len() as u64,
+                Change::Resolution(_) => 0,
+            })
+            .sum();
+        let resolution_changes =
+            step.changes.iter().filter(|change| matches!(change, Change::Resolution(_))).count() as u64;
+        let mut summary = StepSummary {
+            label: step.label.clone(),
+            samples,
+            resolution_changes,
+            bytes: step.bytes,
+            kept: false,
+            dropped_steps: 0,
+        };
+        if step.is_empty() {
+            return Some(summary);
+        }
+        self.generation += 1;
+        self.redo.clear();
+        self.undo.push_back(step);
+        let before = self.undo.len();
+        self.enforce_cap();
+        // Steps go oldest first, so the new step is dropped only when it alone is over the cap.
+        summary.kept = !self.undo.is_empty();
+        summary.dropped_steps = before - self.undo.len() - usize::from(!summary.kept);
+        Some(summary)
+    }
+
+    fn enforce_cap(&mut self) {
+        // Redo steps are the most recently undone work: drop the oldest undo steps first,
+        // then (only if still over) the redo step farthest from the present.
+        while self.bytes_used() > self.cap_bytes {
+            if self.undo.pop_front().is_none() {
+                if self.redo.is_empty() {
+                    break;
+                }
+                self.redo.remove(0);
+            }
+            self.dropped_steps += 1;
+        }
+    }
+
+    /// The log for vertex colours (index = vertex id).
+    pub fn vertex_log(&mut self) -> SampleLog<'_> {
+        match current_samples(&mut self.open) {
+            Some(list) => SampleLog { element: LogElement::Vertices, bits: &mut self.seen.vertex_bits, list: Some(list) },
+            None => SampleLog::off(),
+        }
+    }
+
+    /// The log for the samples of `edge`, which currently has `sample_count` samples.
+    pub fn edge_log(&mut self, edge: u32, sample_count: usize) -> SampleLog<'_> {
+        self.element_log(true, edge, sample_count)
+    }
+
+    /// The log for the interior samples of `face`, which currently has `sample_count` samples.
+    pub fn interior_log(&mut self, face: u32, sample_count: usize) -> SampleLog<'_> {
+        self.element_log(false, face, sample_count)
+    }
+
+    fn element_log(&mut self, is_edge: bool, id: u32, sample_count: usize) -> SampleLog<'_> {
+        let table_len = if is_edge { self.seen.edge_slot.len() } else { self.seen.face_slot.len() };
+        if self.open.is_none() || id as usize >= table_len {
+            return SampleLog::off();
+        }
+        let slot = self.seen.slot(is_edge, id, sample_count);
+        let element = if is_edge { LogElement::Edge(id) } else { LogElement::Interior(id) };
+        match current_samples(&mut self.open) {
+            Some(list) => SampleLog { element, bits: &mut self.seen.slots[slot], list: Some(list) },
+            None => SampleLog::off(),
+        }
+    }
+
+    /// Records one sample's colour before its first write in the open step (no-op without
+    /// an open step). Convenient for occasional writes; the brush uses the element logs.
+    pub fn record_sample(&mut self, store: &ColorStore, sample: SampleRef, old: Rgba) {
+        match sample {
+            SampleRef::Vertex(v) => self.vertex_log().record(v, old),
+            SampleRef::Edge { edge, offset } => {
+                let count = store.edge_samples(edge).len();
+                self.edge_log(edge, count).record(offset, old);
+            }
+            SampleRef::Interior { face, offset } => {
+                let count = store.interior_samples(face).len();
+                self.interior_log(face, count).record(offset, old);
+            }
+        }
+    }
+
+    /// Writes `color` to `sample`, recording the old colour in the open step. Returns
+    /// whether the sample exists.
+    pub fn set_sample(&mut self, store: &mut ColorStore, sample: SampleRef, color: Rgba) -> bool {
+        let Some(old) = store.get(sample) else {
+            return false;
+        };
+        if old.map(f32::to_bits) != color.map(f32::to_bits) {
+            self.record_sample(store, sample, old);
+            store.set(sample, color);
+        }
+        true
+    }
+
+    /// Changes the resolution of `face` (resampling as the store defines), recording the
+    /// face's old resolution and the old samples of the face and its three edges in the open
+    /// step. Returns whether the resolution changed. Without an open step, nothing is
+    /// recorded.
+    pub fn set_face_resolution(
+        &mut self,
+        store: &mut ColorStore,
+        face: u32,
+        resolution: Resolution,
+    ) -> Result<bool, UndoError> {
+        let Some(current) = store.face_resolution(face) else {
+            return Err(StoreError::NoSuchFace { face, face_count: store.topology().face_count() }.into());
+        };
+        if current == resolution {
+            return Ok(false);
+        }
+        if self.open.is_some() {
+            let state = FaceState::capture(store, face)?;
+            // Offsets recorded from now on refer to the new sizes.
+            self.seen.forget(false, face);
+            for (edge, _, _) in &state.edges {
+                self.seen.forget(true, *edge);
+            }
+            if let Some(step) = self.open.as_mut() {
+                step.changes.push(Change::Resolution(Box::new(state)));
+            }
+        }
+        store.set_face_resolution(face, resolution)?;
+        Ok(true)
+    }
+
+    /// Undoes the newest step. Returns `false` when there is nothing to undo.
+    pub fn undo(&mut self, store: &mut ColorStore) -> Result<bool, UndoError> {
+        if self.open.is_some() {
+            return Err(UndoError::Busy);
+        }
+        let Some(step) = self.undo.pop_back() else {
+            return Ok(false);
+        };
+        match step.apply_backwards(store) {
+            Ok(inverse) => {
+                self.redo.push(inverse);
+                self.generation += 1;
+                Ok(true)
+            }
+            Err(error) => {
+                self.clear();
+                self.generation += 1;
+                Err(error)
+            }
+        }
+    }
+
+    /// Redoes the step undone last. Returns `false` when there is nothing to redo.
+    pub fn redo(&mut self, store: &mut ColorStore) -> Result<bool, UndoError> {
+        if self.open.is_some() {
+            return Err(UndoError::Busy);
+        }
+        let Some(step) = self.redo.pop() else {
+            return Ok(false);
+        };
+        match step.apply_backwards(store) {
+            Ok(inverse) => {
+                self.undo.push_back(inverse);
+                self.generation += 1;
+                self.enforce_cap();
+                Ok(true)
+            }
+            Err(error) => {
+                self.clear();
+                self.generation += 1;
+                Err(error)
+            }
+        }
+    }
+}
