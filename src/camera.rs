@@ -190,7 +190,7 @@ impl OrbitCamera {
     /// Looks at `point` from `distance` (clamped as in [`OrbitCamera::zoom`]), keeping the
     /// viewing direction.
     pub fn look_at_point(&mut self, point: DVec3, distance: f64) {
-        if !point.is_finite() || !(distance.is_finite() && distance > 0.0) {
+        if !(point.is_finite() && distance.is_finite() && distance > 0.0) {
             return;
         }
         self.target = point.to_array();

@@ -29,6 +29,9 @@
 //! | [`export_gltf`] | store → .glb tessellated at each face's resolution, one vertex (COLOR_0) per sample |
 //! | [`camera`] | the orbit camera: matrices, framing, pixel rays (shared by render, picking, replay) |
 //! | [`picking`] | obvhs BVH over the mesh, watertight ray casts with our own barycentrics |
+//! | [`brush`] | painting: colour / blur / resolution brushes, stroke dabs, occlusion, mirror, eyedropper, fill |
+//! | [`undo`] | undo / redo per stroke: changed samples and resolution changes only, memory cap |
+//! | [`autosave`] | periodic atomic RGBA32F recovery files; find and load them after a crash |
 //! | [`bake`] | base-colour texture → mesh colors (texture conversion) |
 //! | [`render`] | **GPU**: wgpu context, packed buffers on the GPU, sampling pipelines, readback |
 //! | [`bench`] | the measurements behind `meshpaint bench` (time and size, as JSON) |
@@ -51,8 +54,10 @@
 //! The binary (`src/main.rs`) and the editor ([`app`]) are the only places where everything meets.
 
 pub mod app;
+pub mod autosave;
 pub mod bake;
 pub mod bench;
+pub mod brush;
 pub mod camera;
 pub mod color;
 pub mod document;
@@ -71,4 +76,5 @@ pub mod scene;
 pub mod stats;
 pub mod store;
 pub mod topology;
+pub mod undo;
 pub mod weld;

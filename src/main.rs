@@ -75,6 +75,14 @@ enum Command {
         #[arg(long, short = 'o')]
         output: PathBuf,
     },
+    /// Replay a brush stroke headlessly (the editor's camera, picking and brush code) and
+    /// write the painted mesh: OUT ending in .glb gets a tessellated vertex-colour glTF, any
+    /// other name a packed file.
+    Paint(PaintArgs),
+    /// Test helper: writes a recovery file (and now and then a saved file) in a loop,
+    /// printing each generation after its write returns, until killed.
+    #[command(hide = true, name = "autosave-soak")]
+    AutosaveSoak(SoakArgs),
 }
 
 #[derive(Debug, Subcommand)]
@@ -110,6 +118,22 @@ enum BenchCommand {
         #[arg(long, default_value_t = 20)]
         frames: usize,
     },
+    /// Picking and painting: BVH presets, pick latency, dab time and samples/s for brushes
+    /// covering ~1k / 10k / 100k samples, upload bytes per dab, repack time.
+    Paint {
+        /// A .glb / .gltf file or a packed file (default: the Bunny).
+        #[arg(default_value = "assets/models/Bunny144k/bunny.glb")]
+        file: PathBuf,
+        /// Uniform face resolution R for glTF input.
+        #[arg(long, short = 'r', default_value_t = 8)]
+        resolution: u64,
+        /// Timed dabs per brush size.
+        #[arg(long, default_value_t = 30)]
+        dabs: usize,
+        /// Print compact JSON (default: indented JSON).
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 fn parse_format(name: &str) -> Result<ColorFormat, String> {
@@ -138,6 +162,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bench { what } => bench(what),
         Command::Render(args) => render(args),
         Command::Export { file, resolution, format, output } => export(&file, resolution, format, &output),
+        Command::Paint(args) => paint(args),
+        Command::AutosaveSoak(args) => autosave_soak(args),
     }
 }
 
@@ -242,6 +268,19 @@ fn bench(what: BenchCommand) -> Result<()> {
                 "results": results,
             });
             println!("{report}");
+            Ok(())
+        }
+        BenchCommand::Paint { file, resolution, dabs, json } => {
+            let document = open(&file, resolution)?;
+            let options = meshpaint::brush::PaintBenchOptions { dabs, ..Default::default() };
+            let mut report = meshpaint::brush::bench_paint(&document, &options)?;
+            report["file"] = file.display().to_string().into();
+            report["resolution"] = resolution.into();
+            if json {
+                println!("{report}");
+            } else {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            }
             Ok(())
         }
         BenchCommand::Render { file, resolution, width, height, frames } => {
@@ -423,4 +462,244 @@ fn export(path: &Path, resolution: u64, format: Option<ColorFormat>, output: &Pa
         format.name()
     );
     Ok(())
+}
+
+/// Arguments of `meshpaint paint`.
+#[derive(Debug, clap::Args)]
+struct PaintArgs {
+    /// A .glb / .gltf file or a packed file.
+    file: PathBuf,
+    /// Cursor positions in pixels of the WIDTH × HEIGHT view: "x0,y0 x1,y1 …".
+    #[arg(long, allow_hyphen_values = true)]
+    stroke: String,
+    /// Brush colour, sRGB hex (#rrggbb).
+    #[arg(long, default_value = "#ff0000")]
+    color: String,
+    /// Brush radius in pixels (converted to world units at each dab's depth).
+    #[arg(long, default_value_t = 30.0)]
+    radius_px: f64,
+    /// Brush radius in world units (overrides --radius-px).
+    #[arg(long)]
+    radius_world: Option<f64>,
+    /// Weight at the brush centre, 0..=1.
+    #[arg(long, default_value_t = 1.0)]
+    strength: f32,
+    /// Falloff: smooth, linear, constant or sharp.
+    #[arg(long, default_value = "smooth", value_parser = parse_falloff)]
+    falloff: meshpaint::brush::Falloff,
+    /// Distance between dabs, percent of the radius.
+    #[arg(long, default_value_t = 10.0)]
+    spacing: f64,
+    /// Blend mode: mix, add, multiply or erase (back to the colours before the stroke).
+    #[arg(long, default_value = "mix", value_parser = parse_blend)]
+    blend: meshpaint::brush::BlendMode,
+    /// Tool: paint, blur, raise / lower (face resolution), or set (to --target-resolution).
+    #[arg(long, value_enum, default_value_t = PaintTool::Paint)]
+    tool: PaintTool,
+    /// The resolution `--tool set` gives faces under the brush.
+    #[arg(long)]
+    target_resolution: Option<u64>,
+    /// Paint hidden samples too (no occlusion test).
+    #[arg(long)]
+    no_occlusion: bool,
+    /// Paint samples on back faces too.
+    #[arg(long)]
+    no_backface_culling: bool,
+    /// Also paint mirrored across x = centre of the mesh bounds.
+    #[arg(long)]
+    mirror_x: bool,
+    /// Camera yaw around +Y in degrees (as `meshpaint render`).
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    yaw: f64,
+    /// Camera pitch above the horizon in degrees.
+    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
+    pitch: f64,
+    /// Eye distance from the scene centre (default: frame the bounding sphere).
+    #[arg(long)]
+    distance: Option<f64>,
+    /// View width in pixels.
+    #[arg(long, default_value_t = 1024)]
+    width: u32,
+    /// View height in pixels.
+    #[arg(long, default_value_t = 768)]
+    height: u32,
+    /// Uniform face resolution R for glTF input (a power of two, 1..=4096).
+    #[arg(long, short = 'r', default_value_t = 8)]
+    resolution: u64,
+    /// Colour format of a packed output (default: the input's, rgba8 for glTF).
+    #[arg(long, value_parser = parse_format)]
+    format: Option<ColorFormat>,
+    /// Output: .glb (tessellated, vertex colours) or a packed file.
+    #[arg(long, short = 'o')]
+    output: PathBuf,
+}
+
+/// `--tool` values of `meshpaint paint`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum PaintTool {
+    Paint,
+    Blur,
+    Raise,
+    Lower,
+    Set,
+}
+
+fn parse_falloff(name: &str) -> Result<meshpaint::brush::Falloff, String> {
+    meshpaint::brush::Falloff::from_name(name)
+        .ok_or_else(|| format!("unknown falloff '{name}' (smooth, linear, constant, sharp)"))
+}
+
+fn parse_blend(name: &str) -> Result<meshpaint::brush::BlendMode, String> {
+    meshpaint::brush::BlendMode::from_name(name)
+        .ok_or_else(|| format!("unknown blend mode '{name}' (mix, add, multiply, erase)"))
+}
+
+/// `meshpaint paint`: one stroke replayed through the editor's brush code.
+fn paint(args: PaintArgs) -> Result<()> {
+    use meshpaint::brush::{BrushRadius, BrushSettings, PaintView, Painter, ResolutionOp, Tool};
+    let extension = args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if extension.as_deref() == Some("gltf") {
+        anyhow::bail!("{}: glTF output is written as binary glTF only; name the output .glb", args.output.display());
+    }
+    let stroke = meshpaint::brush::parse_stroke(&args.stroke).map_err(|e| anyhow::anyhow!("--stroke: {e}"))?;
+    let color = meshpaint::brush::parse_hex_color(&args.color)
+        .with_context(|| format!("--color '{}' is not #rrggbb", args.color))?;
+    if let Some(distance) = args.distance {
+        anyhow::ensure!(distance.is_finite() && distance > 0.0, "--distance must be a positive number");
+    }
+    anyhow::ensure!(args.width > 0 && args.height > 0, "--width and --height must be positive");
+    let tool = match (args.tool, args.target_resolution) {
+        (PaintTool::Paint, None) => Tool::Paint,
+        (PaintTool::Blur, None) => Tool::Blur,
+        (PaintTool::Raise, None) => Tool::Resolution(ResolutionOp::Raise),
+        (PaintTool::Lower, None) => Tool::Resolution(ResolutionOp::Lower),
+        (PaintTool::Set, Some(r)) => {
+            Tool::Resolution(ResolutionOp::Set(Resolution::new(r).context("--target-resolution")?))
+        }
+        (PaintTool::Set, None) => anyhow::bail!("--tool set needs --target-resolution N"),
+        (_, Some(_)) => anyhow::bail!("--target-resolution applies to --tool set only"),
+    };
+    let radius = match args.radius_world {
+        Some(radius_world) => BrushRadius::World { radius_world },
+        None => BrushRadius::Pixels { radius_px: args.radius_px },
+    };
+    let settings = BrushSettings {
+        tool,
+        color,
+        blend: args.blend,
+        radius,
+        strength: args.strength,
+        falloff: args.falloff,
+        spacing_percent: args.spacing,
+        occlusion: !args.no_occlusion,
+        backface_culling: !args.no_backface_culling,
+        mirror_x: args.mirror_x,
+    };
+    settings.validate()?;
+
+    let started = std::time::Instant::now();
+    let mut document = open(&args.file, args.resolution)?;
+    let camera = meshpaint::render::default_camera(&document.positions, args.yaw, args.pitch, args.distance);
+    let bvh = meshpaint::picking::MeshBvh::build(
+        &document.positions,
+        &document.store.topology().face_vertices,
+        meshpaint::picking::BvhPreset::default(),
+    );
+    let base = document.store.clone();
+    let view = PaintView {
+        positions: &document.positions,
+        bvh: &bvh,
+        camera: &camera,
+        viewport_px: [args.width, args.height],
+        base: Some(&base),
+    };
+    let mut painter = Painter::new(&document.positions);
+    painter.set_settings(settings);
+    let mut history = meshpaint::undo::UndoHistory::default();
+    let (update, _) = meshpaint::brush::replay_stroke(&mut painter, &view, &mut document.store, &mut history, &stroke)?;
+
+    if extension.as_deref() == Some("glb") {
+        anyhow::ensure!(args.format.is_none(), "--format applies to packed output only");
+        meshpaint::export_gltf::write_tessellated_glb(&args.output, &document.positions, &document.store)
+            .with_context(|| format!("exporting {}", args.file.display()))?;
+    } else {
+        let format = match (args.format, document.source) {
+            (Some(format), _) => format,
+            (None, SourceKind::Packed(format)) => format,
+            (None, SourceKind::Gltf) => ColorFormat::default(),
+        };
+        let packed = document.pack(format).with_context(|| format!("packing {}", args.file.display()))?;
+        packed_file::write_file(&args.output, &packed)?;
+    }
+    eprintln!(
+        "{} → {}: {} cursor positions, {} dabs, {} samples covered, {} changed, {} faces resized ({:.2} s)",
+        args.file.display(),
+        args.output.display(),
+        stroke.len(),
+        update.dabs.len(),
+        update.stats.samples_covered,
+        update.stats.samples_changed,
+        update.stats.faces_resized,
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// Arguments of the hidden `meshpaint autosave-soak` (used by tests/autosave.rs).
+#[derive(Debug, clap::Args)]
+struct SoakArgs {
+    /// The document (glTF or packed).
+    file: PathBuf,
+    /// The recovery file to write in a loop.
+    #[arg(long)]
+    recovery: PathBuf,
+    /// A file saved normally every few generations.
+    #[arg(long)]
+    saved: PathBuf,
+    /// Uniform face resolution R for glTF input.
+    #[arg(long, short = 'r', default_value_t = 8)]
+    resolution: u64,
+    /// The first generation written.
+    #[arg(long, default_value_t = 1)]
+    start_generation: u64,
+    /// Stop after this many generations (0: until killed).
+    #[arg(long, default_value_t = 0)]
+    iterations: u64,
+}
+
+/// Writes generation `g` (vertex 0's red channel is `g`, and a band of samples changes) to the
+/// recovery file, and every third generation to the saved file too, printing
+/// `recovery G` / `saved G` after each write returns.
+fn autosave_soak(args: SoakArgs) -> Result<()> {
+    use std::io::Write;
+    let mut document = open(&args.file, args.resolution)?;
+    let mut stdout = std::io::stdout();
+    let vertices = document.store.topology().vertex_count;
+    anyhow::ensure!(vertices > 0, "{}: no vertices", args.file.display());
+    let mut generation = args.start_generation;
+    let last = args.start_generation.saturating_add(args.iterations.saturating_sub(1));
+    loop {
+        let marker = generation as f32;
+        document.store.set(meshpaint::store::SampleRef::Vertex(0), [marker, 0.0, 0.0, 1.0]);
+        for face in (0..document.store.topology().face_count()).step_by(7) {
+            let len = document.store.interior_samples(face).len() as u32;
+            for offset in 0..len {
+                let shade = ((generation + u64::from(offset)) % 17) as f32 / 16.0;
+                document.store.set(meshpaint::store::SampleRef::Interior { face, offset }, [shade, 0.5, 1.0 - shade, 1.0]);
+            }
+        }
+        meshpaint::autosave::write_recovery(&args.recovery, &document)?;
+        writeln!(stdout, "recovery {generation}")?;
+        stdout.flush()?;
+        if generation.is_multiple_of(3) {
+            let packed = document.pack(meshpaint::autosave::RECOVERY_FORMAT)?;
+            packed_file::write_file(&args.saved, &packed)?;
+            writeln!(stdout, "saved {generation}")?;
+            stdout.flush()?;
+        }
+        if args.iterations != 0 && generation >= last {
+            return Ok(());
+        }
+        generation += 1;
+    }
 }

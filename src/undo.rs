@@ -528,7 +528,9 @@ impl UndoHistory {
     /// The log for vertex colours (index = vertex id).
     pub fn vertex_log(&mut self) -> SampleLog<'_> {
         match current_samples(&mut self.open) {
-            Some(list) => SampleLog { element: LogElement::Vertices, bits: &mut self.seen.vertex_bits, list: Some(list) },
+            Some(list) => {
+                SampleLog { element: LogElement::Vertices, bits: &mut self.seen.vertex_bits, list: Some(list) }
+            }
             None => SampleLog::off(),
         }
     }

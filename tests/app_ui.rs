@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use meshpaint::app::editor::{Action, Editor, Severity};
+use meshpaint::app::editor::{Action, Editor, Mode, Severity};
 use meshpaint::app::loaded::Source;
 use meshpaint::render::{FilterMode, Shading};
 
@@ -101,7 +101,8 @@ fn f1_opens_the_help_window_listing_every_shortcut() {
     assert!(harness.state().show_help);
     assert!(harness.query_by_label("Keyboard and mouse").is_some(), "no help window");
     for shortcut in meshpaint::app::input::SHORTCUTS {
-        assert!(harness.query_by_label(shortcut.keys).is_some(), "help lacks {}", shortcut.keys);
+        // F is listed twice: once per mode.
+        assert!(harness.query_all_by_label(shortcut.keys).next().is_some(), "help lacks {}", shortcut.keys);
         assert!(harness.query_by_label(shortcut.description).is_some(), "help lacks {}", shortcut.description);
     }
     for (gesture, _) in meshpaint::app::input::POINTER_HELP {
@@ -121,7 +122,8 @@ fn every_shortcut_performs_a_distinct_action() {
     assert_eq!(actions.len(), shortcuts.len(), "two shortcuts share an action");
     for (i, a) in shortcuts.iter().enumerate() {
         for b in &shortcuts[i + 1..] {
-            assert!(!(a.key == b.key && a.modifiers == b.modifiers), "{} is bound twice", a.keys);
+            let same_mode = [Mode::View, Mode::Paint].iter().any(|&m| a.scope.includes(m) && b.scope.includes(m));
+            assert!(!(a.key == b.key && a.modifiers == b.modifiers && same_mode), "{} is bound twice", a.keys);
         }
     }
 }
@@ -347,4 +349,200 @@ fn save_without_a_project_file_asks_for_a_name() {
     let dialog = harness.state().dialog.as_ref().expect("Save did not ask for a name");
     assert_eq!(dialog.purpose, meshpaint::app::file_dialog::DialogPurpose::SaveAs);
     assert!(dialog.file_name.ends_with(".mpk"));
+}
+
+/// A file dropped on the window, as egui-winit hands it over.
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn dropping_a_file_on_the_window_opens_it() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    let box_glb = crate_path("assets/models/BoxTextured/BoxTextured.glb");
+    harness.input_mut().dropped_files.push(Arc::new(Dropped(box_glb.clone())));
+    harness.run_steps(1);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.run_steps(2);
+    let open = harness.state().document.as_ref().expect("no document");
+    assert_eq!(open.path.as_deref(), Some(box_glb.as_path()));
+    assert_eq!(open.triangles(), 12);
+    assert!(harness.query_by_label_contains("Opened BoxTextured.glb").is_some());
+}
+
+/// The Duck's colours, sample by sample (interiors, edges, vertices).
+fn colors_of(editor: &Editor) -> Vec<[f32; 4]> {
+    let store = &editor.document.as_ref().unwrap().document.store;
+    let mut out = Vec::new();
+    store.for_each_site(|site| out.push(store.get(site.sample).unwrap()));
+    out
+}
+
+/// Drags with the left button from `from` to `to` over the 3D view, in a few steps.
+fn left_drag(harness: &mut Harness<'static, Editor>, from: egui::Pos2, to: egui::Pos2) {
+    harness.event(egui::Event::PointerMoved(from));
+    harness.run_steps(1);
+    let button = |pos, pressed| egui::Event::PointerButton {
+        pos,
+        button: egui::PointerButton::Primary,
+        pressed,
+        modifiers: egui::Modifiers::NONE,
+    };
+    harness.event(button(from, true));
+    harness.run_steps(1);
+    for step in 1..=5 {
+        harness.event(egui::Event::PointerMoved(from + (to - from) * (step as f32 / 5.0)));
+        harness.run_steps(1);
+    }
+    harness.event(button(to, false));
+    harness.run_steps(2);
+}
+
+#[test]
+fn tab_toggles_paint_mode_and_leaving_repacks() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode, Mode::View);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode, Mode::Paint, "{:?}", harness.state().status);
+    assert!(harness.state().paint.is_some());
+    assert!(harness.query_by_label("Paint mode").is_some(), "the mode is not shown");
+    // The paint layout has level 0 only: trilinear becomes linear.
+    assert_eq!(harness.state().view.filter, FilterMode::Trilinear);
+    assert_eq!(harness.state().render_settings().filter, FilterMode::Linear);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode, Mode::View);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.run_steps(2);
+    assert!(harness.state().status.text.contains("Repacked"), "{:?}", harness.state().status);
+    assert_eq!(harness.state().render_settings().filter, FilterMode::Trilinear);
+    assert!(harness.query_by_label("View mode").is_some());
+}
+
+#[test]
+fn paint_panel_changes_the_brush_settings() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    assert!(!harness.state().brush.mirror_x);
+    harness.get_by_label("X mirror").click();
+    harness.run_steps(2);
+    assert!(harness.state().brush.mirror_x);
+    harness.get_by_label("Occlusion").click();
+    harness.run_steps(2);
+    assert!(!harness.state().brush.occlusion);
+    harness.get_by_label("Blur").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().brush.tool, meshpaint::brush::Tool::Blur);
+    harness.get_by_label("Colour").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().brush.tool, meshpaint::brush::Tool::Paint);
+    harness.get_by_value("Mix").click();
+    harness.run_steps(2);
+    harness.get_by_label("Erase to base").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().brush.blend, meshpaint::brush::BlendMode::EraseToBase);
+    harness.get_by_label("world").click();
+    harness.run_steps(2);
+    assert!(matches!(harness.state().brush.radius, meshpaint::brush::BrushRadius::World { .. }));
+}
+
+#[test]
+fn a_stroke_paints_and_undo_redo_buttons_and_keys_revert_it() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    let original = colors_of(harness.state());
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    let center = harness.state().viewport.rect.center();
+    left_drag(&mut harness, center - egui::vec2(60.0, 0.0), center + egui::vec2(60.0, 0.0));
+    let painted = colors_of(harness.state());
+    let changed = original.iter().zip(&painted).filter(|(a, b)| a != b).count();
+    assert!(changed > 100, "the stroke changed {changed} samples: {:?}", harness.state().status);
+    assert_eq!(harness.state().history.undo_len(), 1);
+    assert!(harness.state().history.bytes_used() > 0);
+    assert!(harness.query_by_label_contains("Undo: 1 steps").is_some(), "undo memory is not shown");
+
+    harness.get_by_label("Undo").click();
+    harness.run_steps(2);
+    assert_eq!(colors_of(harness.state()), original, "undo did not restore the colours");
+    harness.get_by_label("Redo").click();
+    harness.run_steps(2);
+    assert_eq!(colors_of(harness.state()), painted, "redo did not repaint");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(colors_of(harness.state()), original, "Ctrl+Z did not undo");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(colors_of(harness.state()), painted, "Ctrl+Shift+Z did not redo");
+}
+
+#[test]
+fn f_and_shift_f_set_radius_and_strength_interactively() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    let center = harness.state().viewport.rect.center();
+    harness.event(egui::Event::PointerMoved(center));
+    harness.run_steps(1);
+    let before = harness.state().brush;
+    // F: the radius follows the pointer; Enter confirms.
+    harness.key_press(egui::Key::F);
+    harness.run_steps(1);
+    harness.event(egui::Event::PointerMoved(center + egui::vec2(50.0, 0.0)));
+    harness.run_steps(1);
+    harness.key_press(egui::Key::Enter);
+    harness.run_steps(2);
+    let meshpaint::brush::BrushRadius::Pixels { radius_px } = harness.state().brush.radius else {
+        panic!("the radius is not in pixels");
+    };
+    assert!((radius_px - 80.0).abs() < 1.0, "radius {radius_px} px after moving 50 px out from 30 px");
+    assert_eq!(harness.state().camera, {
+        let editor = harness.state();
+        editor.camera
+    });
+    // Shift+F then Esc: the strength comes back.
+    harness.key_press_modifiers(egui::Modifiers::SHIFT, egui::Key::F);
+    harness.run_steps(1);
+    harness.event(egui::Event::PointerMoved(center - egui::vec2(100.0, 0.0)));
+    harness.run_steps(1);
+    assert!(harness.state().brush.strength < before.strength);
+    harness.key_press(egui::Key::Escape);
+    harness.run_steps(2);
+    assert_eq!(harness.state().brush.strength, before.strength);
+    assert!(harness.state().paint.as_ref().unwrap().gesture.is_none());
+}
+
+#[test]
+fn resolution_brush_and_set_r_for_all_change_face_resolutions() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    harness.get_by_label("Resolution").click();
+    harness.run_steps(2);
+    assert!(matches!(harness.state().brush.tool, meshpaint::brush::Tool::Resolution(_)));
+    let center = harness.state().viewport.rect.center();
+    left_drag(&mut harness, center - egui::vec2(30.0, 0.0), center + egui::vec2(30.0, 0.0));
+    let resolutions = |editor: &Editor| editor.document.as_ref().unwrap().document.store.face_resolutions().to_vec();
+    let raised = resolutions(harness.state()).iter().filter(|r| r.get() == 16).count();
+    assert!(raised > 0, "the resolution brush raised no face: {:?}", harness.state().status);
+    harness.get_by_label("Set R for all").click();
+    harness.run_steps(2);
+    assert!(resolutions(harness.state()).iter().all(|r| r.get() == 8), "{:?}", harness.state().status);
+    harness.get_by_label("Undo").click();
+    harness.run_steps(2);
+    assert_eq!(resolutions(harness.state()).iter().filter(|r| r.get() == 16).count(), raised);
 }

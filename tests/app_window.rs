@@ -221,8 +221,12 @@ fn compare(a: &RgbImage, b: &RgbImage) -> (f64, f64) {
     (sum as f64 / (3 * n) as f64, off as f64 / n as f64)
 }
 
+/// The window tests share the machine's displays and cores: one at a time.
+static WINDOW_TESTS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 #[test]
 fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
+    let _serial = WINDOW_TESTS.lock().unwrap_or_else(|e| e.into_inner());
     for tool in ["Xvfb", "xdotool", "import"] {
         require_tool(tool);
     }
@@ -350,6 +354,201 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     let log = read_log(&log_path);
     assert!(status.success(), "exit status {status}:\n{log}");
     assert!(!log.contains("panicked"), "{log}");
+    drop(processes);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn blank_or_misplaced_views_fail_the_checks() {
+    let blank = RgbImage::from_pixel(900, 700, image::Rgb(background()));
+    assert!(std::panic::catch_unwind(|| check_view_not_blank(&blank, "blank")).is_err());
+    let black = RgbImage::from_pixel(900, 700, image::Rgb([0, 0, 0]));
+    assert!(std::panic::catch_unwind(|| check_view_not_blank(&black, "black")).is_err());
+    let mut off_centre = blank.clone();
+    for y in 20..260 {
+        for x in 20..300 {
+            off_centre.put_pixel(x, y, image::Rgb([230, 200, 20]));
+        }
+    }
+    assert!(std::panic::catch_unwind(|| check_view_not_blank(&off_centre, "off centre")).is_err());
+    let mut centred = blank.clone();
+    for y in 200..500 {
+        for x in 300..600 {
+            centred.put_pixel(x, y, image::Rgb([230, 200, 20]));
+        }
+    }
+    check_view_not_blank(&centred, "centred square");
+}
+
+/// Distance from `p` to the segment `a`–`b`.
+fn distance_to_segment(p: (f64, f64), a: (f64, f64), b: (f64, f64)) -> f64 {
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let t = (((p.0 - a.0) * dx + (p.1 - a.1) * dy) / (dx * dx + dy * dy).max(1e-12)).clamp(0.0, 1.0);
+    (p.0 - a.0 - t * dx).hypot(p.1 - a.1 - t * dy)
+}
+
+/// Every sample of `document` with its world position.
+fn samples_with_positions(
+    document: &meshpaint::document::Document,
+) -> Vec<(meshpaint::store::SampleRef, [f32; 4], glam::DVec3)> {
+    let store = &document.store;
+    let mut out = Vec::new();
+    store.for_each_site(|site| {
+        let corners = store.topology().face_vertices[site.face as usize];
+        let mut p = glam::DVec3::ZERO;
+        for (k, &v) in corners.iter().enumerate() {
+            let q = document.positions[v as usize];
+            p += glam::DVec3::new(f64::from(q[0]), f64::from(q[1]), f64::from(q[2])) * f64::from(site.barycentric[k]);
+        }
+        out.push((site.sample, store.get(site.sample).unwrap(), p));
+    });
+    out
+}
+
+#[test]
+fn paint_mode_stroke_lands_under_the_cursor_and_is_saved() {
+    let _serial = WINDOW_TESTS.lock().unwrap_or_else(|e| e.into_inner());
+    for tool in ["Xvfb", "xdotool", "import"] {
+        require_tool(tool);
+    }
+    let dir = std::env::temp_dir().join(format!("meshpaint_app_paint_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log_path = dir.join("app.log");
+    let mut processes = Processes { children: Vec::new() };
+    let display = start_xvfb(&mut processes);
+    let asset = crate_path("assets/models/Duck/Duck.glb");
+    let app = Command::new(env!("CARGO_BIN_EXE_meshpaint"))
+        .arg(&asset)
+        .env("DISPLAY", &display)
+        .env("RUST_LOG", "meshpaint=info")
+        .env("XDG_RUNTIME_DIR", &dir)
+        .env("XDG_STATE_HOME", &dir)
+        .current_dir(&dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&log_path).unwrap())
+        .spawn()
+        .expect("cannot start meshpaint");
+    processes.children.push(app);
+    macro_rules! app {
+        () => {
+            processes.children.last_mut().unwrap()
+        };
+    }
+    wait_for_log(&log_path, "Opened Duck.glb", 0, Duration::from_secs(120), app!());
+    let window = xdotool(&display, &["search", "--sync", "--name", "meshpaint"]);
+    let window = window.lines().next().expect("no meshpaint window").trim().to_owned();
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    pause(3.0);
+    let rect = view_rect(&read_log(&log_path));
+    let (cx, cy) = (rect.0 + rect.2 / 2, rect.1 + rect.3 / 2);
+
+    // Tab enters paint mode.
+    xdotool(&display, &["mousemove", &cx.to_string(), &cy.to_string()]);
+    pause(0.3);
+    let from = read_log(&log_path).len();
+    xdotool(&display, &["key", "Tab"]);
+    wait_for_log(&log_path, "Paint mode", from, Duration::from_secs(30), app!());
+    pause(1.0);
+
+    // A horizontal stroke across the middle of the Duck (the default brush: red, 30 px).
+    let (x0, x1, y) = (cx - 120, cx + 120, cy + 20);
+    xdotool(&display, &["mousemove", &x0.to_string(), &y.to_string()]);
+    pause(0.3);
+    let from = read_log(&log_path).len();
+    xdotool(&display, &["mousedown", "1"]);
+    pause(0.3);
+    for step in 1..=6 {
+        let x = x0 + (x1 - x0) * step / 6;
+        xdotool(&display, &["mousemove", &x.to_string(), &y.to_string()]);
+        pause(0.3);
+    }
+    xdotool(&display, &["mouseup", "1"]);
+    wait_for_log(&log_path, "paint stroke", from, Duration::from_secs(30), app!());
+    pause(1.5);
+    let shot = screenshot(&display, &crate_path("screenshots/app_paint.png"));
+    let view = crop(&shot, rect);
+    let red = view
+        .enumerate_pixels()
+        .filter(|&(px, py, p)| {
+            let (vx, vy) = (f64::from(px + rect.0), f64::from(py + rect.1));
+            distance_to_segment((vx, vy), (f64::from(x0), f64::from(y)), (f64::from(x1), f64::from(y))) < 30.0
+                && p[0] > 150
+                && p[1] < 80
+                && p[2] < 80
+        })
+        .count();
+    assert!(red > 2000, "no red stroke in the paint-mode screenshot ({red} red pixels near the stroke)");
+
+    // Tab leaves (repack), Ctrl+S saves through the dialog.
+    let from = read_log(&log_path).len();
+    xdotool(&display, &["key", "Tab"]);
+    wait_for_log(&log_path, "Repacked", from, Duration::from_secs(60), app!());
+    let saved = dir.join("painted duck.mpk");
+    let from = read_log(&log_path).len();
+    xdotool(&display, &["key", "ctrl+s"]);
+    pause(1.5);
+    xdotool(&display, &["key", "ctrl+a"]);
+    pause(0.3);
+    xdotool(&display, &["type", "--delay", "30", &saved.display().to_string()]);
+    pause(0.5);
+    xdotool(&display, &["key", "Return"]);
+    wait_for_log(&log_path, "Saved", from, Duration::from_secs(120), app!());
+    xdotool(&display, &["key", "ctrl+q"]);
+    let started = Instant::now();
+    while app!().try_wait().unwrap().is_none() {
+        assert!(started.elapsed() < Duration::from_secs(20), "the app did not quit on Ctrl+Q");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    processes.children.pop();
+    let log = read_log(&log_path);
+    assert!(!log.contains("panicked"), "{log}");
+
+    // The saved colours differ from the original only under the stroke.
+    let r8 = meshpaint::layout::Resolution::new(8).unwrap();
+    let painted = meshpaint::document::Document::open(&saved, r8).expect("the saved file does not open");
+    let format = match painted.source {
+        meshpaint::document::SourceKind::Packed(format) => format,
+        other => panic!("the saved file is not packed: {other:?}"),
+    };
+    let original = meshpaint::document::Document::open(&asset, r8).unwrap();
+    // Quantise the original exactly as the save did.
+    let original = meshpaint::document::Document::from_packed(&original.pack(format).unwrap()).unwrap();
+    let before = samples_with_positions(&original);
+    let after = samples_with_positions(&painted);
+    assert_eq!(before.len(), after.len(), "the sample count changed");
+
+    // The app's camera: the same editor state the app computed at this view size.
+    let mut editor = Editor::new(None, Arc::new(|| {}));
+    editor.open(Source::File(asset.clone()));
+    assert!(editor.wait_for_job(Duration::from_secs(60)));
+    editor.viewport.rect = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(rect.2 as f32, rect.3 as f32));
+    editor.viewport.pixels_per_point = 1.0;
+    editor.frame_all();
+    let camera = editor.camera;
+    let a = (f64::from(x0 - rect.0), f64::from(y - rect.1));
+    let b = (f64::from(x1 - rect.0), f64::from(y - rect.1));
+    let radius_px = 30.0;
+    let mut changed = 0;
+    let mut worst: f64 = 0.0;
+    for ((sample, old, position), (sample_after, new, _)) in before.iter().zip(&after) {
+        assert_eq!(sample, sample_after);
+        if old == new {
+            continue;
+        }
+        changed += 1;
+        let (px, py) = camera.project(*position, rect.2, rect.3).expect("a changed sample behind the camera");
+        let d = distance_to_segment((px, py), a, b);
+        worst = worst.max(d);
+        assert!(
+            d <= radius_px * 1.25 + 4.0,
+            "sample {sample:?} changed at ({px:.1}, {py:.1}), {d:.1} px from the stroke (radius {radius_px} px)"
+        );
+        // The default brush paints red.
+        assert!(new[0] > new[1] && new[0] > new[2], "sample {sample:?} changed to {new:?}, not towards red");
+    }
+    eprintln!("{changed} samples changed, farthest {worst:.1} px from the stroke");
+    assert!(changed >= 1000, "only {changed} samples changed");
     drop(processes);
     let _ = std::fs::remove_dir_all(&dir);
 }

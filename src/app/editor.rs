@@ -37,6 +37,8 @@ pub enum Mode {
     /// Look at the mesh: navigation only.
     #[default]
     View,
+    /// Paint on the mesh: the left button paints with the brush ([`super::paint`]).
+    Paint,
 }
 
 impl Mode {
@@ -44,6 +46,7 @@ impl Mode {
     pub fn name(self) -> &'static str {
         match self {
             Mode::View => "View",
+            Mode::Paint => "Paint",
         }
     }
 }
@@ -134,6 +137,18 @@ pub enum Action {
     ToggleHelp,
     /// Close the application.
     Quit,
+    /// Enter or leave paint mode.
+    TogglePaintMode,
+    /// Undo the last stroke (paint mode).
+    Undo,
+    /// Redo the last undone stroke (paint mode).
+    Redo,
+    /// Pick the colour under the cursor into the brush (paint mode).
+    Eyedropper,
+    /// Set the brush radius by moving the mouse (paint mode).
+    RadiusGesture,
+    /// Set the brush strength by moving the mouse (paint mode).
+    StrengthGesture,
 }
 
 /// What a job produced.
@@ -143,6 +158,10 @@ pub enum JobOutput {
     Loaded(Box<OpenDocument>),
     /// A file was written.
     Written(Written, WriteKind),
+    /// The store was repacked after paint mode.
+    Repacked(Box<super::paint::Repacked>),
+    /// A recovery file was written.
+    Autosaved(super::autosave_ui::Autosaved),
 }
 
 /// Which kind of file a write job produced.
@@ -247,6 +266,24 @@ pub struct Editor {
     pub viewport_pointer: Option<egui::Pos2>,
     /// Set when the user asked to quit.
     pub quit_requested: bool,
+    /// The brush settings (kept between paint sessions).
+    pub brush: crate::brush::BrushSettings,
+    /// Paint mode's state while it is on.
+    pub paint: Option<super::paint::PaintSession>,
+    /// Undo / redo of paint mode, one step per stroke (cleared when another document opens).
+    pub history: crate::undo::UndoHistory,
+    /// The GPU mesh holds the paint layout (level 0 only): the filter is limited to level 0.
+    pub gpu_paint_layout: bool,
+    /// Bytes uploaded to the GPU during the previous frame.
+    pub upload_bytes_last_frame: u64,
+    /// Bytes uploaded to the GPU so far this frame.
+    pub upload_bytes_this_frame: u64,
+    /// Counts edits of the colours (autosave compares it).
+    pub edit_generation: u64,
+    /// The resolution of "Set R for all".
+    pub resolution_for_all: Resolution,
+    /// Autosave settings and state.
+    pub autosave: super::autosave_ui::AutosaveState,
     /// A load error to report once the built-in scene has replaced a failed start-up file.
     fallback_error: Option<String>,
     /// Where file dialogs start.
@@ -290,6 +327,15 @@ impl Editor {
             scene_generation: 0,
             viewport_pointer: None,
             quit_requested: false,
+            brush: crate::brush::BrushSettings::default(),
+            paint: None,
+            history: crate::undo::UndoHistory::new(crate::undo::DEFAULT_CAP_BYTES),
+            gpu_paint_layout: false,
+            upload_bytes_last_frame: 0,
+            upload_bytes_this_frame: 0,
+            edit_generation: 0,
+            resolution_for_all: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
+            autosave: super::autosave_ui::AutosaveState::default(),
             fallback_error: None,
             last_directory: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
         }
@@ -310,6 +356,13 @@ impl Editor {
     pub fn render_settings(&self) -> RenderSettings {
         let mut settings = RenderSettings::new(self.camera);
         settings.filter = self.view.filter;
+        if self.gpu_paint_layout || self.mode == Mode::Paint {
+            // The paint layout holds level 0 only.
+            settings.filter = match self.view.filter {
+                FilterMode::Nearest | FilterMode::NearestMipLevel(_) => FilterMode::Nearest,
+                FilterMode::Linear | FilterMode::MipLevel(_) | FilterMode::Trilinear => FilterMode::Linear,
+            };
+        }
         settings.shading = self.view.shading;
         settings.overlays = self.view.overlays;
         settings
@@ -392,7 +445,7 @@ impl Editor {
     fn finish_job(&mut self, label: String, finished: Finished<JobOutput>) {
         match finished {
             Finished::Done { value: JobOutput::Loaded(document), elapsed } => {
-                let document = *document;
+                let mut document = *document;
                 let mut text = format!(
                     "Opened {}: {} triangles, {} samples ({:.2} s)",
                     document.title,
@@ -410,6 +463,12 @@ impl Editor {
                     log::info!("{}: {note}", document.title);
                 }
                 self.camera = OrbitCamera::framing(document.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES);
+                // A new document: paint mode, its GPU layout and the undo history end.
+                self.paint = None;
+                self.mode = Mode::View;
+                self.gpu_paint_layout = false;
+                self.history.clear();
+                self.autosave.document_opened(&mut document, self.edit_generation);
                 self.document = Some(document);
                 self.scene_generation += 1;
                 self.frame_all();
@@ -437,6 +496,9 @@ impl Editor {
                         open.format = format;
                     }
                 }
+                if kind == WriteKind::Save {
+                    self.saved_document();
+                }
                 let verb = match kind {
                     WriteKind::Save => "Saved",
                     WriteKind::ExportPacked | WriteKind::ExportGltf => "Exported",
@@ -446,7 +508,16 @@ impl Editor {
                     format!("{verb} {}: {} ({:.2} s)", written.path.display(), written.summary, elapsed.as_secs_f64()),
                 );
             }
+            Finished::Done { value: JobOutput::Repacked(repacked), elapsed } => self.finish_repack(*repacked, elapsed),
+            Finished::Done { value: JobOutput::Autosaved(autosaved), .. } => self.finish_autosave(autosaved),
+            Finished::Failed(message) if label.starts_with(super::autosave_ui::AUTOSAVE_LABEL) => {
+                self.autosave.failed();
+                self.set_status(Severity::Warning, format!("Autosave failed: {message}"));
+            }
             Finished::Failed(message) => {
+                if label == "Repacking" {
+                    self.gpu_paint_layout = true;
+                }
                 let is_open = label.starts_with("Opening");
                 if is_open && self.document.is_none() && !label.ends_with(loaded::DEFAULT_SCENE_NAME) {
                     // Nothing was open (a bad file on the command line): show the Duck.
@@ -505,6 +576,12 @@ impl Editor {
             }
             Action::ToggleHelp => self.show_help = !self.show_help,
             Action::Quit => self.quit_requested = true,
+            Action::TogglePaintMode => self.toggle_paint_mode(),
+            Action::Undo => self.undo(),
+            Action::Redo => self.redo(),
+            Action::Eyedropper => self.eyedropper(),
+            Action::RadiusGesture => self.start_gesture(super::paint::GestureKind::Radius),
+            Action::StrengthGesture => self.start_gesture(super::paint::GestureKind::Strength),
         }
     }
 

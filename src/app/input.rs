@@ -7,7 +7,38 @@
 
 use egui::{Key, Modifiers, PointerButton};
 
-use super::editor::{Action, Editor};
+use super::editor::{Action, Editor, Mode};
+
+/// In which mode a shortcut works.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scope {
+    /// Everywhere.
+    Any,
+    /// In view mode only.
+    View,
+    /// In paint mode only.
+    Paint,
+}
+
+impl Scope {
+    /// Whether the shortcut works in `mode`.
+    pub fn includes(self, mode: Mode) -> bool {
+        match self {
+            Scope::Any => true,
+            Scope::View => mode == Mode::View,
+            Scope::Paint => mode == Mode::Paint,
+        }
+    }
+
+    /// How the help window writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Scope::Any => "",
+            Scope::View => "view",
+            Scope::Paint => "paint",
+        }
+    }
+}
 
 /// Degrees of orbit per point of pointer travel.
 pub const ORBIT_DEGREES_PER_POINT: f64 = 0.4;
@@ -29,6 +60,8 @@ pub struct Shortcut {
     pub action: Action,
     /// Description for the help window.
     pub description: &'static str,
+    /// The mode it works in.
+    pub scope: Scope,
 }
 
 const fn shortcut(
@@ -38,13 +71,38 @@ const fn shortcut(
     action: Action,
     description: &'static str,
 ) -> Shortcut {
-    Shortcut { modifiers, key, keys, action, description }
+    Shortcut { modifiers, key, keys, action, description, scope: Scope::Any }
+}
+
+const fn scoped(scope: Scope, shortcut: Shortcut) -> Shortcut {
+    Shortcut { scope, ..shortcut }
 }
 
 const CTRL_SHIFT: Modifiers = Modifiers { alt: false, ctrl: false, shift: true, mac_cmd: false, command: true };
 
 /// Every keyboard shortcut, most specific first (the help window lists them in this order).
 pub const SHORTCUTS: &[Shortcut] = &[
+    scoped(Scope::Paint, shortcut(CTRL_SHIFT, Key::Z, "Ctrl+Shift+Z", Action::Redo, "Redo the last undone stroke")),
+    scoped(Scope::Paint, shortcut(Modifiers::COMMAND, Key::Z, "Ctrl+Z", Action::Undo, "Undo the last stroke")),
+    shortcut(Modifiers::NONE, Key::Tab, "Tab", Action::TogglePaintMode, "Enter / leave paint mode"),
+    scoped(
+        Scope::Paint,
+        shortcut(Modifiers::SHIFT, Key::F, "Shift+F", Action::StrengthGesture, "Brush strength: move, click / Enter"),
+    ),
+    scoped(
+        Scope::Paint,
+        shortcut(
+            Modifiers::NONE,
+            Key::F,
+            "F",
+            Action::RadiusGesture,
+            "Brush radius: move, click / Enter (Esc cancels)",
+        ),
+    ),
+    scoped(
+        Scope::Paint,
+        shortcut(Modifiers::NONE, Key::S, "S", Action::Eyedropper, "Pick the colour under the cursor"),
+    ),
     shortcut(CTRL_SHIFT, Key::S, "Ctrl+Shift+S", Action::SaveAs, "Save as… (packed file)"),
     shortcut(CTRL_SHIFT, Key::E, "Ctrl+Shift+E", Action::ExportPacked, "Export packed buffers…"),
     shortcut(Modifiers::COMMAND, Key::O, "Ctrl+O", Action::Open, "Open a .glb / .gltf / packed file…"),
@@ -55,12 +113,15 @@ pub const SHORTCUTS: &[Shortcut] = &[
     shortcut(Modifiers::COMMAND, Key::Num3, "Ctrl+3", Action::ViewLeft, "View from the left"),
     shortcut(Modifiers::COMMAND, Key::Num7, "Ctrl+7", Action::ViewBottom, "View from below"),
     shortcut(Modifiers::NONE, Key::Home, "Home", Action::FrameAll, "Frame the whole mesh"),
-    shortcut(
-        Modifiers::NONE,
-        Key::F,
-        "F",
-        Action::FrameUnderCursor,
-        "Centre on the point under the cursor, move closer",
+    scoped(
+        Scope::View,
+        shortcut(
+            Modifiers::NONE,
+            Key::F,
+            "F",
+            Action::FrameUnderCursor,
+            "Centre on the point under the cursor, move closer (also Alt + middle click)",
+        ),
     ),
     shortcut(Modifiers::NONE, Key::Num1, "1", Action::ViewFront, "View from the front"),
     shortcut(Modifiers::NONE, Key::Num3, "3", Action::ViewRight, "View from the right"),
@@ -82,6 +143,7 @@ pub const POINTER_HELP: &[(&str, &str)] = &[
     ("Alt + Shift + left drag", "Pan (trackpads)"),
     ("Alt + Ctrl + left drag", "Zoom (trackpads)"),
     ("Alt + middle click", "Centre on the point under the cursor"),
+    ("Left drag (paint mode)", "Paint with the brush"),
     ("Drop a file on the window", "Open it"),
 ];
 
@@ -98,10 +160,20 @@ pub fn global_input(editor: &mut Editor, ctx: &egui::Context) {
     if let Some(path) = dropped.into_iter().next() {
         editor.open(super::loaded::Source::File(path));
     }
-    let typing = ctx.egui_wants_keyboard_input();
+    if editor.gesture_input(ctx) {
+        return;
+    }
+    // Only a text field keeps keys from the shortcuts (Tab may have focused a button).
+    let typing = ctx.text_edit_focused();
+    if !typing && let Some(id) = ctx.memory(|m| m.focused()) {
+        ctx.memory_mut(|m| m.surrender_focus(id));
+    }
     let mut actions = Vec::new();
     for shortcut in SHORTCUTS {
         if typing && shortcut.key != Key::F1 {
+            continue;
+        }
+        if !shortcut.scope.includes(editor.mode) {
             continue;
         }
         if editor.dialog.is_some() && !matches!(shortcut.action, Action::ToggleHelp | Action::Quit) {
@@ -120,6 +192,9 @@ pub fn global_input(editor: &mut Editor, ctx: &egui::Context) {
 pub fn viewport_input(editor: &mut Editor, ui: &egui::Ui, response: &egui::Response) {
     editor.viewport_pointer = response.hover_pos();
     let modifiers = ui.input(|i| i.modifiers);
+    if editor.mode == Mode::Paint {
+        paint_input(editor, ui, response, modifiers);
+    }
     let height = f64::from(response.rect.height().max(1.0));
     let navigating =
         response.dragged_by(PointerButton::Middle) || (modifiers.alt && response.dragged_by(PointerButton::Primary));
@@ -168,5 +243,38 @@ pub fn viewport_input(editor: &mut Editor, ui: &egui::Ui, response: &egui::Respo
     }
     if moved && let Some(open) = &editor.document {
         editor.camera.fit_depth_to(open.bounds);
+    }
+}
+
+/// The brush in paint mode: the left button paints (not with Alt, which navigates).
+fn paint_input(editor: &mut Editor, ui: &egui::Ui, response: &egui::Response, modifiers: Modifiers) {
+    let (pressed, down, latest) =
+        ui.input(|i| (i.pointer.primary_pressed(), i.pointer.primary_down(), i.pointer.latest_pos()));
+    let Some(session) = editor.paint.as_mut() else {
+        return;
+    };
+    if let Some(pos) = response.hover_pos() {
+        session.last_pointer = Some(pos);
+    }
+    if session.swallow_primary {
+        session.swallow_primary = down;
+        return;
+    }
+    if session.gesture.is_some() || editor.dialog.is_some() {
+        return;
+    }
+    let stroking = session.painter.is_stroking();
+    if !stroking && pressed && !modifiers.alt && response.hovered() {
+        if let Some(pos) = latest {
+            editor.begin_stroke(pos);
+        }
+    } else if stroking && let Some(pos) = latest {
+        editor.stroke_to(pos);
+    }
+    if !down {
+        editor.end_stroke();
+    }
+    if editor.paint.as_ref().is_some_and(|p| p.painter.is_stroking()) {
+        ui.ctx().request_repaint();
     }
 }

@@ -160,9 +160,7 @@ impl<T: Send + 'static> Jobs<T> {
     pub fn wait(&mut self, timeout: Duration) -> Option<(String, Finished<T>)> {
         let deadline = Instant::now() + timeout;
         loop {
-            if self.running.is_none() {
-                return None;
-            }
+            self.running.as_ref()?;
             if let Some(finished) = self.poll() {
                 return Some(finished);
             }

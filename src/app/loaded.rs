@@ -1,5 +1,5 @@
 //! The open document as the editor holds it: the [`Document`] (its editable
-//! [`meshpaint::store::ColorStore`]) side by side with its [`GpuMesh`] and picking BVH, and
+//! [`crate::store::ColorStore`]) side by side with its [`GpuMesh`] and picking BVH, and
 //! the work that makes one (open a file, the built-in scene) or writes one (save, export).
 //!
 //! Everything here runs on a job's worker thread ([`super::jobs`]); the GPU upload too

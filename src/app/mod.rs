@@ -12,12 +12,22 @@
 //! | [`loaded`] | the open document (store and GPU mesh side by side); open, save, export work |
 //! | [`jobs`] | one background job at a time with progress; panics become messages |
 //! | [`file_dialog`] | an egui file browser (works under Xvfb, keyboard-drivable) |
+//! | [`paint`] | paint mode: brush strokes, live GPU upload, undo / redo, tool panel |
+//! | [`autosave_ui`] | periodic autosave and the recovery offer |
+//!
+//! Paint mode is [`Mode::Paint`] (Tab, [`input::SHORTCUTS`]): its tools get the pointer in
+//! [`input::viewport_input`], edit the store through `Arc::make_mut` on
+//! [`loaded::OpenDocument::document`] (jobs hold their own snapshot), upload dirty samples
+//! with `GpuMesh::write_samples` on the document's `gpu_mesh`, bump
+//! [`Editor::scene_generation`] so the view redraws, and repack when the mode is left.
 
+pub mod autosave_ui;
 pub mod editor;
 pub mod file_dialog;
 pub mod input;
 pub mod jobs;
 pub mod loaded;
+pub mod paint;
 pub mod panels;
 pub mod window;
 

@@ -15,7 +15,9 @@ impl Editor {
     /// One frame of the editor's UI inside `ui` (the window's root). Afterwards
     /// [`Editor::viewport`] holds the 3D view's area, which the window shell renders.
     pub fn ui(&mut self, ui: &mut egui::Ui) {
+        self.upload_bytes_last_frame = std::mem::take(&mut self.upload_bytes_this_frame);
         self.poll_jobs();
+        self.autosave_tick();
         let ctx = ui.ctx().clone();
         input::global_input(self, &ctx);
         egui::Panel::top("menu bar").show(ui, |ui| self.menu_bar_ui(ui));
@@ -29,6 +31,7 @@ impl Editor {
             self.help_window_ui(&ctx);
         }
         self.dialog_ui(&ctx);
+        self.recovery_dialog_ui(&ctx);
         if self.jobs.is_busy() {
             // Animate the progress bar; a finished job wakes the UI by itself.
             ctx.request_repaint_after(std::time::Duration::from_millis(100));
@@ -86,6 +89,7 @@ impl Editor {
     /// The side panel: file, view and scene sections.
     pub fn side_panel_ui(&mut self, ui: &mut egui::Ui) {
         egui::ScrollArea::vertical().show(ui, |ui| {
+            egui::CollapsingHeader::new("Paint").default_open(true).show(ui, |ui| self.paint_panel_ui(ui));
             egui::CollapsingHeader::new("File").default_open(true).show(ui, |ui| self.file_panel_ui(ui));
             egui::CollapsingHeader::new("View").default_open(true).show(ui, |ui| self.view_panel_ui(ui));
             egui::CollapsingHeader::new("Scene").default_open(true).show(ui, |ui| self.scene_panel_ui(ui));
@@ -139,6 +143,7 @@ impl Editor {
                 .labelled_by(label.id)
                 .on_hover_text("Uniform face resolution given to .glb / .gltf files opened next");
         });
+        self.autosave_settings_ui(ui);
     }
 
     /// Filter, shading, overlays and camera.
@@ -167,6 +172,9 @@ impl Editor {
             });
             response.response.labelled_by(label.id);
         });
+        if self.gpu_paint_layout {
+            ui.label(egui::RichText::new("Paint mode shows level 0 (nearest or linear)").weak());
+        }
         if let FilterMode::MipLevel(level) | FilterMode::NearestMipLevel(level) = &mut self.view.filter {
             ui.add(egui::Slider::new(level, 0..=max_level.max(1)).text("MIP level"));
         }
@@ -220,6 +228,7 @@ impl Editor {
                 None => row(ui, "Document", "none".into()),
             }
             row(ui, "GPU memory", human_bytes(gpu_bytes));
+            row(ui, "Uploaded last frame", human_bytes(self.upload_bytes_last_frame));
             let fps = if self.frame_stats.fps > 0.0 { format!("{:.1}", self.frame_stats.fps) } else { "–".into() };
             row(ui, "fps", fps);
             row(ui, "Frame time", format!("{:.1} ms", self.frame_stats.frame_ms));
@@ -234,7 +243,12 @@ impl Editor {
     /// The status line: mode, last message, and a running job's progress.
     pub fn status_line_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
-            ui.label(egui::RichText::new(self.mode.name()).strong());
+            let mode = egui::RichText::new(format!("{} mode", self.mode.name())).strong();
+            let mode = match self.mode {
+                super::editor::Mode::Paint => mode.color(egui::Color32::from_rgb(255, 170, 60)),
+                super::editor::Mode::View => mode,
+            };
+            ui.label(mode).on_hover_text("Tab toggles paint mode");
             ui.separator();
             if let Some((label, fraction, stage, elapsed)) = self.jobs.status() {
                 ui.add(egui::ProgressBar::new(fraction).desired_width(220.0).show_percentage().animate(true));
@@ -277,10 +291,11 @@ impl Editor {
                     }
                 });
                 ui.separator();
-                egui::Grid::new("key help").num_columns(2).spacing([16.0, 4.0]).striped(true).show(ui, |ui| {
+                egui::Grid::new("key help").num_columns(3).spacing([16.0, 4.0]).striped(true).show(ui, |ui| {
                     for shortcut in SHORTCUTS {
                         ui.label(egui::RichText::new(shortcut.keys).strong().monospace());
                         ui.label(shortcut.description);
+                        ui.label(egui::RichText::new(shortcut.scope.name()).weak());
                         ui.end_row();
                     }
                 });
@@ -320,14 +335,23 @@ impl Editor {
                 );
             }
         }
+        let hint = match self.mode {
+            super::editor::Mode::View => {
+                "Middle drag: orbit · Shift: pan · Wheel: zoom · Home: frame all · Tab: paint · F1: help"
+            }
+            super::editor::Mode::Paint => {
+                "PAINT · Left drag: paint · F / Shift+F: radius / strength · S: pick colour · Ctrl+Z: undo · Tab: leave"
+            }
+        };
         painter.text(
             rect.left_bottom() + egui::vec2(8.0, -6.0),
             egui::Align2::LEFT_BOTTOM,
-            "Middle drag: orbit · Shift: pan · Wheel: zoom · Home: frame all · F1: help",
+            hint,
             egui::FontId::proportional(12.0),
             egui::Color32::from_gray(150),
         );
         input::viewport_input(self, ui, &response);
+        self.brush_cursor_ui(&painter);
     }
 }
 

@@ -276,6 +276,29 @@ impl GpuMesh {
         Ok(())
     }
 
+    /// Overwrites face records `first_face..first_face + records.len()` (e.g. faces whose
+    /// paint-layout blocks moved). Refuses writes past the face count.
+    pub fn write_face_records(
+        &self,
+        ctx: &GpuContext,
+        first_face: u32,
+        records: &[FaceRecord],
+    ) -> Result<(), RenderError> {
+        if u64::from(first_face) + records.len() as u64 > u64::from(self.face_count) {
+            return Err(RenderError::InvalidMesh(format!(
+                "writing {} face records at face {first_face} overruns the {} faces",
+                records.len(),
+                self.face_count
+            )));
+        }
+        if records.is_empty() {
+            return Ok(());
+        }
+        let offset = u64::from(first_face) * std::mem::size_of::<FaceRecord>() as u64;
+        ctx.queue.write_buffer(&self.face_records, offset, bytemuck::cast_slice(records));
+        Ok(())
+    }
+
     /// GPU memory of the mesh's buffers and atlas, in bytes.
     pub fn gpu_bytes(&self) -> u64 {
         let atlas = u64::from(self.atlas.width) * u64::from(self.atlas.height) * self.format.bytes_per_sample() as u64;

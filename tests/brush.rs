@@ -1,0 +1,888 @@
+//! The brushes against independent truths: brute-force distance tests over every stored
+//! sample (world positions from `for_each_site`), closed-form falloff and blend values,
+//! analytic visibility (occlusion, backface culling), mirror symmetry on an x-symmetric mesh,
+//! gap-free fast strokes, blur against its neighbour mean, the resolution brush against a
+//! brute-force sphere/triangle test, fill, eyedropper, and repacking after painting.
+
+// Colour channels are indexed 0..4 in parallel arrays; an index reads clearest.
+#![allow(clippy::needless_range_loop)]
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+use meshpaint::brush::{
+    self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, ResolutionOp, Tool,
+};
+use meshpaint::camera::{BoundingSphere, OrbitCamera};
+use meshpaint::color::{ColorFormat, Rgba};
+use meshpaint::layout::Resolution;
+use meshpaint::packer;
+use meshpaint::picking::{BvhPreset, MeshBvh};
+use meshpaint::store::{ColorStore, SampleRef};
+use meshpaint::topology::Topology;
+use meshpaint::undo::UndoHistory;
+
+type Mesh = (Vec<[f32; 3]>, Vec<[u32; 3]>);
+
+const WIDTH: u32 = 1024;
+const HEIGHT: u32 = 768;
+const GREY: Rgba = [0.5, 0.5, 0.5, 1.0];
+const GREEN: Rgba = [0.1, 0.9, 0.2, 1.0];
+
+fn r(value: u64) -> Resolution {
+    Resolution::new(value).unwrap()
+}
+
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn unit(&mut self) -> f32 {
+        (self.next() >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn color(&mut self) -> Rgba {
+        [self.unit(), self.unit(), self.unit(), 1.0]
+    }
+}
+
+// ---------------------------------------------------------------- meshes
+
+/// An `n × n` grid of quads (two triangles each) in the plane `z`, over `[x0, x1] × [y0, y1]`,
+/// front (counter-clockwise) side towards +z.
+fn grid(n: u32, z: f32, [x0, x1]: [f32; 2], [y0, y1]: [f32; 2]) -> Mesh {
+    let mut positions = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+            positions.push([x0 + (x1 - x0) * u, y0 + (y1 - y0) * v, z]);
+        }
+    }
+    let id = |i: u32, j: u32| j * (n + 1) + i;
+    let mut triangles = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    (positions, triangles)
+}
+
+/// Two meshes in one (indices of the second shifted).
+fn join((mut positions, mut triangles): Mesh, (p2, t2): Mesh) -> Mesh {
+    let offset = positions.len() as u32;
+    positions.extend(p2);
+    triangles.extend(t2.into_iter().map(|t| t.map(|v| v + offset)));
+    (positions, triangles)
+}
+
+/// Icosahedron subdivided `levels` times, vertices on the unit sphere, outward winding.
+/// Symmetric under x → −x (vertices and faces), bit for bit.
+fn icosphere(levels: u32) -> Mesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut vertices: Vec<DVec3> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|p| DVec3::from_array(*p).normalize())
+    .collect();
+    let mut triangles: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut midpoints = HashMap::new();
+        let mut midpoint = |a: u32, b: u32, vertices: &mut Vec<DVec3>| {
+            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                vertices.push(((vertices[a as usize] + vertices[b as usize]) * 0.5).normalize());
+                vertices.len() as u32 - 1
+            })
+        };
+        let mut next = Vec::with_capacity(triangles.len() * 4);
+        for [a, b, c] in triangles {
+            let ab = midpoint(a, b, &mut vertices);
+            let bc = midpoint(b, c, &mut vertices);
+            let ca = midpoint(c, a, &mut vertices);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        triangles = next;
+    }
+    (vertices.iter().map(|v| v.as_vec3().to_array()).collect(), triangles)
+}
+
+// ---------------------------------------------------------------- helpers
+
+fn dvec(p: [f32; 3]) -> DVec3 {
+    DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
+}
+
+/// A mesh ready to paint: store, BVH and camera.
+struct Scene {
+    positions: Vec<[f32; 3]>,
+    store: ColorStore,
+    bvh: MeshBvh,
+    camera: OrbitCamera,
+}
+
+impl Scene {
+    fn new((positions, triangles): Mesh, resolution: u64, color: Rgba, yaw: f64, pitch: f64) -> Self {
+        let topology = Topology::build(positions.len() as u32, &triangles).unwrap();
+        let store = ColorStore::uniform(topology, r(resolution), color);
+        let bvh = MeshBvh::build(&positions, &triangles, BvhPreset::FastBuild);
+        let camera = OrbitCamera::framing(BoundingSphere::of_points(&positions), yaw, pitch);
+        Scene { positions, store, bvh, camera }
+    }
+
+    fn view<'a>(&'a self, base: Option<&'a ColorStore>) -> PaintView<'a> {
+        PaintView {
+            positions: &self.positions,
+            bvh: &self.bvh,
+            camera: &self.camera,
+            viewport_px: [WIDTH, HEIGHT],
+            base,
+        }
+    }
+
+    /// Every stored sample with its world position (brute force, from `for_each_site`).
+    fn sites(&self) -> Vec<(SampleRef, DVec3, u32)> {
+        let mut out = Vec::new();
+        let faces = &self.store.topology().face_vertices;
+        self.store.for_each_site(|site| {
+            let corners = faces[site.face as usize];
+            let p = (0..3).map(|k| dvec(self.positions[corners[k] as usize]) * f64::from(site.barycentric[k])).sum();
+            out.push((site.sample, p, site.face));
+        });
+        out
+    }
+
+    /// Replays a stroke with `settings` (one undo step) and returns its dabs.
+    fn stroke(&mut self, settings: BrushSettings, points: &[[f64; 2]]) -> Vec<brush::Dab> {
+        let mut painter = Painter::new(&self.positions);
+        painter.set_settings(settings);
+        let mut history = UndoHistory::default();
+        let mut store = self.store.clone();
+        let view = self.view(None);
+        let (update, _) = brush::replay_stroke(&mut painter, &view, &mut store, &mut history, points).unwrap();
+        self.store = store;
+        update.dabs
+    }
+}
+
+fn plain(tool: Tool, color: Rgba, radius: BrushRadius) -> BrushSettings {
+    BrushSettings {
+        tool,
+        color,
+        blend: BlendMode::Mix,
+        radius,
+        strength: 1.0,
+        falloff: Falloff::Constant,
+        spacing_percent: 10.0,
+        occlusion: false,
+        backface_culling: false,
+        mirror_x: false,
+    }
+}
+
+fn bits(color: Rgba) -> [u32; 4] {
+    color.map(f32::to_bits)
+}
+
+/// The outward unit normal of a face.
+fn face_normal(positions: &[[f32; 3]], corners: [u32; 3]) -> DVec3 {
+    let [a, b, c] = corners.map(|v| dvec(positions[v as usize]));
+    (b - a).cross(c - a).normalize()
+}
+
+// ---------------------------------------------------------------- footprint
+
+#[test]
+fn a_stroke_changes_exactly_the_samples_inside_its_dabs() {
+    let mut scene = Scene::new(icosphere(3), 16, GREY, 30.0, 20.0);
+    let before = scene.store.clone();
+    let settings = plain(Tool::Paint, GREEN, BrushRadius::Pixels { radius_px: 40.0 });
+    let dabs = scene.stroke(settings, &[[400.0, 300.0], [560.0, 420.0], [640.0, 380.0]]);
+    assert!(dabs.len() > 20, "{} dabs", dabs.len());
+    let (mut inside, mut outside, mut band) = (0, 0, 0);
+    for (sample, p, _) in scene.sites() {
+        // Signed distance to the union of the dab spheres, relative to the radius.
+        let margin = dabs
+            .iter()
+            .map(|dab| ((p - DVec3::from_array(dab.center_world)).length() - dab.radius_world) / dab.radius_world)
+            .fold(f64::INFINITY, f64::min);
+        let now = scene.store.get(sample).unwrap();
+        if margin.abs() < 1e-6 {
+            band += 1;
+            continue;
+        }
+        if margin < 0.0 {
+            inside += 1;
+            assert_eq!(bits(now), bits(GREEN), "{sample:?} at {p} is inside (margin {margin}) but not painted");
+        } else {
+            outside += 1;
+            assert_eq!(bits(now), bits(before.get(sample).unwrap()), "{sample:?} at {p} is outside but changed");
+        }
+    }
+    assert!(inside > 1000 && outside > 1000, "inside {inside}, outside {outside}, band {band}");
+    assert!(band < 10, "{band} samples on the rim");
+    // The dab radius is the pixel radius at the hit depth.
+    for dab in &dabs {
+        let center = DVec3::from_array(dab.center_world);
+        let (x, y) = scene.camera.project(center, WIDTH, HEIGHT).unwrap();
+        assert!((x - dab.cursor_px[0]).abs() < 1e-6 && (y - dab.cursor_px[1]).abs() < 1e-6);
+        let (right, _) = scene.camera.right_up();
+        let (x2, _) = scene.camera.project(center + right * dab.radius_world, WIDTH, HEIGHT).unwrap();
+        // One screen-parallel radius at the hit projects to 40 px (perspective: to first order).
+        assert!(((x2 - x).abs() - 40.0).abs() < 0.5, "{} px", (x2 - x).abs());
+        assert!(scene.bvh.faces_in_sphere(center, 1e-9).contains(&dab.face));
+    }
+}
+
+#[test]
+fn each_shared_sample_is_updated_once_per_dab() {
+    // Add with constant weight 1: a sample updated twice would get the colour twice.
+    let scene = Scene::new(icosphere(2), 4, [0.0, 0.0, 0.0, 1.0], 0.0, 0.0);
+    let mut store = scene.store.clone();
+    let mut painter = Painter::new(&scene.positions);
+    let add = [0.25, 0.125, 0.0625, 0.0];
+    painter.set_settings(BrushSettings { blend: BlendMode::Add, ..plain(Tool::Paint, add, BrushRadius::default()) });
+    let mut history = UndoHistory::default();
+    let center = DVec3::from_array(scene.positions[0].map(f64::from));
+    let stats = painter.dab_at(&scene.view(None), &mut store, &mut history, center, 0.7).unwrap();
+    let mut covered = 0;
+    for (sample, p, _) in scene.sites() {
+        let now = store.get(sample).unwrap();
+        if (p - center).length() < 0.7 {
+            covered += 1;
+            assert_eq!(now, [0.25, 0.125, 0.0625, 1.0], "{sample:?}");
+        } else {
+            assert_eq!(now, [0.0, 0.0, 0.0, 1.0], "{sample:?}");
+        }
+    }
+    assert_eq!(stats.samples_covered, covered);
+    assert_eq!(stats.samples_changed, covered);
+}
+
+/// The falloff curves' closed forms, written independently of the library.
+fn closed_form(falloff: Falloff, x: f64) -> f64 {
+    let s = 1.0 - x;
+    match falloff {
+        Falloff::Smooth => 3.0 * s * s - 2.0 * s * s * s,
+        Falloff::Linear => s,
+        Falloff::Constant => 1.0,
+        Falloff::Sharp => s * s,
+    }
+}
+
+#[test]
+fn strength_falloff_and_blend_follow_the_closed_forms() {
+    let scene = Scene::new(grid(8, 0.0, [-1.0, 1.0], [-1.0, 1.0]), 16, GREY, 0.0, 0.0);
+    let center = DVec3::new(0.1, -0.05, 0.0);
+    let radius = 0.6;
+    let strength = 0.7f32;
+    let mut base = scene.store.clone();
+    base.fill_with(|site| [0.2 + 0.1 * site.barycentric[0], 0.3, 0.4, 1.0]);
+    let color: Rgba = [0.9, 0.5, 0.25, 0.5];
+    for falloff in Falloff::ALL {
+        for blend in BlendMode::ALL {
+            let mut store = scene.store.clone();
+            let mut painter = Painter::new(&scene.positions);
+            painter.set_settings(BrushSettings {
+                falloff,
+                blend,
+                strength,
+                ..plain(Tool::Paint, color, BrushRadius::World { radius_world: radius })
+            });
+            let mut history = UndoHistory::default();
+            painter.dab_at(&scene.view(Some(&base)), &mut store, &mut history, center, radius).unwrap();
+            let mut checked = 0;
+            for (sample, p, _) in scene.sites() {
+                let x = (p - center).length() / radius;
+                let old = GREY;
+                let now = store.get(sample).unwrap();
+                if x >= 1.0 - 1e-9 {
+                    assert_eq!(now, old, "{falloff:?} {blend:?} {sample:?} outside");
+                    continue;
+                }
+                let w = f64::from(strength) * closed_form(falloff, x);
+                let b = base.get(sample).unwrap();
+                let target: [f64; 4] = std::array::from_fn(|c| {
+                    let (o, k) = (f64::from(old[c]), f64::from(color[c]));
+                    match blend {
+                        BlendMode::Mix => k,
+                        BlendMode::Add if c < 3 => o + k,
+                        BlendMode::Multiply if c < 3 => o * k,
+                        BlendMode::Add | BlendMode::Multiply => o,
+                        BlendMode::EraseToBase => f64::from(b[c]),
+                    }
+                });
+                for c in 0..4 {
+                    let expected = f64::from(old[c]) * (1.0 - w) + target[c] * w;
+                    assert!(
+                        (f64::from(now[c]) - expected).abs() < 2e-6,
+                        "{falloff:?} {blend:?} {sample:?} x={x}: channel {c} is {} expected {expected}",
+                        now[c]
+                    );
+                }
+                checked += 1;
+            }
+            assert!(checked > 500, "{checked}");
+        }
+    }
+}
+
+#[test]
+fn erase_to_base_restores_the_snapshot_even_after_a_resolution_change() {
+    let mut scene = Scene::new(icosphere(2), 4, GREY, 0.0, 0.0);
+    let mut rng = Rng(7);
+    scene.store.fill_with(|_| rng.color());
+    let base = scene.store.clone();
+    let mut store = scene.store.clone();
+    let mut history = UndoHistory::default();
+    let mut painter = Painter::new(&scene.positions);
+    let view = scene.view(Some(&base));
+    let center = DVec3::from_array(scene.positions[5].map(f64::from));
+    painter.set_settings(plain(Tool::Paint, GREEN, BrushRadius::default()));
+    painter.dab_at(&view, &mut store, &mut history, center, 0.8).unwrap();
+    // Erase everything painted with weight 1: back to the base bit for bit.
+    painter.set_settings(BrushSettings {
+        blend: BlendMode::EraseToBase,
+        ..plain(Tool::Paint, GREEN, BrushRadius::default())
+    });
+    painter.dab_at(&view, &mut store, &mut history, center, 0.8).unwrap();
+    let mut all = Vec::new();
+    store.for_each_site(|site| all.push(site.sample));
+    for sample in &all {
+        assert_eq!(bits(store.get(*sample).unwrap()), bits(base.get(*sample).unwrap()), "{sample:?}");
+    }
+    // A face raised after the snapshot: erase samples the base linearly there.
+    let face = 3;
+    store.set_face_resolution(face, r(8)).unwrap();
+    painter.dab_at(&view, &mut store, &mut history, center, 5.0).unwrap();
+    let corners = store.topology().face_vertices[face as usize];
+    for i in 0..=8u32 {
+        for j in 0..=8 - i {
+            let bary = [(8 - i - j) as f32 / 8.0, i as f32 / 8.0, j as f32 / 8.0];
+            let expected =
+                meshpaint::sampler::sample(&base, face, bary, meshpaint::sampler::Filter::Linear, 0).unwrap();
+            let now = store.face_sample(face, i, j).unwrap();
+            for c in 0..4 {
+                assert!((now[c] - expected[c]).abs() < 1e-6, "({i},{j}) of face {face} corners {corners:?}");
+            }
+        }
+    }
+    // Without a base, erase is refused.
+    let no_base = scene.view(None);
+    assert!(matches!(
+        painter.begin_stroke(&no_base, &mut store, &mut history, [512.0, 384.0]),
+        Err(brush::BrushError::NoBase)
+    ));
+}
+
+// ---------------------------------------------------------------- visibility
+
+/// Two parallel grids facing the eye (+z): a back plate at z = −0.3 and a front plate at
+/// z = +0.3 covering only x < 0. A dab reaching under the front plate must not paint the
+/// part of the back plate it hides when occlusion is on.
+#[test]
+fn occlusion_leaves_hidden_samples_untouched() {
+    let back = grid(24, -0.3, [-1.0, 1.0], [-1.0, 1.0]);
+    let front = grid(12, 0.3, [-1.0, 0.0], [-1.0, 1.0]);
+    let scene = Scene::new(join(back, front), 8, GREY, 0.0, 0.0);
+    let eye = scene.camera.eye();
+    let center = DVec3::new(0.25, 0.0, -0.3);
+    let radius = 0.7;
+    let back_vertices = 25 * 25;
+    for (occlusion, culling) in [(true, false), (false, true), (false, false), (true, true)] {
+        let mut store = scene.store.clone();
+        let mut painter = Painter::new(&scene.positions);
+        painter.set_settings(BrushSettings {
+            occlusion,
+            backface_culling: culling,
+            ..plain(Tool::Paint, GREEN, BrushRadius::World { radius_world: radius })
+        });
+        let mut history = UndoHistory::default();
+        painter.dab_at(&scene.view(None), &mut store, &mut history, center, radius).unwrap();
+        let (mut hidden, mut visible) = (0, 0);
+        for (sample, p, face) in scene.sites() {
+            let d = (p - center).length();
+            if (d - radius).abs() < 1e-9 {
+                continue;
+            }
+            let on_back = scene.store.topology().face_vertices[face as usize][0] < back_vertices;
+            // Analytic visibility: where the eye→sample segment crosses z = 0.3.
+            let t = (0.3 - eye.z) / (p.z - eye.z);
+            let crossing = eye + (p - eye) * t;
+            let blocked = on_back && crossing.x < 0.0 && crossing.y.abs() < 1.0;
+            if on_back && d < radius && (crossing.x.abs() < 1e-6 || (crossing.y.abs() - 1.0).abs() < 1e-6) {
+                continue;
+            }
+            let painted = store.get(sample).unwrap() != GREY;
+            let expected = d < radius && !(occlusion && blocked);
+            assert_eq!(painted, expected, "occlusion {occlusion} culling {culling}: {sample:?} at {p}");
+            if d < radius && blocked {
+                hidden += 1;
+            } else if d < radius {
+                visible += 1;
+            }
+        }
+        assert!(hidden > 100 && visible > 100, "{hidden} hidden, {visible} visible");
+    }
+}
+
+/// On a closed convex mesh, a dab larger than the mesh: with occlusion or backface culling
+/// only the side facing the eye is painted.
+#[test]
+fn occlusion_and_culling_keep_the_far_side_of_a_closed_mesh_unpainted() {
+    let scene = Scene::new(icosphere(3), 4, GREY, 30.0, 20.0);
+    let eye = scene.camera.eye();
+    let center = DVec3::from_array(scene.camera.target) + scene.camera.eye_direction();
+    for (occlusion, culling) in [(true, false), (false, true)] {
+        let mut store = scene.store.clone();
+        let mut painter = Painter::new(&scene.positions);
+        painter.set_settings(BrushSettings {
+            occlusion,
+            backface_culling: culling,
+            ..plain(Tool::Paint, GREEN, BrushRadius::World { radius_world: 2.5 })
+        });
+        let mut history = UndoHistory::default();
+        painter.dab_at(&scene.view(None), &mut store, &mut history, center, 2.5).unwrap();
+        let (mut front, mut back) = (0, 0);
+        for (sample, p, face) in scene.sites() {
+            // Facing: the face normal against the direction to the eye (every face of a
+            // sample agrees away from the silhouette).
+            let normal = face_normal(&scene.positions, scene.store.topology().face_vertices[face as usize]);
+            let facing = normal.dot((eye - p).normalize());
+            let painted = store.get(sample).unwrap() != GREY;
+            if facing > 0.15 {
+                assert!(painted, "occlusion {occlusion} culling {culling}: visible {sample:?} unpainted");
+                front += 1;
+            } else if facing < -0.15 {
+                assert!(!painted, "occlusion {occlusion} culling {culling}: hidden {sample:?} painted");
+                back += 1;
+            }
+        }
+        assert!(front > 1000 && back > 1000, "{front} {back}");
+    }
+}
+
+// ---------------------------------------------------------------- mirror
+
+#[test]
+fn mirror_paints_the_mirrored_samples() {
+    // yaw 90: the eye is on +x; the mirrored dab on −x is seen from the mirrored eye.
+    for (occlusion, culling) in [(false, false), (true, true)] {
+        let mut scene = Scene::new(icosphere(3), 8, GREY, 90.0, 10.0);
+        let painter = Painter::new(&scene.positions);
+        assert_eq!(painter.mirror_plane_x(), 0.0);
+        let settings = BrushSettings {
+            mirror_x: true,
+            occlusion,
+            backface_culling: culling,
+            falloff: Falloff::Smooth,
+            strength: 0.8,
+            ..plain(Tool::Paint, GREEN, BrushRadius::Pixels { radius_px: 60.0 })
+        };
+        let dabs = scene.stroke(settings, &[[470.0, 340.0], [560.0, 420.0]]);
+        assert!(!dabs.is_empty());
+        let key = |p: DVec3| (p * 1e5).round().as_i64vec3().to_array();
+        let sites = scene.sites();
+        let by_position: HashMap<[i64; 3], Rgba> =
+            sites.iter().map(|&(sample, p, _)| (key(p), scene.store.get(sample).unwrap())).collect();
+        let eye = scene.camera.eye();
+        let (mut painted, mut mirrored_side) = (0, 0);
+        for &(sample, p, face) in &sites {
+            let now = scene.store.get(sample).unwrap();
+            let mirror = DVec3::new(-p.x, p.y, p.z);
+            let other = by_position[&key(mirror)];
+            // Skip the rims: distance to a sphere ≈ radius, or facing ≈ 0 (either eye).
+            let near_rim = dabs.iter().any(|dab| {
+                let c = DVec3::from_array(dab.center_world);
+                let d = (p - c).length().min((mirror - DVec3::new(-c.x, c.y, c.z)).length());
+                (d - dab.radius_world).abs() < 1e-3 * dab.radius_world
+                    || ((p - DVec3::new(-c.x, c.y, c.z)).length() - dab.radius_world).abs() < 1e-3 * dab.radius_world
+            });
+            let normal = face_normal(&scene.positions, scene.store.topology().face_vertices[face as usize]);
+            let mirrored_eye = DVec3::new(-eye.x, eye.y, eye.z);
+            let grazing =
+                normal.dot((eye - p).normalize()).abs() < 0.1 || normal.dot((mirrored_eye - p).normalize()).abs() < 0.1;
+            if near_rim || ((occlusion || culling) && grazing) {
+                continue;
+            }
+            for c in 0..4 {
+                assert!((now[c] - other[c]).abs() < 1e-5, "{sample:?} at {p}: {now:?} vs mirror {other:?}");
+            }
+            if now != GREY {
+                painted += 1;
+                if p.x < -0.1 {
+                    mirrored_side += 1;
+                }
+            }
+        }
+        assert!(painted > 500 && mirrored_side > 200, "{painted} painted, {mirrored_side} on the mirrored side");
+    }
+}
+
+// ---------------------------------------------------------------- strokes
+
+/// Distance from `p` to the segment `a..b`.
+fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+    (p - (a + ab * t)).length()
+}
+
+#[test]
+fn fast_strokes_leave_no_gaps() {
+    // A plane facing the eye; two cursor events 424 px apart with a 10 px brush.
+    for radius in [BrushRadius::Pixels { radius_px: 10.0 }, BrushRadius::World { radius_world: 0.03 }] {
+        let mut scene = Scene::new(grid(32, 0.0, [-1.0, 1.0], [-1.0, 1.0]), 8, GREY, 0.0, 0.0);
+        let settings =
+            BrushSettings { spacing_percent: 25.0, falloff: Falloff::Smooth, ..plain(Tool::Paint, GREEN, radius) };
+        let dabs = scene.stroke(settings, &[[300.0, 384.0], [724.0, 390.0]]);
+        let radius_world = dabs[0].radius_world;
+        let radius_px = radius_world / (scene.camera.world_per_pixel(f64::from(HEIGHT)));
+        let length_px = 424f64.hypot(6.0);
+        assert!(
+            dabs.len() as f64 >= length_px / (0.25 * radius_px),
+            "{} dabs for {length_px} px at spacing {} px",
+            dabs.len(),
+            0.25 * radius_px
+        );
+        for pair in dabs.windows(2) {
+            let step = (pair[1].cursor_px[0] - pair[0].cursor_px[0]).hypot(pair[1].cursor_px[1] - pair[0].cursor_px[1]);
+            assert!(step <= 0.25 * radius_px * 1.001, "{step} px between dabs");
+        }
+        let a = DVec3::from_array(dabs[0].center_world);
+        let b = DVec3::from_array(dabs[dabs.len() - 1].center_world);
+        let mut band = 0;
+        for (sample, p, _) in scene.sites() {
+            let d = segment_distance(p, a, b);
+            let painted = scene.store.get(sample).unwrap() != GREY;
+            if d <= 0.9 * radius_world {
+                assert!(painted, "{sample:?} at {p}, {d} from the stroke (radius {radius_world}), has no paint");
+                band += 1;
+            } else if d > radius_world * (1.0 + 1e-6) {
+                assert!(!painted, "{sample:?} at {p}, {d} from the stroke, was painted");
+            }
+        }
+        assert!(band > 1000, "{band}");
+    }
+}
+
+#[test]
+fn a_stroke_is_one_undo_step_and_misses_place_no_dabs() {
+    let scene = Scene::new(icosphere(2), 4, GREY, 0.0, 0.0);
+    let mut store = scene.store.clone();
+    let mut history = UndoHistory::default();
+    let mut painter = Painter::new(&scene.positions);
+    painter.set_settings(plain(Tool::Paint, GREEN, BrushRadius::Pixels { radius_px: 20.0 }));
+    let view = scene.view(None);
+    // Starts off the mesh (corner of the view), crosses it, ends off it.
+    let first = painter.begin_stroke(&view, &mut store, &mut history, [5.0, 5.0]).unwrap();
+    assert!(first.dabs.is_empty());
+    let mut dabs = 0;
+    for point in [[512.0, 384.0], [1000.0, 760.0]] {
+        dabs += painter.stroke_to(&view, &mut store, &mut history, point).unwrap().dabs.len();
+    }
+    assert!(dabs > 10);
+    assert!(painter.is_stroking() && history.is_recording());
+    let summary = painter.end_stroke(&mut history).unwrap();
+    assert!(summary.kept && summary.samples > 0);
+    assert_eq!(history.undo_len(), 1);
+    assert_eq!(history.undo_label(), Some("paint stroke"));
+    // Every dirty sample was recorded, and the dirty elements are exactly the changed ones.
+    let dirty = store.take_dirty();
+    assert!(!dirty.is_empty());
+    history.undo(&mut store).unwrap();
+    let mut all = Vec::new();
+    store.for_each_site(|site| all.push(site.sample));
+    assert!(all.iter().all(|&s| store.get(s) == Some(GREY)));
+}
+
+// ---------------------------------------------------------------- blur
+
+#[test]
+fn blur_moves_samples_towards_their_neighbour_mean() {
+    let mut scene = Scene::new(grid(4, 0.0, [-1.0, 1.0], [-1.0, 1.0]), 16, GREY, 0.0, 0.0);
+    let mut rng = Rng(3);
+    scene.store.fill_with(|_| rng.color());
+    let before = scene.store.clone();
+    let mut store = scene.store.clone();
+    let mut painter = Painter::new(&scene.positions);
+    let strength = 0.6;
+    painter.set_settings(BrushSettings {
+        strength,
+        falloff: Falloff::Linear,
+        ..plain(Tool::Blur, GREEN, BrushRadius::World { radius_world: 0.6 })
+    });
+    let center = DVec3::new(0.05, 0.1, 0.0);
+    let mut history = UndoHistory::default();
+    painter.dab_at(&scene.view(None), &mut store, &mut history, center, 0.6).unwrap();
+    // Interior samples: their six neighbours are all in their face.
+    let mut checked = 0;
+    for (sample, p, face) in scene.sites() {
+        let d = (p - center).length();
+        let now = store.get(sample).unwrap();
+        let old = before.get(sample).unwrap();
+        if d >= 0.6 {
+            assert_eq!(now, old, "{sample:?} outside changed");
+            continue;
+        }
+        let SampleRef::Interior { offset, .. } = sample else {
+            continue;
+        };
+        let (i, j) = meshpaint::layout::interior_sample_at(r(16), offset).unwrap();
+        let neighbours = [(i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1), (i + 1, j - 1), (i - 1, j + 1)];
+        let w = f64::from(strength) * (1.0 - d / 0.6);
+        for c in 0..4 {
+            let mean: f64 =
+                neighbours.iter().map(|&(a, b)| f64::from(before.face_sample(face, a, b).unwrap()[c])).sum::<f64>()
+                    / 6.0;
+            let expected = f64::from(old[c]) * (1.0 - w) + mean * w;
+            assert!((f64::from(now[c]) - expected).abs() < 1e-5, "{sample:?} channel {c}");
+        }
+        checked += 1;
+    }
+    assert!(checked > 300, "{checked}");
+    // A constant colour stays (nearly bit-) constant under blur.
+    let mut flat = scene.store.clone();
+    flat.fill_with(|_| [0.25, 0.5, 0.75, 1.0]);
+    painter.dab_at(&scene.view(None), &mut flat, &mut history, center, 0.6).unwrap();
+    flat.for_each_site(|site| {
+        let color = flat.get(site.sample).unwrap();
+        assert!((color[0] - 0.25).abs() < 1e-6 && (color[2] - 0.75).abs() < 1e-6);
+    });
+}
+
+// ---------------------------------------------------------------- resolution brush
+
+/// Whether triangle `t` has a point within `radius` of `c`: dense barycentric sampling plus
+/// the corners and edge points (a brute force independent of the library's closest point).
+fn triangle_within(t: [DVec3; 3], c: DVec3, radius: f64) -> Option<bool> {
+    let n = 200;
+    let mut min = f64::INFINITY;
+    for i in 0..=n {
+        for j in 0..=n - i {
+            let (u, v) = (f64::from(i) / f64::from(n), f64::from(j) / f64::from(n));
+            let p = t[0] * (1.0 - u - v) + t[1] * u + t[2] * v;
+            min = min.min((p - c).length());
+        }
+    }
+    // Undecided within the sampling error (the grid spacing bounds it).
+    let spacing = (t[1] - t[0]).length().max((t[2] - t[0]).length()) / f64::from(n);
+    if (min - radius).abs() < spacing {
+        return None;
+    }
+    Some(min < radius)
+}
+
+#[test]
+fn the_resolution_brush_changes_the_faces_the_sphere_touches_once_per_stroke() {
+    let mut scene = Scene::new(icosphere(2), 4, GREY, 30.0, 20.0);
+    let before = scene.store.clone();
+    let settings = BrushSettings {
+        spacing_percent: 2.0,
+        ..plain(Tool::Resolution(ResolutionOp::Raise), GREEN, BrushRadius::World { radius_world: 0.35 })
+    };
+    // Many overlapping dabs: each face is raised once.
+    let dabs = scene.stroke(settings, &[[512.0, 384.0], [530.0, 384.0], [512.0, 400.0], [540.0, 370.0]]);
+    assert!(dabs.len() >= 20, "{} dabs", dabs.len());
+    let topology = scene.store.topology();
+    let mut raised = 0;
+    for face in 0..topology.face_count() {
+        let corners = topology.face_vertices[face as usize].map(|v| dvec(scene.positions[v as usize]));
+        let touched: Vec<Option<bool>> = dabs
+            .iter()
+            .map(|dab| triangle_within(corners, DVec3::from_array(dab.center_world), dab.radius_world))
+            .collect();
+        let now = scene.store.face_resolution(face).unwrap();
+        if touched.contains(&Some(true)) {
+            assert_eq!(now, r(8), "face {face} touched but not raised once");
+            raised += 1;
+        } else if touched.iter().all(|t| *t == Some(false)) {
+            assert_eq!(now, r(4), "face {face} untouched but changed");
+        }
+    }
+    assert!(raised > 5, "{raised}");
+    // Lower and set work the same way, and samples follow the store's resampling.
+    let mut store = before.clone();
+    let mut history = UndoHistory::default();
+    let mut painter = Painter::new(&scene.positions);
+    painter.set_settings(plain(Tool::Resolution(ResolutionOp::Set(r(1))), GREEN, BrushRadius::default()));
+    let center = DVec3::from_array(scene.positions[0].map(f64::from));
+    let stats = painter.dab_at(&scene.view(None), &mut store, &mut history, center, 0.2).unwrap();
+    assert!(stats.faces_resized > 0);
+    let mut expected = before.clone();
+    for face in scene.bvh.faces_in_sphere(center, 0.2) {
+        expected.set_face_resolution(face, r(1)).unwrap();
+    }
+    assert_eq!(store.face_resolutions(), expected.face_resolutions());
+    let mut all = Vec::new();
+    expected.for_each_site(|site| all.push(site.sample));
+    for s in all {
+        assert_eq!(store.get(s), expected.get(s));
+    }
+}
+
+#[test]
+fn set_resolution_for_all_or_a_selection() {
+    let scene = Scene::new(icosphere(1), 4, GREY, 0.0, 0.0);
+    let mut store = scene.store.clone();
+    let mut history = UndoHistory::default();
+    assert_eq!(brush::set_resolution(&mut store, &mut history, Some(&[1, 3, 5]), r(16)).unwrap(), 3);
+    assert_eq!(store.face_resolution(3), Some(r(16)));
+    assert_eq!(store.face_resolution(2), Some(r(4)));
+    assert_eq!(brush::set_resolution(&mut store, &mut history, None, r(2)).unwrap(), 80);
+    assert!(store.face_resolutions().iter().all(|&x| x == r(2)));
+    assert!(brush::set_resolution(&mut store, &mut history, Some(&[999]), r(2)).is_err());
+    assert_eq!(history.undo_len(), 2);
+}
+
+// ---------------------------------------------------------------- fill and eyedropper
+
+#[test]
+fn fill_covers_the_whole_mesh_or_the_connected_part() {
+    let two = join(grid(3, 0.0, [-1.0, -0.1], [-1.0, 1.0]), grid(3, 0.0, [0.1, 1.0], [-1.0, 1.0]));
+    let scene = Scene::new(two, 4, GREY, 0.0, 0.0);
+    let half = scene.store.topology().face_count() / 2;
+    assert_eq!(brush::connected_faces(&scene.store, 2), (0..half).collect::<Vec<_>>());
+    let mut store = scene.store.clone();
+    let mut history = UndoHistory::default();
+    let stats =
+        brush::fill(&mut store, &mut history, FillScope::Connected { face: 2 }, GREEN, BlendMode::Mix, 1.0, None)
+            .unwrap();
+    let mut left = 0;
+    for (sample, _, face) in scene.sites() {
+        let expected = if face < half { GREEN } else { GREY };
+        assert_eq!(store.get(sample), Some(expected), "{sample:?}");
+        left += u64::from(face < half);
+    }
+    assert_eq!(stats.samples_changed, left);
+    brush::fill(&mut store, &mut history, FillScope::All, GREEN, BlendMode::Mix, 1.0, None).unwrap();
+    for (sample, _, _) in scene.sites() {
+        assert_eq!(store.get(sample), Some(GREEN));
+    }
+    assert_eq!(history.undo_len(), 2);
+    assert!(
+        brush::fill(&mut store, &mut history, FillScope::Connected { face: 9999 }, GREEN, BlendMode::Mix, 1.0, None)
+            .is_err()
+    );
+}
+
+#[test]
+fn the_eyedropper_reads_the_linear_colour_under_the_cursor() {
+    let mut scene = Scene::new(grid(4, 0.0, [-1.0, 1.0], [-1.0, 1.0]), 8, GREY, 0.0, 0.0);
+    // A linear field in x is reproduced exactly by linear filtering (up to rounding).
+    let positions = scene.positions.clone();
+    let faces = scene.store.topology().face_vertices.clone();
+    scene.store.fill_with(|site| {
+        let c = faces[site.face as usize];
+        let x: f32 = (0..3).map(|k| positions[c[k] as usize][0] * site.barycentric[k]).sum();
+        [0.5 + 0.25 * x, 0.3, 0.2, 1.0]
+    });
+    let view = scene.view(None);
+    for cursor in [[512.0, 384.0], [420.0, 300.0], [600.0, 500.0]] {
+        let hit = view.pick(cursor).unwrap();
+        let color = brush::eyedropper(&view, &scene.store, cursor).unwrap();
+        let expected = 0.5 + 0.25 * hit.position_world[0] as f32;
+        assert!((color[0] - expected).abs() < 1e-5, "{color:?} vs {expected}");
+        assert!((color[1] - 0.3).abs() < 1e-6);
+    }
+    assert_eq!(brush::eyedropper(&view, &scene.store, [2.0, 2.0]), None);
+}
+
+// ---------------------------------------------------------------- repacking
+
+#[test]
+fn repacking_after_painting_matches_packing_the_same_colours_directly() {
+    let mut scene = Scene::new(icosphere(2), 8, GREY, 30.0, 20.0);
+    let mut rng = Rng(11);
+    scene.store.fill_with(|_| rng.color());
+    scene.stroke(
+        BrushSettings {
+            falloff: Falloff::Smooth,
+            strength: 0.6,
+            ..plain(Tool::Paint, GREEN, BrushRadius::Pixels { radius_px: 50.0 })
+        },
+        &[[450.0, 350.0], [600.0, 420.0]],
+    );
+    scene.stroke(
+        plain(Tool::Resolution(ResolutionOp::Raise), GREEN, BrushRadius::Pixels { radius_px: 30.0 }),
+        &[[520.0, 380.0]],
+    );
+    scene.stroke(plain(Tool::Blur, GREEN, BrushRadius::Pixels { radius_px: 40.0 }), &[[500.0, 390.0], [540.0, 360.0]]);
+    let painted = scene.store.clone();
+    assert!(painted.face_resolutions().iter().any(|&x| x == r(16)));
+    // The same colours written into a fresh store with the same resolutions.
+    let mut direct =
+        ColorStore::with_resolutions(painted.topology().clone(), painted.face_resolutions().to_vec(), [0.0; 4])
+            .unwrap();
+    let mut writes = Vec::new();
+    painted.for_each_site(|site| writes.push((site.sample, painted.get(site.sample).unwrap())));
+    for (sample, color) in writes {
+        assert!(direct.set(sample, color));
+    }
+    for format in ColorFormat::ALL {
+        let packed = packer::pack(&painted, &scene.positions, format).unwrap();
+        assert_eq!(packed, packer::pack(&direct, &scene.positions, format).unwrap(), "{format:?}");
+        // unpack(pack) repacks byte for byte.
+        let unpacked = packer::unpack(&packed).unwrap();
+        assert_eq!(packer::pack(&unpacked, &scene.positions, format).unwrap(), packed, "{format:?} round trip");
+    }
+}
+
+// ---------------------------------------------------------------- parsing
+
+#[test]
+fn strokes_and_colours_parse() {
+    assert_eq!(brush::parse_stroke("1,2  3.5,-4").unwrap(), vec![[1.0, 2.0], [3.5, -4.0]]);
+    assert!(brush::parse_stroke("").is_err());
+    assert!(brush::parse_stroke("1;2").is_err());
+    assert!(brush::parse_stroke("1,x").is_err());
+    assert_eq!(brush::parse_hex_color("#ffffff"), Some([1.0, 1.0, 1.0, 1.0]));
+    let c = brush::parse_hex_color("808080").unwrap();
+    assert!((c[0] - 0.21586).abs() < 1e-4, "{c:?}");
+    assert_eq!(brush::parse_hex_color("#12345"), None);
+    assert_eq!(brush::parse_hex_color("#gg0000"), None);
+    for falloff in Falloff::ALL {
+        assert_eq!(Falloff::from_name(falloff.name()), Some(falloff));
+        assert_eq!(falloff.weight(0.0), 1.0);
+        assert_eq!(falloff.weight(1.5), 0.0);
+        assert_eq!(falloff.weight(f32::NAN), 0.0);
+    }
+    let invalid = BrushSettings { strength: 1.5, ..BrushSettings::default() };
+    assert!(invalid.validate().is_err());
+}
