@@ -676,6 +676,12 @@ pub fn visible(bvh: &MeshBvh, eye: DVec3, point: DVec3) -> bool {
     bvh.cast(eye, to / distance, distance * (1.0 - OCCLUSION_TOLERANCE)).is_none()
 }
 
+/// Whether two colours differ in any bit (one 128-bit comparison).
+#[inline(always)]
+fn differs(a: Rgba, b: Rgba) -> bool {
+    bytemuck::cast::<Rgba, u128>(a) != bytemuck::cast::<Rgba, u128>(b)
+}
+
 fn position(positions: &[[f32; 3]], v: u32) -> DVec3 {
     positions.get(v as usize).map_or(DVec3::ZERO, |p| DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])))
 }
@@ -758,7 +764,7 @@ fn paint_interior<C: Coverage>(
                 _ => old,
             };
             let new = op.blend.blend(old, op.color, base, w);
-            if new.map(f32::to_bits) != old.map(f32::to_bits) {
+            if differs(new, old) {
                 log.record(offset, old);
                 store.set(SampleRef::Interior { face, offset }, new);
                 counts.changed += 1;
@@ -814,7 +820,7 @@ fn paint_edge<C: Coverage>(
             _ => old,
         };
         let new = op.blend.blend(old, op.color, base, w);
-        if new.map(f32::to_bits) != old.map(f32::to_bits) {
+        if differs(new, old) {
             log.record(offset, old);
             store.set(SampleRef::Edge { edge, offset }, new);
             counts.changed += 1;
@@ -867,7 +873,7 @@ fn paint_vertex<C: Coverage>(
         _ => old,
     };
     let new = op.blend.blend(old, op.color, base, w);
-    if new.map(f32::to_bits) != old.map(f32::to_bits) {
+    if differs(new, old) {
         history.vertex_log().record(v, old);
         store.set(SampleRef::Vertex(v), new);
         counts.changed = 1;
@@ -1067,7 +1073,7 @@ fn blur_faces<C: Coverage>(
         }
         let mean = merged.sum.map(|s| s / merged.count as f32);
         let new = BlendMode::Mix.blend(old, mean, old, merged.weight);
-        if history.set_sample(store, merged.sample, new) && new.map(f32::to_bits) != old.map(f32::to_bits) {
+        if history.set_sample(store, merged.sample, new) && differs(new, old) {
             stats.samples_changed += 1;
         }
     }

@@ -918,12 +918,8 @@ fn exported_glb_reopens_in_meshpaint_with_the_sample_colours_at_its_vertices() {
     std::fs::remove_file(&path).ok();
     // The exporter writes one vertex per sample; welding keeps them apart (distinct positions).
     assert_eq!(reopened.positions.len(), tessellation.positions.len());
-    let color_at: std::collections::HashMap<[u32; 3], [f32; 4]> = tessellation
-        .positions
-        .iter()
-        .zip(&tessellation.colors)
-        .map(|(p, c)| (p.map(f32::to_bits), *c))
-        .collect();
+    let color_at: std::collections::HashMap<[u32; 3], [f32; 4]> =
+        tessellation.positions.iter().zip(&tessellation.colors).map(|(p, c)| (p.map(f32::to_bits), *c)).collect();
     for (v, p) in reopened.positions.iter().enumerate() {
         let expected = color_at[&p.map(f32::to_bits)];
         assert_eq!(reopened.store.vertex_color(v as u32), Some(expected), "vertex {v}");

@@ -463,7 +463,6 @@ impl Editor {
     /// Starts the radius (F) or strength (Shift+F) gesture at the pointer.
     pub fn start_gesture(&mut self, kind: GestureKind) {
         let pointer = self.viewport_pointer.unwrap_or_else(|| self.viewport.rect.center());
-        let ppp = self.viewport.pixels_per_point.max(0.01);
         let radius_pt = self.brush_radius_points(None);
         let before = self.brush;
         let Some(session) = self.paint.as_mut() else {
@@ -473,7 +472,6 @@ impl Editor {
             GestureKind::Radius => radius_pt,
             GestureKind::Strength => before.strength * STRENGTH_GESTURE_POINTS,
         };
-        let _ = ppp;
         session.gesture = Some(Gesture { kind, center: pointer - egui::vec2(offset, 0.0), before });
         let what = match kind {
             GestureKind::Radius => "radius",
