@@ -114,16 +114,15 @@ struct FaceData {
     interior_base: u32,
 }
 
+// Few varyings: a software rasteriser sets up and stores every one per vertex/triangle.
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) bary: vec3<f32>,
-    @location(1) @interpolate(flat) normal: vec3<f32>,
+    // rgb: the face's heat-map colour (linear); a: dot(face normal, light direction).
+    @location(1) @interpolate(flat) shade: vec4<f32>,
     // LEVEL_MODE 0: `LevelData` at the face's fixed level; 1: `FaceData` (see pack_*).
     @location(2) @interpolate(flat) face0: vec4<u32>,
     @location(3) @interpolate(flat) face1: vec4<u32>,
-    @location(4) @interpolate(flat) face2: vec4<u32>,
-    // Heat-map colour (linear RGB) and log2 R_f of the face.
-    @location(5) @interpolate(flat) heat: vec3<f32>,
 }
 
 fn face_corners(face: u32) -> vec3<u32> {
@@ -190,34 +189,37 @@ fn level_data(f: FaceData, level: u32) -> LevelData {
     return d;
 }
 
-// Flat-varying encodings of LevelData and FaceData (three vec4<u32>).
-fn pack_level(d: LevelData) -> array<vec4<u32>, 3> {
-    return array<vec4<u32>, 3>(
-        vec4<u32>(d.r, d.vertex),
-        vec4<u32>(d.edge_start, d.interior),
-        vec4<u32>(d.edge_step, 0u),
-    );
+// Flat-varying encodings of LevelData and FaceData (two vec4<u32>). Bit fields of the
+// first word: LevelData: r (bits 0..12), log2 of edge k's stride (13 + 4k), edge k
+// reversed (25 + k); FaceData: log2 R_f (0..3), log2 R_e of edge k (4 + 4k), edge k
+// reversed (16 + k).
+fn reversed_bits(reversed: vec3<bool>, shift: u32) -> u32 {
+    let bits = select(vec3<u32>(0u), vec3<u32>(1u, 2u, 4u), reversed);
+    return (bits.x | bits.y | bits.z) << shift;
 }
 
-fn unpack_level(a: vec4<u32>, b: vec4<u32>, c: vec4<u32>) -> LevelData {
+fn pack_level(f: FaceData, d: LevelData) -> array<vec4<u32>, 2> {
+    let s = f.edge_log2 - vec3<u32>(f.log2_f);
+    let bits = d.r | (s.x << 13u) | (s.y << 17u) | (s.z << 21u) | reversed_bits(f.reversed, 25u);
+    return array<vec4<u32>, 2>(vec4<u32>(bits, d.vertex), vec4<u32>(d.edge_start, d.interior));
+}
+
+fn unpack_level(a: vec4<u32>, b: vec4<u32>) -> LevelData {
     var d: LevelData;
-    d.r = a.x;
+    d.r = a.x & 0x1fffu;
     d.vertex = a.yzw;
     d.edge_start = b.xyz;
     d.interior = b.w;
-    d.edge_step = c.xyz;
+    let stride = vec3<u32>(1u) << ((vec3<u32>(a.x) >> vec3<u32>(13u, 17u, 21u)) & vec3<u32>(15u));
+    let reversed = (vec3<u32>(a.x) & vec3<u32>(1u << 25u, 1u << 26u, 1u << 27u)) != vec3<u32>(0u);
+    d.edge_step = select(stride, vec3<u32>(0u) - stride, reversed);
     return d;
 }
 
-fn pack_face(f: FaceData) -> array<vec4<u32>, 3> {
+fn pack_face(f: FaceData) -> array<vec4<u32>, 2> {
     let bits = f.log2_f | (f.edge_log2.x << 4u) | (f.edge_log2.y << 8u) | (f.edge_log2.z << 12u)
-        | (select(0u, 1u, f.reversed.x) << 16u) | (select(0u, 1u, f.reversed.y) << 17u)
-        | (select(0u, 1u, f.reversed.z) << 18u);
-    return array<vec4<u32>, 3>(
-        vec4<u32>(bits, f.vertex_base),
-        vec4<u32>(f.edge_base, f.interior_base),
-        vec4<u32>(0u),
-    );
+        | reversed_bits(f.reversed, 16u);
+    return array<vec4<u32>, 2>(vec4<u32>(bits, f.vertex_base), vec4<u32>(f.edge_base, f.interior_base));
 }
 
 fn unpack_face(a: vec4<u32>, b: vec4<u32>) -> FaceData {
@@ -231,26 +233,25 @@ fn unpack_face(a: vec4<u32>, b: vec4<u32>) -> FaceData {
     return f;
 }
 
-fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
-    return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
-}
-
 // Resolution heat map: a ramp over log2 R = 0..12 (dark blue, blue, cyan, green, yellow,
-// orange, magenta at 0, 2, 4, …, 12).
+// orange, magenta at 0, 2, 4, …, 12, mixed in sRGB), tabulated in linear RGB.
 fn heat_color(log2_r: u32) -> vec3<f32> {
-    var stops = array<vec3<f32>, 7>(
-        vec3<f32>(0.10, 0.10, 0.45),
-        vec3<f32>(0.15, 0.40, 0.95),
-        vec3<f32>(0.00, 0.85, 0.90),
-        vec3<f32>(0.20, 0.85, 0.25),
-        vec3<f32>(0.98, 0.90, 0.15),
-        vec3<f32>(0.98, 0.45, 0.08),
-        vec3<f32>(0.90, 0.15, 0.70),
+    var table = array<vec3<f32>, 13>(
+        vec3<f32>(0.0100228, 0.0100228, 0.1706449),
+        vec3<f32>(0.0143499, 0.0508761, 0.4479884),
+        vec3<f32>(0.0196066, 0.1328683, 0.8900055),
+        vec3<f32>(0.0065714, 0.3485102, 0.8377929),
+        vec3<f32>(0.0000000, 0.6920712, 0.7874123),
+        vec3<f32>(0.0100228, 0.6920712, 0.2901425),
+        vec3<f32>(0.0331048, 0.6920712, 0.0508761),
+        vec3<f32>(0.3069994, 0.7388448, 0.0331048),
+        vec3<f32>(0.9551046, 0.7874123, 0.0196066),
+        vec3<f32>(0.9551046, 0.4132082, 0.0125104),
+        vec3<f32>(0.9551046, 0.1706449, 0.0071944),
+        vec3<f32>(0.8688995, 0.0732390, 0.1259674),
+        vec3<f32>(0.7874123, 0.0196066, 0.4479884),
     );
-    let t = f32(min(log2_r, 12u)) * 0.5;
-    let k = min(u32(floor(t)), 5u);
-    let c = mix(stops[k], stops[k + 1u], t - f32(k));
-    return srgb_to_linear(c);
+    return table[min(log2_r, 12u)];
 }
 
 @vertex
@@ -279,20 +280,19 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
         normal = n / len;
     }
     let f = face_data(face, c);
-    var packed: array<vec4<u32>, 3>;
+    var packed: array<vec4<u32>, 2>;
     if LEVEL_MODE == 1u {
         packed = pack_face(f);
     } else {
-        packed = pack_level(level_data(f, min(u.level, f.log2_f)));
+        packed = pack_level(f, level_data(f, min(u.level, f.log2_f)));
     }
     var out: VertexOut;
     out.clip = u.clip_from_world * vec4<f32>(p, 1.0);
     out.bary = bary;
-    out.normal = normal;
+    // The fragment stage flips the sign for back faces: dot(−n, l) = −dot(n, l) exactly.
+    out.shade = vec4<f32>(heat_color(f.log2_f), dot(normal, u.light.xyz));
     out.face0 = packed[0];
     out.face1 = packed[1];
-    out.face2 = packed[2];
-    out.heat = heat_color(f.log2_f);
     return out;
 }
 
@@ -419,18 +419,17 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
         let c1 = sample_level(level_data(f, min(l0 + 1u, f.log2_f)), bary);
         color = select(c0, mix(c0, c1, t), t > 0.0);
     } else {
-        color = sample_level(unpack_level(in.face0, in.face1, in.face2), bary);
+        color = sample_level(unpack_level(in.face0, in.face1), bary);
     }
 
     var rgb = color.rgb * u.tint.rgb;
     let alpha = color.a * u.tint.a;
     if (u.flags & FLAG_HEATMAP) != 0u {
-        rgb = in.heat;
+        rgb = in.shade.rgb;
     }
     if (u.flags & FLAG_LIT) != 0u {
-        let n = select(-in.normal, in.normal, front_facing);
         let ambient = u.light.w;
-        let diffuse = max(dot(n, u.light.xyz), 0.0);
+        let diffuse = max(select(-in.shade.w, in.shade.w, front_facing), 0.0);
         rgb = rgb * (ambient + (1.0 - ambient) * diffuse);
     }
     if (u.flags & FLAG_WIREFRAME) != 0u {

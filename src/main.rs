@@ -75,9 +75,10 @@ enum Command {
         #[arg(long, short = 'o')]
         output: PathBuf,
     },
-    /// Replay a brush stroke headlessly (the editor's camera, picking and brush code) and
-    /// write the painted mesh: OUT ending in .glb gets a tessellated vertex-colour glTF, any
-    /// other name a packed file.
+    /// Replay a brush stroke headlessly and write the painted mesh.
+    ///
+    /// Uses the editor's camera, picking and brush code. OUT ending in .glb gets a
+    /// tessellated vertex-colour glTF, any other name a packed file.
     Paint(PaintArgs),
     /// Test helper: writes a recovery file (and now and then a saved file) in a loop,
     /// printing each generation after its write returns, until killed.
@@ -685,7 +686,9 @@ fn autosave_soak(args: SoakArgs) -> Result<()> {
             let len = document.store.interior_samples(face).len() as u32;
             for offset in 0..len {
                 let shade = ((generation + u64::from(offset)) % 17) as f32 / 16.0;
-                document.store.set(meshpaint::store::SampleRef::Interior { face, offset }, [shade, 0.5, 1.0 - shade, 1.0]);
+                document
+                    .store
+                    .set(meshpaint::store::SampleRef::Interior { face, offset }, [shade, 0.5, 1.0 - shade, 1.0]);
             }
         }
         meshpaint::autosave::write_recovery(&args.recovery, &document)?;

@@ -514,13 +514,14 @@ impl UndoHistory {
     fn enforce_cap(&mut self) {
         // Redo steps are the most recently undone work: drop the oldest undo steps first,
         // then (only if still over) the redo step farthest from the present.
-        while self.bytes_used() > self.cap_bytes {
-            if self.undo.pop_front().is_none() {
-                if self.redo.is_empty() {
-                    break;
-                }
-                self.redo.remove(0);
-            }
+        let mut used = self.bytes_used();
+        while used > self.cap_bytes {
+            let dropped = match self.undo.pop_front() {
+                Some(step) => step,
+                None if !self.redo.is_empty() => self.redo.remove(0),
+                None => break,
+            };
+            used -= dropped.bytes;
             self.dropped_steps += 1;
         }
     }

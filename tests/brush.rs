@@ -886,3 +886,105 @@ fn strokes_and_colours_parse() {
     let invalid = BrushSettings { strength: 1.5, ..BrushSettings::default() };
     assert!(invalid.validate().is_err());
 }
+
+// ---------------------------------------------------------------- headless replay (CLI)
+
+/// `meshpaint paint` replays a stroke through the same camera, picking and brush code as the
+/// library: its output equals a replay done here with `render::default_camera`.
+#[test]
+fn the_paint_command_replays_strokes_like_the_library() {
+    let dir = std::env::temp_dir().join(format!("meshpaint-brush-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Duck/Duck.glb");
+    let output = dir.join("painted.mpk");
+    let stroke = "300,300 700,400 500,600";
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_meshpaint"))
+        .args(["paint", input.to_str().unwrap(), "--stroke", stroke, "--color", "#00ff00", "--radius-px", "20"])
+        .args(["--strength", "0.8", "--width", "800", "--height", "600", "--yaw", "40", "--pitch", "-10"])
+        .args(["--resolution", "4", "--format", "rgba32f", "-o", output.to_str().unwrap()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let from_cli = meshpaint::packed_file::read_file(&output).unwrap();
+
+    let mut document = meshpaint::document::Document::open(&input, r(4)).unwrap();
+    let camera = meshpaint::render::default_camera(&document.positions, 40.0, -10.0, None);
+    let bvh = MeshBvh::build(&document.positions, &document.store.topology().face_vertices, BvhPreset::FastBuild);
+    let base = document.store.clone();
+    let view = PaintView {
+        positions: &document.positions,
+        bvh: &bvh,
+        camera: &camera,
+        viewport_px: [800, 600],
+        base: Some(&base),
+    };
+    let mut painter = Painter::new(&document.positions);
+    painter.set_settings(BrushSettings {
+        color: brush::parse_hex_color("#00ff00").unwrap(),
+        radius: BrushRadius::Pixels { radius_px: 20.0 },
+        strength: 0.8,
+        ..BrushSettings::default()
+    });
+    let mut history = UndoHistory::default();
+    let points = brush::parse_stroke(stroke).unwrap();
+    let (update, _) = brush::replay_stroke(&mut painter, &view, &mut document.store, &mut history, &points).unwrap();
+    assert!(update.dabs.len() > 50 && update.stats.samples_changed > 1000);
+    assert_eq!(from_cli, document.pack(ColorFormat::Rgba32F).unwrap(), "CLI and library replays differ");
+
+    // .glb output, and refusals.
+    let glb = dir.join("painted.glb");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_meshpaint"))
+        .args(["paint", input.to_str().unwrap(), "--stroke", stroke, "-o", glb.to_str().unwrap()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    assert!(meshpaint::import::import_gltf(&glb).is_ok());
+    for bad in [
+        vec!["--stroke", "1,2,3"],
+        vec!["--stroke", "1,2", "--color", "red"],
+        vec!["--stroke", "1,2", "--strength", "2"],
+        vec!["--stroke", "1,2", "--tool", "set"],
+    ] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_meshpaint"))
+            .arg("paint")
+            .arg(&input)
+            .args(&bad)
+            .arg("-o")
+            .arg(dir.join("never.mpk"))
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{bad:?} accepted");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains("error"), "{bad:?}: {stderr}");
+        assert!(!dir.join("never.mpk").exists());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bench_paint_reports_every_measurement() {
+    let input = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Duck/Duck.glb");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_meshpaint"))
+        .args(["bench", "paint", input.to_str().unwrap(), "--resolution", "4", "--dabs", "2", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["bench"], "paint");
+    assert_eq!(report["bvh_presets"].as_array().unwrap().len(), 6);
+    for preset in report["bvh_presets"].as_array().unwrap() {
+        assert!(preset["build_seconds"].as_f64().unwrap() > 0.0);
+        assert!(preset["pick_seconds_best"].as_f64().unwrap() > 0.0);
+        assert_eq!(preset["hits"], preset["picks"]);
+    }
+    let brushes = report["brushes"].as_array().unwrap();
+    assert_eq!(brushes.len(), 3);
+    for (row, target) in brushes.iter().zip([1_000u64, 10_000]) {
+        let covered = row["paint_in_stroke"]["samples_covered"].as_u64().unwrap();
+        assert!(covered * 100 >= target * 99 && covered < target + target / 5, "{covered} for {target}");
+        assert!(row["paint_in_stroke"]["upload_bytes_rgba8"].as_u64().unwrap() >= 4 * covered);
+        assert!(row["paint_first_dab"]["samples_per_second_best"].as_f64().unwrap() > 0.0);
+    }
+    assert!(report["repack_rgba8"]["timing"]["best_seconds"].as_f64().unwrap() > 0.0);
+    assert!(report["pick_latency"]["best_seconds"].as_f64().unwrap() > 0.0);
+}
