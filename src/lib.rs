@@ -34,7 +34,7 @@
 //! | [`autosave`] | periodic atomic RGBA32F recovery files; find and load them after a crash |
 //! | [`bake`] | base-colour texture → mesh colors (texture conversion) |
 //! | [`render`] | **GPU**: wgpu context, packed buffers on the GPU, sampling pipelines, readback |
-//! | [`bench`] | the measurements behind `meshpaint bench` (time and size, as JSON) |
+//! | [`bench`](mod@bench) | the measurements behind `meshpaint bench` (time and size, as JSON) |
 //! | [`packed_file`] | the packed file format (docs/FORMAT.md): writer and hostile-input-proof reader |
 //! | [`app`] | **GPU + UI**: the desktop editor (winit, egui, wgpu): window, panels, input, background jobs |
 //!

@@ -2,6 +2,8 @@
 //! changes, a buffer updated only with the planned uploads samples exactly like the store,
 //! and each upload is proportional to what changed.
 
+mod common;
+use common::{Rng, octahedron};
 use meshpaint::color::ColorFormat;
 use meshpaint::layout::{self, Resolution};
 use meshpaint::packed::PackedMesh;
@@ -9,26 +11,6 @@ use meshpaint::paint_layout::PaintLayout;
 use meshpaint::sampler::MeshColorSource;
 use meshpaint::store::{ColorStore, SampleRef};
 use meshpaint::topology::Topology;
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
-
-fn octahedron() -> (Vec<[f32; 3]>, Topology) {
-    let positions =
-        vec![[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
-    let triangles = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
-    (positions, Topology::build(6, &triangles).unwrap())
-}
 
 /// Every lattice point of every face reads the store's colour from the mirror buffer.
 fn assert_mirror_matches(mirror: &PackedMesh, store: &ColorStore) {

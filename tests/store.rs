@@ -5,6 +5,8 @@
 // Colour channels are indexed 0..4 in parallel arrays; an index reads clearest.
 #![allow(clippy::needless_range_loop)]
 
+mod common;
+use common::{Rng, octahedron};
 use meshpaint::color::Rgba;
 use meshpaint::layout::{self, Resolution};
 use meshpaint::store::{ColorStore, SampleRef};
@@ -12,30 +14,6 @@ use meshpaint::topology::Topology;
 
 fn r(value: u64) -> Resolution {
     Resolution::new(value).unwrap()
-}
-
-/// Octahedron: closed, 6 vertices, 12 edges, 8 faces, mixed edge orientations.
-fn octahedron() -> (Vec<[f32; 3]>, Topology) {
-    let positions =
-        vec![[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
-    let triangles = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
-    (positions, Topology::build(6, &triangles).unwrap())
-}
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn color(&mut self) -> Rgba {
-        [self.unit(), self.unit(), self.unit(), self.unit()]
-    }
 }
 
 /// Fills every sample with a random colour.
