@@ -1,11 +1,11 @@
 // Mesh colors: vertex pulling plus a per-fragment mesh-colors lookup in the colour atlas.
 //
 // The vertex stage draws 3·F vertices without a vertex buffer: face = vertex_index / 3,
-// corner = vertex_index % 3, positions pulled from the index and position storage
-// buffers (positions are relative to the render origin, see src/render/mesh_gpu.rs).
-// It also reads the face record and decodes everything per face the fragment stage
-// needs into flat varyings, so a fragment reads no storage buffer: its only memory
-// accesses are the atlas texels of its samples.
+// corner = vertex_index % 3, vertex ids and positions pulled from RGBA32 data textures
+// (one texel fetch per entry; positions are relative to the render origin, see
+// src/render/mesh_gpu.rs). It also reads the face record and decodes everything per face
+// the fragment stage needs into flat varyings, so a fragment's only memory accesses are
+// the atlas texels of its samples.
 //
 // The fragment stage mirrors the CPU reference exactly — keep in sync with:
 //   src/layout.rs   `sanitize_barycentric`, `linear_samples_uv`, `nearest_sample`,
@@ -75,14 +75,18 @@ const LOG2_SHIFT: u32 = 28u;
 const BASE_MASK: u32 = 0x0fffffffu;
 const MAX_LOG2_RESOLUTION: u32 = 12u;
 
+// Data textures: entry k is texel (k % 2^MESH_DATA_WIDTH_LOG2, k >> MESH_DATA_WIDTH_LOG2).
+// Keep in sync with `MESH_DATA_WIDTH` in src/render/mesh_gpu.rs.
+const MESH_DATA_WIDTH_LOG2: u32 = 12u;
+
 @group(0) @binding(0) var<uniform> u: FrameUniforms;
-// x, y, z of each vertex, relative to the render origin.
-@group(0) @binding(1) var<storage, read> positions: array<f32>;
-// c0, c1, c2 of each face.
-@group(0) @binding(2) var<storage, read> indices: array<u32>;
+// (x, y, z, 0) of each vertex, relative to the render origin.
+@group(0) @binding(1) var positions: texture_2d<f32>;
+// (c0, c1, c2, 0) of each face.
+@group(0) @binding(2) var indices: texture_2d<u32>;
 // Keep in sync with `FaceRecord` in src/packed.rs: (interior, edge0, edge1, edge2),
 // each word `base | log2 << 28`.
-@group(0) @binding(3) var<storage, read> face_records: array<vec4<u32>>;
+@group(0) @binding(3) var face_records: texture_2d<u32>;
 @group(0) @binding(4) var atlas: texture_2d<f32>;
 
 // Per-face addressing at one MIP level: the colour-buffer index of every lattice point
@@ -125,14 +129,18 @@ struct VertexOut {
     @location(3) @interpolate(flat) face1: vec4<u32>,
 }
 
+fn data_texel(k: u32) -> vec2<u32> {
+    return vec2<u32>(k & ((1u << MESH_DATA_WIDTH_LOG2) - 1u), k >> MESH_DATA_WIDTH_LOG2);
+}
+
 fn face_corners(face: u32) -> vec3<u32> {
     let f = min(face, max(u.face_count, 1u) - 1u);
     let last = max(u.vertex_count, 1u) - 1u;
-    return min(vec3<u32>(indices[3u * f], indices[3u * f + 1u], indices[3u * f + 2u]), vec3<u32>(last));
+    return min(textureLoad(indices, data_texel(f), 0).xyz, vec3<u32>(last));
 }
 
 fn load_position(v: u32) -> vec3<f32> {
-    return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
+    return textureLoad(positions, data_texel(v), 0).xyz;
 }
 
 fn is_finite(x: f32) -> bool {
@@ -157,7 +165,7 @@ fn interior_level_offset(m: u32, l: u32) -> u32 {
 
 // Decodes the face record and corners of `face` (sampler::packed_sample_index's inputs).
 fn face_data(face: u32, corners: vec3<u32>) -> FaceData {
-    let record = face_records[min(face, max(u.face_count, 1u) - 1u)];
+    let record = textureLoad(face_records, data_texel(min(face, max(u.face_count, 1u) - 1u)), 0);
     var f: FaceData;
     f.log2_f = min(record.x >> LOG2_SHIFT, MAX_LOG2_RESOLUTION);
     f.vertex_base = corners * u.vertex_levels;

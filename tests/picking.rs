@@ -688,7 +688,7 @@ fn edge_cases_of_the_query_api() {
 /// 144k-triangle bunny (best of three runs each). Run with
 /// `cargo test --release --test picking -- --ignored --nocapture bench_bvh_kinds`.
 #[test]
-#[ignore]
+#[ignore = "a measurement, not a test: run with --release --ignored --nocapture"]
 fn bench_bvh_kinds() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Bunny144k/bunny.glb");
     let scene = meshpaint::import::import_gltf(&path).unwrap();

@@ -1,8 +1,15 @@
-//! A [`PackedMesh`] on the GPU: positions, indices and face records in storage buffers,
-//! the colour buffer in a 2D colour-atlas texture.
+//! A [`PackedMesh`] on the GPU: positions, indices and face records in RGBA32 "data"
+//! textures (one 16-byte entry per texel), the colour buffer in a 2D colour-atlas texture.
+//!
+//! Why textures and not storage buffers for the vertex-pulling data: the vertex shader
+//! reads a whole entry (a position, a face's three vertex ids, a face record) with one
+//! texel fetch. On software rasterisers (lavapipe) a storage-buffer load with a per-lane
+//! address runs a scalar loop per component, which cost ~10 % of a frame on dense meshes
+//! (Bunny, 144 k triangles). Textures also lift the storage binding limit (128 MiB on
+//! lavapipe): a data texture holds up to `MESH_DATA_WIDTH × max_texture_dimension_2d`
+//! entries (67 M with 16384 rows).
 
 use glam::DVec3;
-use wgpu::util::DeviceExt;
 
 use super::{GpuContext, RenderError, Renderer};
 use crate::camera::BoundingSphere;
@@ -18,6 +25,95 @@ pub fn default_atlas_width(limits: &wgpu::Limits) -> u32 {
 
 /// Bytes written per `write_texture` call when uploading many rows (bounds staging memory).
 const UPLOAD_BAND_BYTES: u64 = 64 << 20;
+
+/// Row width of the data textures (positions, indices, face records): entry `k` is texel
+/// `(k % MESH_DATA_WIDTH, k / MESH_DATA_WIDTH)`. Keep in sync with `MESH_DATA_WIDTH_LOG2` in
+/// shaders/mesh_colors.wgsl.
+const MESH_DATA_WIDTH: u32 = 1 << 12;
+
+/// Bytes per data-texture entry (one RGBA32 texel).
+const DATA_TEXEL_BYTES: u64 = 16;
+
+/// Writes `data` (whole texels of `bytes_per_texel`) into `texture`, whose rows are `width`
+/// texels, starting at texel index `first` (texel `(first % width, first / width)`): partial
+/// rows at the ends, bands of full rows in between.
+fn write_texel_rows(
+    ctx: &GpuContext,
+    texture: &wgpu::Texture,
+    width: u32,
+    bytes_per_texel: u64,
+    first: u64,
+    data: &[u8],
+) {
+    let count = data.len() as u64 / bytes_per_texel;
+    let width = u64::from(width);
+    let band_rows = (UPLOAD_BAND_BYTES / (width * bytes_per_texel)).max(1);
+    let mut done = 0u64;
+    while done < count {
+        let (x, y) = ((first + done) % width, (first + done) / width);
+        let remaining = count - done;
+        // A partial row (unaligned start or the tail), else a band of full rows.
+        let (texels_per_row, rows) = if x != 0 || remaining < width {
+            ((width - x).min(remaining), 1)
+        } else {
+            (width, (remaining / width).min(band_rows))
+        };
+        let start = (done * bytes_per_texel) as usize;
+        let end = start + (texels_per_row * rows * bytes_per_texel) as usize;
+        ctx.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: x as u32, y: y as u32, z: 0 },
+                aspect: wgpu::TextureAspect::All,
+            },
+            &data[start..end],
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some((texels_per_row * bytes_per_texel) as u32),
+                rows_per_image: Some(rows as u32),
+            },
+            wgpu::Extent3d { width: texels_per_row as u32, height: rows as u32, depth_or_array_layers: 1 },
+        );
+        done += texels_per_row * rows;
+    }
+}
+
+/// A data texture of `format` (RGBA32 float or uint) holding `entries` 16-byte entries in
+/// rows of [`MESH_DATA_WIDTH`], filled with `bytes`; refused when it needs more rows than
+/// the device allows.
+fn data_texture(
+    ctx: &GpuContext,
+    what: &'static str,
+    format: wgpu::TextureFormat,
+    bytes: &[u8],
+) -> Result<wgpu::Texture, RenderError> {
+    let entries = bytes.len() as u64 / DATA_TEXEL_BYTES;
+    let rows = entries.div_ceil(u64::from(MESH_DATA_WIDTH)).max(1);
+    let max_dimension = ctx.limits().max_texture_dimension_2d;
+    let height = u32::try_from(rows).ok().filter(|&rows| rows <= max_dimension).ok_or_else(|| {
+        RenderError::InvalidMesh(format!(
+            "{entries} {what} need {rows} texture rows of {MESH_DATA_WIDTH}, more than the device's {max_dimension}"
+        ))
+    })?;
+    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(what),
+        size: wgpu::Extent3d { width: MESH_DATA_WIDTH, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    write_texel_rows(ctx, &texture, MESH_DATA_WIDTH, DATA_TEXEL_BYTES, 0, bytes);
+    Ok(texture)
+}
+
+/// Bytes of a texture's level 0 with 16-byte texels.
+fn data_texture_bytes(texture: &wgpu::Texture) -> u64 {
+    u64::from(texture.width()) * u64::from(texture.height()) * DATA_TEXEL_BYTES
+}
 
 /// Where samples live in the colour atlas.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -87,35 +183,15 @@ pub struct GpuMesh {
     pub format: ColorFormat,
     /// Where samples live in the atlas.
     pub atlas: AtlasLayout,
-    positions: wgpu::Buffer,
-    indices: wgpu::Buffer,
-    face_records: wgpu::Buffer,
+    /// Rgba32Float: x, y, z (relative to the origin), 0 per vertex.
+    positions: wgpu::Texture,
+    /// Rgba32Uint: c0, c1, c2, 0 per face.
+    indices: wgpu::Texture,
+    /// Rgba32Uint: the four words of each face's [`FaceRecord`].
+    face_records: wgpu::Texture,
     atlas_texture: wgpu::Texture,
     pub(crate) uniforms: wgpu::Buffer,
     pub(crate) bind_group: wgpu::BindGroup,
-}
-
-/// Creates a storage buffer of `bytes` (padded to 16 bytes: empty bindings are invalid),
-/// refusing buffers larger than the binding limit.
-fn storage_buffer(ctx: &GpuContext, what: &'static str, bytes: &[u8]) -> Result<wgpu::Buffer, RenderError> {
-    let limit = ctx.limits().max_storage_buffer_binding_size;
-    if bytes.len() as u64 > limit {
-        return Err(RenderError::BufferTooLarge { what, bytes: bytes.len() as u64, limit });
-    }
-    let padded;
-    let contents = if bytes.len() < 16 || !bytes.len().is_multiple_of(4) {
-        let mut data = bytes.to_vec();
-        data.resize(bytes.len().next_multiple_of(4).max(16), 0);
-        padded = data;
-        &padded[..]
-    } else {
-        bytes
-    };
-    Ok(ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(what),
-        contents,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-    }))
 }
 
 impl GpuMesh {
@@ -168,19 +244,30 @@ impl GpuMesh {
 
         let bounds = BoundingSphere::of_points(&packed.positions);
         let origin = DVec3::from_array(bounds.center);
-        let relative: Vec<f32> = packed
+        let relative: Vec<[f32; 4]> = packed
             .positions
             .iter()
-            .flat_map(|p| {
+            .map(|p| {
                 let p = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - origin;
-                [p.x as f32, p.y as f32, p.z as f32]
+                [p.x as f32, p.y as f32, p.z as f32, 0.0]
             })
             .collect();
-        let positions =
-            storage_buffer(ctx, "positions (relative to the render origin)", bytemuck::cast_slice(&relative))?;
-        let indices = storage_buffer(ctx, "indices", bytemuck::cast_slice(&packed.indices))?;
-        let face_records =
-            storage_buffer(ctx, "face records", bytemuck::cast_slice::<FaceRecord, u8>(&packed.face_records))?;
+        let corners: Vec<[u32; 4]> = packed.indices.iter().map(|&[c0, c1, c2]| [c0, c1, c2, 0]).collect();
+        let positions = data_texture(
+            ctx,
+            "positions (relative to the render origin)",
+            wgpu::TextureFormat::Rgba32Float,
+            bytemuck::cast_slice(&relative),
+        )?;
+        let indices =
+            data_texture(ctx, "faces' vertex ids", wgpu::TextureFormat::Rgba32Uint, bytemuck::cast_slice(&corners))?;
+        // A face record is four u32 words: exactly one Rgba32Uint texel.
+        let face_records = data_texture(
+            ctx,
+            "face records",
+            wgpu::TextureFormat::Rgba32Uint,
+            bytemuck::cast_slice::<FaceRecord, u8>(&packed.face_records),
+        )?;
 
         let atlas_texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("colour atlas"),
@@ -192,7 +279,8 @@ impl GpuMesh {
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
-        let atlas_view = atlas_texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let view = |texture: &wgpu::Texture| texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let atlas_view = view(&atlas_texture);
         let uniforms = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("mesh colors uniforms"),
             size: std::mem::size_of::<super::FrameUniforms>() as u64,
@@ -204,9 +292,9 @@ impl GpuMesh {
             layout: renderer.mesh_bind_group_layout(),
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: positions.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: indices.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: face_records.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view(&positions)) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&view(&indices)) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&view(&face_records)) },
                 wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&atlas_view) },
             ],
         });
@@ -242,37 +330,7 @@ impl GpuMesh {
                 self.atlas.samples
             )));
         }
-        let width = u64::from(self.atlas.width);
-        let band_rows = (UPLOAD_BAND_BYTES / (width * bytes_per_sample)).max(1);
-        let mut done = 0u64;
-        while done < count {
-            let (x, y) = self.atlas.texel(first + done);
-            let remaining = count - done;
-            // A partial row (unaligned start or the tail), else a band of full rows.
-            let (texels_per_row, rows) = if x != 0 || remaining < width {
-                ((width - u64::from(x)).min(remaining), 1)
-            } else {
-                (width, (remaining / width).min(band_rows))
-            };
-            let start = (done * bytes_per_sample) as usize;
-            let end = start + (texels_per_row * rows * bytes_per_sample) as usize;
-            ctx.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &self.atlas_texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d { x, y, z: 0 },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                &encoded[start..end],
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some((texels_per_row * bytes_per_sample) as u32),
-                    rows_per_image: Some(rows as u32),
-                },
-                wgpu::Extent3d { width: texels_per_row as u32, height: rows as u32, depth_or_array_layers: 1 },
-            );
-            done += texels_per_row * rows;
-        }
+        write_texel_rows(ctx, &self.atlas_texture, self.atlas.width, bytes_per_sample, first, encoded);
         Ok(())
     }
 
@@ -294,14 +352,17 @@ impl GpuMesh {
         if records.is_empty() {
             return Ok(());
         }
-        let offset = u64::from(first_face) * std::mem::size_of::<FaceRecord>() as u64;
-        ctx.queue.write_buffer(&self.face_records, offset, bytemuck::cast_slice(records));
+        let bytes = bytemuck::cast_slice::<FaceRecord, u8>(records);
+        write_texel_rows(ctx, &self.face_records, MESH_DATA_WIDTH, DATA_TEXEL_BYTES, u64::from(first_face), bytes);
         Ok(())
     }
 
-    /// GPU memory of the mesh's buffers and atlas, in bytes.
+    /// GPU memory of the mesh's data textures and atlas, in bytes.
     pub fn gpu_bytes(&self) -> u64 {
         let atlas = u64::from(self.atlas.width) * u64::from(self.atlas.height) * self.format.bytes_per_sample() as u64;
-        self.positions.size() + self.indices.size() + self.face_records.size() + atlas
+        data_texture_bytes(&self.positions)
+            + data_texture_bytes(&self.indices)
+            + data_texture_bytes(&self.face_records)
+            + atlas
     }
 }

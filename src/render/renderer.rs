@@ -177,18 +177,6 @@ fn layout_entry(binding: u32, visibility: wgpu::ShaderStages, ty: wgpu::BindingT
     wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None }
 }
 
-fn storage_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    layout_entry(
-        binding,
-        visibility,
-        wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-    )
-}
-
 fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     layout_entry(
         binding,
@@ -211,16 +199,27 @@ impl Renderer {
 
     fn build(ctx: &GpuContext, color_format: wgpu::TextureFormat) -> Self {
         let device = &ctx.device;
-        // Geometry and face records are read by the vertex stage only (it passes everything
-        // per face to the fragment stage as flat varyings); fragments read only the atlas.
-        let vertex = wgpu::ShaderStages::VERTEX;
+        // Positions, vertex ids and face records: RGBA32 data textures read by the vertex stage
+        // only (it passes everything per face to the fragment stage as flat varyings), so
+        // fragments read nothing but the atlas. See src/render/mesh_gpu.rs for why textures.
+        let data = |binding, sample_type| {
+            layout_entry(
+                binding,
+                wgpu::ShaderStages::VERTEX,
+                wgpu::BindingType::Texture {
+                    sample_type,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+            )
+        };
         let mesh_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mesh colors layout"),
             entries: &[
                 uniform_entry(0),
-                storage_entry(1, vertex),
-                storage_entry(2, vertex),
-                storage_entry(3, vertex),
+                data(1, wgpu::TextureSampleType::Float { filterable: false }),
+                data(2, wgpu::TextureSampleType::Uint),
+                data(3, wgpu::TextureSampleType::Uint),
                 layout_entry(
                     4,
                     wgpu::ShaderStages::FRAGMENT,
@@ -342,8 +341,8 @@ impl Renderer {
         self.color_format
     }
 
-    /// The bind-group layout of the mesh-colors pipeline (uniforms, positions, indices,
-    /// face records, colour atlas).
+    /// The bind-group layout of the mesh-colors pipeline (uniforms; positions, vertex ids and
+    /// face records as RGBA32 data textures; colour atlas).
     pub fn mesh_bind_group_layout(&self) -> &wgpu::BindGroupLayout {
         &self.mesh_layout
     }
