@@ -62,7 +62,7 @@ struct FrameUniforms {
 }
 
 // Pipeline constants, set by the renderer from `FilterMode::uniform_fields` (keep in sync
-// with `MeshPipelineKey` in src/render/renderer.rs): 0 = nearest, 1 = linear.
+// with `MESH_PIPELINE_KEYS` in src/render/renderer.rs): 0 = nearest, 1 = linear.
 override FILTER_KIND: u32 = 1u;
 // 0 = fixed level `u.level`, 1 = automatic level (trilinear).
 override LEVEL_MODE: u32 = 1u;

@@ -5,10 +5,14 @@
 //!
 //! - **Vertex pulling.** The mesh-colors pipeline has no vertex buffer: it draws `3·F`
 //!   vertices; the vertex shader takes `face = vertex_index / 3`, `corner = vertex_index % 3`
-//!   and reads the corner's vertex id and position from storage buffers. The face id
-//!   reaches the fragment shader as a flat varying, the barycentrics as `(1,0,0)`,
-//!   `(0,1,0)`, `(0,0,1)` interpolated perspective-correct. No `primitive_index` feature
-//!   is needed, so it runs on every backend.
+//!   and reads the corner's vertex id, its position and the face record from RGBA32 data
+//!   textures (4096 texels wide; on lavapipe a texel fetch is cheaper than a storage-buffer
+//!   load, and textures lift the 128 MiB binding limit). It decodes everything per-face once
+//!   and passes it to the fragment shader as flat varyings, with the barycentrics
+//!   `(1,0,0)`, `(0,1,0)`, `(0,0,1)` interpolated perspective-correct, so a fragment reads
+//!   only colour-atlas texels. No `primitive_index` feature is needed: it runs on every
+//!   backend. Filter and level mode are pipeline constants (one pipeline per mode): a CPU
+//!   rasteriser executes both sides of a branch, so one uber-shader paid for every filter.
 //! - **Colour atlas.** The colour buffer (all samples with their MIP chains) is a 2D
 //!   texture of width `W` used as an array: sample `index` is texel `(index % W, index / W)`.
 //!   One storage binding is limited to 128 MiB on lavapipe and WebGPU defaults while a
