@@ -10,33 +10,20 @@
 //! import `wgpu`, `egui` or `winit`; they are exact, deterministic and tested against
 //! independent truths (closed-form counts, brute-force enumeration).
 //!
-//! | module | responsibility |
+//! | folder | holds |
 //! |---|---|
-//! | [`scene`] | imported data: source meshes, instances, materials, textures |
-//! | [`import`] | glTF (.glb/.gltf) → [`scene::Scene`], every bad input refused with a message |
-//! | [`weld`] | scene → one indexed mesh; vertices with bitwise-equal positions merged per mesh instance |
-//! | [`topology`] | unique edges, face→edge incidence, boundary / non-manifold edges, valence |
-//! | [`layout`] | mesh-colors layout math: sample counts, sample classification, MIP offsets, filtering |
-//! | [`stats`] | the numbers `meshpaint info` prints |
-//! | [`color`] | linear RGBA, sRGB transfer, packed colour formats (RGBA8 sRGB / 16F / 32F) |
-//! | [`store`] | the editable map-based store: per-element samples, per-face resolution, dirty tracking |
-//! | [`resample`] | exact-inverse 2× refinement / reduction used when a face's resolution changes |
-//! | [`packed`] | the linear GPU layout: 16-byte face records and the colour buffer with MIP chains |
-//! | [`packer`] | store → packed (MIP chains, eq. 2.5/2.6) and packed → store |
-//! | [`paint_layout`] | the paint-mode GPU layout: level 0 in blocks with slack; dirty ranges and patched records |
-//! | [`sampler`] | the CPU reference sampler (nearest, linear, MIP level) on the store and on packed buffers |
-//! | [`document`] | open glTF or packed files into a store; pack for export |
-//! | [`export_gltf`] | store → .glb tessellated at each face's resolution, one vertex (COLOR_0) per sample |
+//! | [`mesh`] | [`mesh::scene`] (imported data), [`mesh::import`] (glTF → scene, every bad input refused with a message), [`mesh::weld`] (one indexed mesh, bitwise-equal positions merged per instance), [`mesh::topology`] (edges, incidence, boundary / non-manifold, valence) |
+//! | [`colors`] | the mesh-colors core: [`colors::layout`] (sample counts, classification, MIP offsets, filtering), [`colors::format`] (linear RGBA, sRGB, RGBA8 / 16F / 32F), [`colors::store`] (the map-based store with per-face R and dirty tracking), [`colors::resample`] (exact 2× refine / reduce), [`colors::stats`] (the sample budget `info` prints) |
+//! | [`packing`] | [`packing::linear`] (16-byte face records, colour buffer with MIP chains), [`packing::packer`] (store ⇄ linear, eq. 2.5/2.6), [`packing::paint_layout`] (paint-mode blocks with slack, dirty ranges), [`packing::sampler`] (the CPU reference sampler, the truth the GPU is tested against), [`packing::file`] (the packed file format) |
+//! | [`paint`] | [`paint::picking`] (obvhs BVH, watertight rays), [`paint::brush`] (colour / blur / resolution brushes, tools, replay), [`paint::undo`] (per stroke, memory cap) |
+//! | [`io`] | [`io::document`] (open glTF or packed files into a store; pack for export), [`io::export_gltf`], [`io::bake`] (texture → mesh colors), [`io::autosave`] |
 //! | [`camera`] | the orbit camera: matrices, framing, pixel rays (shared by render, picking, replay) |
-//! | [`picking`] | obvhs BVH over the mesh, watertight ray casts with our own barycentrics |
-//! | [`brush`] | painting: colour / blur / resolution brushes, stroke dabs, occlusion, mirror, eyedropper, fill |
-//! | [`undo`] | undo / redo per stroke: changed samples and resolution changes only, memory cap |
-//! | [`autosave`] | periodic atomic RGBA32F recovery files; find and load them after a crash |
-//! | [`bake`] | base-colour texture → mesh colors (texture conversion) |
 //! | [`render`] | **GPU**: wgpu context, packed buffers on the GPU, sampling pipelines, readback |
-//! | [`bench`](mod@bench) | the measurements behind `meshpaint bench` (time and size, as JSON) |
-//! | [`packed_file`] | the packed file format (docs/FORMAT.md): writer and hostile-input-proof reader |
+//! | [`bench`](mod@bench) | **GPU**: the measurements behind `meshpaint bench` (time and size, as JSON) |
 //! | [`app`] | **GPU + UI**: the desktop editor (winit, egui, wgpu): window, panels, input, background jobs |
+//!
+//! `mesh`, `colors`, `packing`, `paint`, `io` and `camera` are the core: they never import
+//! `wgpu`, `egui` or `winit` (`tests/architecture.rs` checks it).
 //!
 //! ## Data flow
 //!
@@ -54,27 +41,11 @@
 //! The binary (`src/main.rs`) and the editor ([`app`]) are the only places where everything meets.
 
 pub mod app;
-pub mod autosave;
-pub mod bake;
 pub mod bench;
-pub mod brush;
 pub mod camera;
-pub mod color;
-pub mod document;
-pub mod export_gltf;
-pub mod import;
-pub mod layout;
-pub mod packed;
-pub mod packed_file;
-pub mod packer;
-pub mod paint_layout;
-pub mod picking;
+pub mod colors;
+pub mod io;
+pub mod mesh;
+pub mod packing;
+pub mod paint;
 pub mod render;
-pub mod resample;
-pub mod sampler;
-pub mod scene;
-pub mod stats;
-pub mod store;
-pub mod topology;
-pub mod undo;
-pub mod weld;

@@ -7,11 +7,11 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 
-use meshpaint::color::ColorFormat;
-use meshpaint::document::{Document, SourceKind};
-use meshpaint::layout::Resolution;
-use meshpaint::packed_file;
-use meshpaint::stats::MeshStats;
+use meshpaint::colors::format::ColorFormat;
+use meshpaint::colors::layout::Resolution;
+use meshpaint::colors::stats::MeshStats;
+use meshpaint::io::document::{Document, SourceKind};
+use meshpaint::packing::file as packed_file;
 
 /// Paint colour directly on 3D triangle meshes with mesh colors (no UV map).
 ///
@@ -206,12 +206,12 @@ fn info(path: &Path, resolution: u64, json: bool) -> Result<()> {
     if !is_packed_file(path)? {
         // Counts need the welded topology only, not the samples: stay cheap at any R.
         let resolution = Resolution::new(resolution).context("--resolution")?;
-        let scene = meshpaint::import::import_gltf(path)?;
+        let scene = meshpaint::mesh::import::import_gltf(path)?;
         for warning in &scene.warnings {
             log::warn!("{}: {warning}", path.display());
         }
-        let mesh = meshpaint::weld::weld_scene(&scene);
-        let topology = meshpaint::topology::Topology::build(mesh.positions_world.len() as u32, &mesh.triangles)
+        let mesh = meshpaint::mesh::weld::weld_scene(&scene);
+        let topology = meshpaint::mesh::topology::Topology::build(mesh.positions_world.len() as u32, &mesh.triangles)
             .with_context(|| format!("{}: building topology", path.display()))?;
         let stats = MeshStats::new(&topology, mesh.degenerate_triangles_dropped, resolution);
         if json {
@@ -257,7 +257,7 @@ fn bench(what: BenchCommand) -> Result<()> {
             let formats = if format.is_empty() { ColorFormat::ALL.to_vec() } else { format };
             let mut results = Vec::new();
             for format in formats {
-                let result = meshpaint::bench::bench_pack(&document, format, runs)?;
+                let result = meshpaint::bench::pack::bench_pack(&document, format, runs)?;
                 results.push(result.to_json());
             }
             let report = serde_json::json!({
@@ -273,8 +273,8 @@ fn bench(what: BenchCommand) -> Result<()> {
         }
         BenchCommand::Paint { file, resolution, dabs, json } => {
             let document = open(&file, resolution)?;
-            let options = meshpaint::brush::PaintBenchOptions { dabs, ..Default::default() };
-            let mut report = meshpaint::brush::bench_paint(&document, &options)?;
+            let options = meshpaint::bench::PaintBenchOptions { dabs, ..Default::default() };
+            let mut report = meshpaint::bench::bench_paint(&document, &options)?;
             report["file"] = file.display().to_string().into();
             report["resolution"] = resolution.into();
             if json {
@@ -286,7 +286,7 @@ fn bench(what: BenchCommand) -> Result<()> {
         }
         BenchCommand::Render { file, resolution, width, height, frames } => {
             let document = open(&file, resolution)?;
-            let result = meshpaint::render::bench_render(&file, &document, width, height, frames)?;
+            let result = meshpaint::bench::bench_render(&file, &document, width, height, frames)?;
             let mut report = result.to_json();
             report["file"] = file.display().to_string().into();
             report["resolution"] = resolution.into();
@@ -438,7 +438,7 @@ fn export(path: &Path, resolution: u64, format: Option<ColorFormat>, output: &Pa
     }
     let document = open(path, resolution)?;
     if extension.as_deref() == Some("glb") {
-        let summary = meshpaint::export_gltf::write_tessellated_glb(output, &document.positions, &document.store)
+        let summary = meshpaint::io::export_gltf::write_tessellated_glb(output, &document.positions, &document.store)
             .with_context(|| format!("exporting {}", path.display()))?;
         eprintln!(
             "{} → {}: {} faces, {} vertices (one per sample), {} triangles, {} B",
@@ -487,13 +487,13 @@ struct PaintArgs {
     strength: f32,
     /// Falloff: smooth, linear, constant or sharp.
     #[arg(long, default_value = "smooth", value_parser = parse_falloff)]
-    falloff: meshpaint::brush::Falloff,
+    falloff: meshpaint::paint::brush::Falloff,
     /// Distance between dabs, percent of the radius.
     #[arg(long, default_value_t = 10.0)]
     spacing: f64,
     /// Blend mode: mix, add, multiply or erase (back to the colours before the stroke).
     #[arg(long, default_value = "mix", value_parser = parse_blend)]
-    blend: meshpaint::brush::BlendMode,
+    blend: meshpaint::paint::brush::BlendMode,
     /// Tool: paint, blur, raise / lower (face resolution), or set (to --target-resolution).
     #[arg(long, value_enum, default_value_t = PaintTool::Paint)]
     tool: PaintTool,
@@ -545,25 +545,25 @@ enum PaintTool {
     Set,
 }
 
-fn parse_falloff(name: &str) -> Result<meshpaint::brush::Falloff, String> {
-    meshpaint::brush::Falloff::from_name(name)
+fn parse_falloff(name: &str) -> Result<meshpaint::paint::brush::Falloff, String> {
+    meshpaint::paint::brush::Falloff::from_name(name)
         .ok_or_else(|| format!("unknown falloff '{name}' (smooth, linear, constant, sharp)"))
 }
 
-fn parse_blend(name: &str) -> Result<meshpaint::brush::BlendMode, String> {
-    meshpaint::brush::BlendMode::from_name(name)
+fn parse_blend(name: &str) -> Result<meshpaint::paint::brush::BlendMode, String> {
+    meshpaint::paint::brush::BlendMode::from_name(name)
         .ok_or_else(|| format!("unknown blend mode '{name}' (mix, add, multiply, erase)"))
 }
 
 /// `meshpaint paint`: one stroke replayed through the editor's brush code.
 fn paint(args: PaintArgs) -> Result<()> {
-    use meshpaint::brush::{BrushRadius, BrushSettings, PaintView, Painter, ResolutionOp, Tool};
+    use meshpaint::paint::brush::{BrushRadius, BrushSettings, PaintView, Painter, ResolutionOp, Tool};
     let extension = args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if extension.as_deref() == Some("gltf") {
         anyhow::bail!("{}: glTF output is written as binary glTF only; name the output .glb", args.output.display());
     }
-    let stroke = meshpaint::brush::parse_stroke(&args.stroke).map_err(|e| anyhow::anyhow!("--stroke: {e}"))?;
-    let color = meshpaint::brush::parse_hex_color(&args.color)
+    let stroke = meshpaint::paint::brush::parse_stroke(&args.stroke).map_err(|e| anyhow::anyhow!("--stroke: {e}"))?;
+    let color = meshpaint::paint::brush::parse_hex_color(&args.color)
         .with_context(|| format!("--color '{}' is not #rrggbb", args.color))?;
     if let Some(distance) = args.distance {
         anyhow::ensure!(distance.is_finite() && distance > 0.0, "--distance must be a positive number");
@@ -601,10 +601,10 @@ fn paint(args: PaintArgs) -> Result<()> {
     let started = std::time::Instant::now();
     let mut document = open(&args.file, args.resolution)?;
     let camera = meshpaint::render::default_camera(&document.positions, args.yaw, args.pitch, args.distance);
-    let bvh = meshpaint::picking::MeshBvh::build(
+    let bvh = meshpaint::paint::picking::MeshBvh::build(
         &document.positions,
         &document.store.topology().face_vertices,
-        meshpaint::picking::BvhPreset::default(),
+        meshpaint::paint::picking::BvhPreset::default(),
     );
     let base = document.store.clone();
     let view = PaintView {
@@ -616,12 +616,13 @@ fn paint(args: PaintArgs) -> Result<()> {
     };
     let mut painter = Painter::new(&document.positions);
     painter.set_settings(settings);
-    let mut history = meshpaint::undo::UndoHistory::default();
-    let (update, _) = meshpaint::brush::replay_stroke(&mut painter, &view, &mut document.store, &mut history, &stroke)?;
+    let mut history = meshpaint::paint::undo::UndoHistory::default();
+    let (update, _) =
+        meshpaint::paint::brush::replay_stroke(&mut painter, &view, &mut document.store, &mut history, &stroke)?;
 
     if extension.as_deref() == Some("glb") {
         anyhow::ensure!(args.format.is_none(), "--format applies to packed output only");
-        meshpaint::export_gltf::write_tessellated_glb(&args.output, &document.positions, &document.store)
+        meshpaint::io::export_gltf::write_tessellated_glb(&args.output, &document.positions, &document.store)
             .with_context(|| format!("exporting {}", args.file.display()))?;
     } else {
         let format = match (args.format, document.source) {
@@ -681,21 +682,22 @@ fn autosave_soak(args: SoakArgs) -> Result<()> {
     let last = args.start_generation.saturating_add(args.iterations.saturating_sub(1));
     loop {
         let marker = generation as f32;
-        document.store.set(meshpaint::store::SampleRef::Vertex(0), [marker, 0.0, 0.0, 1.0]);
+        document.store.set(meshpaint::colors::store::SampleRef::Vertex(0), [marker, 0.0, 0.0, 1.0]);
         for face in (0..document.store.topology().face_count()).step_by(7) {
             let len = document.store.interior_samples(face).len() as u32;
             for offset in 0..len {
                 let shade = ((generation + u64::from(offset)) % 17) as f32 / 16.0;
-                document
-                    .store
-                    .set(meshpaint::store::SampleRef::Interior { face, offset }, [shade, 0.5, 1.0 - shade, 1.0]);
+                document.store.set(
+                    meshpaint::colors::store::SampleRef::Interior { face, offset },
+                    [shade, 0.5, 1.0 - shade, 1.0],
+                );
             }
         }
-        meshpaint::autosave::write_recovery(&args.recovery, &document)?;
+        meshpaint::io::autosave::write_recovery(&args.recovery, &document)?;
         writeln!(stdout, "recovery {generation}")?;
         stdout.flush()?;
         if generation.is_multiple_of(3) {
-            let packed = document.pack(meshpaint::autosave::RECOVERY_FORMAT)?;
+            let packed = document.pack(meshpaint::io::autosave::RECOVERY_FORMAT)?;
             packed_file::write_file(&args.saved, &packed)?;
             writeln!(stdout, "saved {generation}")?;
             stdout.flush()?;

@@ -255,14 +255,14 @@ fn export_gltf_through_the_dialog_writes_a_glb() {
     // Save as a packed file, then open it again: same triangles, Save now writes there.
     let project = dir.join("duck.mpk");
     let _ = std::fs::remove_file(&project);
-    harness.state_mut().save_to(project.clone(), meshpaint::color::ColorFormat::Rgba16F);
+    harness.state_mut().save_to(project.clone(), meshpaint::colors::format::ColorFormat::Rgba16F);
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
     assert_eq!(harness.state().document.as_ref().unwrap().project_path.as_deref(), Some(project.as_path()));
     harness.state_mut().open(Source::File(project.clone()));
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
     let open = harness.state().document.as_ref().unwrap();
     assert_eq!(open.triangles(), 4212);
-    assert_eq!(open.format, meshpaint::color::ColorFormat::Rgba16F);
+    assert_eq!(open.format, meshpaint::colors::format::ColorFormat::Rgba16F);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -444,18 +444,18 @@ fn paint_panel_changes_the_brush_settings() {
     assert!(!harness.state().brush.occlusion);
     harness.get_by_label("Blur").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().brush.tool, meshpaint::brush::Tool::Blur);
+    assert_eq!(harness.state().brush.tool, meshpaint::paint::brush::Tool::Blur);
     harness.get_by_label("Colour").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().brush.tool, meshpaint::brush::Tool::Paint);
+    assert_eq!(harness.state().brush.tool, meshpaint::paint::brush::Tool::Paint);
     harness.get_by_value("Mix").click();
     harness.run_steps(2);
     harness.get_by_label("Erase to base").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().brush.blend, meshpaint::brush::BlendMode::EraseToBase);
+    assert_eq!(harness.state().brush.blend, meshpaint::paint::brush::BlendMode::EraseToBase);
     harness.get_by_label("world").click();
     harness.run_steps(2);
-    assert!(matches!(harness.state().brush.radius, meshpaint::brush::BrushRadius::World { .. }));
+    assert!(matches!(harness.state().brush.radius, meshpaint::paint::brush::BrushRadius::World { .. }));
 }
 
 #[test]
@@ -505,7 +505,7 @@ fn f_and_shift_f_set_radius_and_strength_interactively() {
     harness.run_steps(1);
     harness.key_press(egui::Key::Enter);
     harness.run_steps(2);
-    let meshpaint::brush::BrushRadius::Pixels { radius_px } = harness.state().brush.radius else {
+    let meshpaint::paint::brush::BrushRadius::Pixels { radius_px } = harness.state().brush.radius else {
         panic!("the radius is not in pixels");
     };
     assert!((radius_px - 80.0).abs() < 1.0, "radius {radius_px} px after moving 50 px out from 30 px");
@@ -533,7 +533,7 @@ fn resolution_brush_and_set_r_for_all_change_face_resolutions() {
     harness.run_steps(2);
     harness.get_by_label("Resolution").click();
     harness.run_steps(2);
-    assert!(matches!(harness.state().brush.tool, meshpaint::brush::Tool::Resolution(_)));
+    assert!(matches!(harness.state().brush.tool, meshpaint::paint::brush::Tool::Resolution(_)));
     let center = harness.state().viewport.rect.center();
     left_drag(&mut harness, center - egui::vec2(30.0, 0.0), center + egui::vec2(30.0, 0.0));
     let resolutions = |editor: &Editor| editor.document.as_ref().unwrap().document.store.face_resolutions().to_vec();

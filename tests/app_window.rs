@@ -134,7 +134,8 @@ fn crop(image: &RgbImage, (x, y, w, h): (u32, u32, u32, u32)) -> RgbImage {
 
 /// The background's sRGB bytes.
 fn background() -> [u8; 3] {
-    let [r, g, b, _] = meshpaint::render::RenderSettings::DEFAULT_BACKGROUND.map(meshpaint::color::encode_srgb8);
+    let [r, g, b, _] =
+        meshpaint::render::RenderSettings::DEFAULT_BACKGROUND.map(meshpaint::colors::format::encode_srgb8);
     [r, g, b]
 }
 
@@ -314,7 +315,7 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     let bytes = std::fs::read(&exported).expect("no exported file");
     assert_eq!(&bytes[..4], b"glTF");
     assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize, bytes.len());
-    let scene = meshpaint::import::import_gltf(&exported).expect("the exported .glb does not load");
+    let scene = meshpaint::mesh::import::import_gltf(&exported).expect("the exported .glb does not load");
     assert_eq!(scene.instanced_triangle_count(), 4212 * 8 * 8, "R = 8: R² triangles per face");
 
     // 4. Open a broken file (Ctrl+O): the error shows, the Duck stays, the app runs on.
@@ -389,8 +390,8 @@ fn distance_to_segment(p: (f64, f64), a: (f64, f64), b: (f64, f64)) -> f64 {
 
 /// Every sample of `document` with its world position.
 fn samples_with_positions(
-    document: &meshpaint::document::Document,
-) -> Vec<(meshpaint::store::SampleRef, [f32; 4], glam::DVec3)> {
+    document: &meshpaint::io::document::Document,
+) -> Vec<(meshpaint::colors::store::SampleRef, [f32; 4], glam::DVec3)> {
     let store = &document.store;
     let mut out = Vec::new();
     store.for_each_site(|site| {
@@ -505,15 +506,15 @@ fn paint_mode_stroke_lands_under_the_cursor_and_is_saved() {
     assert!(!log.contains("panicked"), "{log}");
 
     // The saved colours differ from the original only under the stroke.
-    let r8 = meshpaint::layout::Resolution::new(8).unwrap();
-    let painted = meshpaint::document::Document::open(&saved, r8).expect("the saved file does not open");
+    let r8 = meshpaint::colors::layout::Resolution::new(8).unwrap();
+    let painted = meshpaint::io::document::Document::open(&saved, r8).expect("the saved file does not open");
     let format = match painted.source {
-        meshpaint::document::SourceKind::Packed(format) => format,
+        meshpaint::io::document::SourceKind::Packed(format) => format,
         other => panic!("the saved file is not packed: {other:?}"),
     };
-    let original = meshpaint::document::Document::open(&asset, r8).unwrap();
+    let original = meshpaint::io::document::Document::open(&asset, r8).unwrap();
     // Quantise the original exactly as the save did.
-    let original = meshpaint::document::Document::from_packed(&original.pack(format).unwrap()).unwrap();
+    let original = meshpaint::io::document::Document::from_packed(&original.pack(format).unwrap()).unwrap();
     let before = samples_with_positions(&original);
     let after = samples_with_positions(&painted);
     assert_eq!(before.len(), after.len(), "the sample count changed");

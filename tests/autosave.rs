@@ -9,12 +9,12 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use meshpaint::autosave::{self, Autosaver};
-use meshpaint::color::{ColorFormat, Rgba};
-use meshpaint::document::Document;
-use meshpaint::layout::Resolution;
-use meshpaint::packed_file;
-use meshpaint::store::{ColorStore, SampleRef};
+use meshpaint::colors::format::{ColorFormat, Rgba};
+use meshpaint::colors::layout::Resolution;
+use meshpaint::colors::store::{ColorStore, SampleRef};
+use meshpaint::io::autosave::{self, Autosaver};
+use meshpaint::io::document::Document;
+use meshpaint::packing::file as packed_file;
 
 const BIN: &str = env!("CARGO_BIN_EXE_meshpaint");
 

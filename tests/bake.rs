@@ -7,14 +7,14 @@
 
 use std::path::Path;
 
-use meshpaint::bake::{TexturePyramid, bake_texture, has_base_color};
-use meshpaint::color::{Rgba, decode_rgba8_srgb, linear_to_srgb};
-use meshpaint::document::Document;
-use meshpaint::layout::Resolution;
-use meshpaint::scene::{Material, Scene, Texture};
-use meshpaint::store::{ColorStore, SampleRef};
-use meshpaint::topology::Topology;
-use meshpaint::weld::{WeldedMesh, weld_scene};
+use meshpaint::colors::format::{Rgba, decode_rgba8_srgb, linear_to_srgb};
+use meshpaint::colors::layout::Resolution;
+use meshpaint::colors::store::{ColorStore, SampleRef};
+use meshpaint::io::bake::{TexturePyramid, bake_texture, has_base_color};
+use meshpaint::io::document::Document;
+use meshpaint::mesh::scene::{Material, Scene, Texture};
+use meshpaint::mesh::topology::Topology;
+use meshpaint::mesh::weld::{WeldedMesh, weld_scene};
 
 fn r(value: u64) -> Resolution {
     Resolution::new(value).unwrap()
@@ -365,7 +365,7 @@ fn baked_mean(store: &ColorStore) -> [f64; 3] {
 }
 
 fn bake_asset(relative: &str, resolution: u64) -> (WeldedMesh, Scene, ColorStore) {
-    let scene = meshpaint::import::import_gltf(&asset(relative)).unwrap();
+    let scene = meshpaint::mesh::import::import_gltf(&asset(relative)).unwrap();
     let mesh = weld_scene(&scene);
     let store = baked(&mesh, &scene, resolution);
     (mesh, scene, store)
@@ -412,7 +412,7 @@ fn document_open_bakes_textured_models() {
     // Cubes: factor-only materials, one colour per face.
     let path = asset("Cubes/Cubes.glb");
     let document = Document::open(&path, r(2)).unwrap();
-    let scene = meshpaint::import::import_gltf(&path).unwrap();
+    let scene = meshpaint::mesh::import::import_gltf(&path).unwrap();
     let mesh = weld_scene(&scene);
     document.store.for_each_site(|site| {
         let material = mesh.triangle_materials[site.face as usize].unwrap();
@@ -423,9 +423,9 @@ fn document_open_bakes_textured_models() {
     // Suzanne has no material: the position colour field stays.
     let path = asset("Suzanne/monkey.glb");
     let document = Document::open(&path, r(2)).unwrap();
-    let (min, size) = meshpaint::document::bounds(&document.positions);
+    let (min, size) = meshpaint::io::document::bounds(&document.positions);
     for v in 0..document.positions.len() as u32 {
-        let expected = meshpaint::document::position_color(document.positions[v as usize], min, size);
+        let expected = meshpaint::io::document::position_color(document.positions[v as usize], min, size);
         let got = document.store.vertex_color(v).unwrap();
         assert!((0..4).all(|c| (got[c] - expected[c]).abs() < 1e-6), "vertex {v}: {got:?} vs {expected:?}");
     }

@@ -10,17 +10,17 @@
 use std::collections::HashMap;
 
 use glam::DVec3;
-use meshpaint::brush::{
+use meshpaint::camera::{BoundingSphere, OrbitCamera};
+use meshpaint::colors::format::{ColorFormat, Rgba};
+use meshpaint::colors::layout::Resolution;
+use meshpaint::colors::store::{ColorStore, SampleRef};
+use meshpaint::mesh::topology::Topology;
+use meshpaint::packing::packer;
+use meshpaint::paint::brush::{
     self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, ResolutionOp, Tool,
 };
-use meshpaint::camera::{BoundingSphere, OrbitCamera};
-use meshpaint::color::{ColorFormat, Rgba};
-use meshpaint::layout::Resolution;
-use meshpaint::packer;
-use meshpaint::picking::{BvhPreset, MeshBvh};
-use meshpaint::store::{ColorStore, SampleRef};
-use meshpaint::topology::Topology;
-use meshpaint::undo::UndoHistory;
+use meshpaint::paint::picking::{BvhPreset, MeshBvh};
+use meshpaint::paint::undo::UndoHistory;
 
 type Mesh = (Vec<[f32; 3]>, Vec<[u32; 3]>);
 
@@ -396,7 +396,8 @@ fn erase_to_base_restores_the_snapshot_even_after_a_resolution_change() {
         for j in 0..=8 - i {
             let bary = [(8 - i - j) as f32 / 8.0, i as f32 / 8.0, j as f32 / 8.0];
             let expected =
-                meshpaint::sampler::sample(&base, face, bary, meshpaint::sampler::Filter::Linear, 0).unwrap();
+                meshpaint::packing::sampler::sample(&base, face, bary, meshpaint::packing::sampler::Filter::Linear, 0)
+                    .unwrap();
             let now = store.face_sample(face, i, j).unwrap();
             for c in 0..4 {
                 assert!((now[c] - expected[c]).abs() < 1e-6, "({i},{j}) of face {face} corners {corners:?}");
@@ -664,7 +665,7 @@ fn blur_moves_samples_towards_their_neighbour_mean() {
         let SampleRef::Interior { offset, .. } = sample else {
             continue;
         };
-        let (i, j) = meshpaint::layout::interior_sample_at(r(16), offset).unwrap();
+        let (i, j) = meshpaint::colors::layout::interior_sample_at(r(16), offset).unwrap();
         let neighbours = [(i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1), (i + 1, j - 1), (i - 1, j + 1)];
         let w = f64::from(strength) * (1.0 - d / 0.6);
         for c in 0..4 {
@@ -905,9 +906,9 @@ fn the_paint_command_replays_strokes_like_the_library() {
         .status()
         .unwrap();
     assert!(status.success());
-    let from_cli = meshpaint::packed_file::read_file(&output).unwrap();
+    let from_cli = meshpaint::packing::file::read_file(&output).unwrap();
 
-    let mut document = meshpaint::document::Document::open(&input, r(4)).unwrap();
+    let mut document = meshpaint::io::document::Document::open(&input, r(4)).unwrap();
     let camera = meshpaint::render::default_camera(&document.positions, 40.0, -10.0, None);
     let bvh = MeshBvh::build(&document.positions, &document.store.topology().face_vertices, BvhPreset::FastBuild);
     let base = document.store.clone();
@@ -938,7 +939,7 @@ fn the_paint_command_replays_strokes_like_the_library() {
         .status()
         .unwrap();
     assert!(status.success());
-    assert!(meshpaint::import::import_gltf(&glb).is_ok());
+    assert!(meshpaint::mesh::import::import_gltf(&glb).is_ok());
     for bad in [
         vec!["--stroke", "1,2,3"],
         vec!["--stroke", "1,2", "--color", "red"],

@@ -13,14 +13,14 @@ use std::process::Command;
 use std::sync::Mutex;
 
 use glam::Mat4;
-use meshpaint::document::Document;
-use meshpaint::export_gltf::{ExportError, GENERATOR, export_tessellated_glb, write_tessellated_glb};
-use meshpaint::import::{import_gltf, import_gltf_slice};
-use meshpaint::layout::Resolution;
-use meshpaint::sampler::{Filter, sample};
-use meshpaint::scene::SourceMesh;
-use meshpaint::store::{ColorStore, SampleRef};
-use meshpaint::topology::Topology;
+use meshpaint::colors::layout::Resolution;
+use meshpaint::colors::store::{ColorStore, SampleRef};
+use meshpaint::io::document::Document;
+use meshpaint::io::export_gltf::{ExportError, GENERATOR, export_tessellated_glb, write_tessellated_glb};
+use meshpaint::mesh::import::{import_gltf, import_gltf_slice};
+use meshpaint::mesh::scene::SourceMesh;
+use meshpaint::mesh::topology::Topology;
+use meshpaint::packing::sampler::{Filter, sample};
 use serde_json::{Value, json};
 
 fn r(value: u64) -> Resolution {
@@ -664,7 +664,7 @@ fn out_of_range_colours_are_clamped() {
 
 #[test]
 fn cli_exports_glb_and_packed_files() {
-    use meshpaint::packed_file;
+    use meshpaint::packing::file as packed_file;
     const BIN: &str = env!("CARGO_BIN_EXE_meshpaint");
     let dir = TempDir::new("cli");
     let input = model("BoxTextured/BoxTextured.glb");
@@ -688,7 +688,7 @@ fn cli_exports_glb_and_packed_files() {
         run(&["export".as_ref(), input.as_os_str(), "-o".as_ref(), packed.as_os_str(), "-r".as_ref(), "2".as_ref()]);
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     let mesh = packed_file::read_file(&packed).unwrap();
-    assert_eq!(mesh.format, meshpaint::color::ColorFormat::Rgba8Srgb);
+    assert_eq!(mesh.format, meshpaint::colors::format::ColorFormat::Rgba8Srgb);
     assert_eq!(mesh.face_records.len(), 12);
     let packed16 = dir.join("box16.mpk");
     let args = [
@@ -700,7 +700,7 @@ fn cli_exports_glb_and_packed_files() {
         "rgba16f".as_ref(),
     ];
     assert!(run(&args).status.success());
-    assert_eq!(packed_file::read_file(&packed16).unwrap().format, meshpaint::color::ColorFormat::Rgba16F);
+    assert_eq!(packed_file::read_file(&packed16).unwrap().format, meshpaint::colors::format::ColorFormat::Rgba16F);
 
     // A packed file exports to .glb too (its own per-face resolutions, here R = 2).
     let from_packed = dir.join("from_packed.glb");
@@ -904,16 +904,16 @@ fn bad_color_0_accessors_are_refused() {
 
 #[test]
 fn exported_glb_reopens_in_meshpaint_with_the_sample_colours_at_its_vertices() {
-    use meshpaint::document::Document;
-    use meshpaint::layout::Resolution;
+    use meshpaint::colors::layout::Resolution;
+    use meshpaint::io::document::Document;
     let source = Document::open(
         &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Duck/Duck.glb"),
         Resolution::new(4).unwrap(),
     )
     .unwrap();
-    let tessellation = meshpaint::export_gltf::tessellate(&source.positions, &source.store).unwrap();
+    let tessellation = meshpaint::io::export_gltf::tessellate(&source.positions, &source.store).unwrap();
     let path = std::env::temp_dir().join(format!("meshpaint-reopen-{}.glb", std::process::id()));
-    meshpaint::export_gltf::write_tessellated_glb(&path, &source.positions, &source.store).unwrap();
+    meshpaint::io::export_gltf::write_tessellated_glb(&path, &source.positions, &source.store).unwrap();
     let reopened = Document::open(&path, Resolution::ONE).unwrap();
     std::fs::remove_file(&path).ok();
     // The exporter writes one vertex per sample; welding keeps them apart (distinct positions).

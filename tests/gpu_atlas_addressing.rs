@@ -13,12 +13,12 @@
 
 use glam::DVec3;
 use meshpaint::camera::{BoundingSphere, OrbitCamera};
-use meshpaint::color::ColorFormat;
-use meshpaint::packed::{FaceRecord, PackedMesh, pack_word};
+use meshpaint::colors::format::ColorFormat;
+use meshpaint::packing::linear::{FaceRecord, PackedMesh, pack_word};
+use meshpaint::packing::sampler::packed_sample_index;
 use meshpaint::render::{
     DrawItem, FilterMode, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderSettings, Renderer, Shading,
 };
-use meshpaint::sampler::packed_sample_index;
 
 const SIZE: u32 = 256;
 const GRID: u32 = 8;

@@ -3,7 +3,7 @@
 //!
 //! Truth per pixel: the ray through the pixel centre (`OrbitCamera::ray_through_pixel`) is
 //! intersected with every triangle in `f64` (no BVH: a handful of triangles), giving the face
-//! and its barycentrics; `meshpaint::sampler::sample` on the same `PackedMesh` gives the
+//! and its barycentrics; `meshpaint::packing::sampler::sample` on the same `PackedMesh` gives the
 //! colour, encoded to sRGB8 as the render target does. Errors are reported in 8-bit steps.
 //! Pixels whose centre lies within a margin of a triangle edge are skipped (coverage rules),
 //! and for nearest filtering so are pixels within 1e-3 lattice units of a cell boundary.
@@ -17,16 +17,16 @@ use std::sync::OnceLock;
 use glam::DVec3;
 use image::RgbaImage;
 use meshpaint::camera::{BoundingSphere, OrbitCamera};
-use meshpaint::color::{ColorFormat, encode_rgba8_srgb};
-use meshpaint::layout::{self, Resolution};
-use meshpaint::packed::PackedMesh;
-use meshpaint::packer::pack;
+use meshpaint::colors::format::{ColorFormat, encode_rgba8_srgb};
+use meshpaint::colors::layout::{self, Resolution};
+use meshpaint::colors::store::ColorStore;
+use meshpaint::mesh::topology::Topology;
+use meshpaint::packing::linear::PackedMesh;
+use meshpaint::packing::packer::pack;
+use meshpaint::packing::sampler::{Filter, sample};
 use meshpaint::render::{
     DrawItem, FilterMode, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderSettings, Renderer, Shading,
 };
-use meshpaint::sampler::{Filter, sample};
-use meshpaint::store::ColorStore;
-use meshpaint::topology::Topology;
 
 const SIZE: u32 = 256;
 /// Largest allowed per-channel difference in 8-bit steps.
@@ -650,11 +650,11 @@ fn mesh_colors_and_the_uv_baseline_look_alike() {
     use meshpaint::render::{BaselineMesh, default_camera};
     let gpu = gpu();
     let path = model("Duck/Duck.glb");
-    let document = meshpaint::document::Document::open(&path, r(16)).unwrap();
+    let document = meshpaint::io::document::Document::open(&path, r(16)).unwrap();
     let packed = document.pack(ColorFormat::Rgba8Srgb).unwrap();
     let mesh = upload(&packed, None);
-    let scene = meshpaint::import::import_gltf(&path).unwrap();
-    let welded = meshpaint::weld::weld_scene(&scene);
+    let scene = meshpaint::mesh::import::import_gltf(&path).unwrap();
+    let welded = meshpaint::mesh::weld::weld_scene(&scene);
     let (material, texture) =
         scene.materials.iter().find_map(|m| Some((m, scene.textures.get(m.base_color_texture? as usize)?))).unwrap();
     let baseline = BaselineMesh::new(
@@ -756,10 +756,10 @@ fn atlas_layout_wraps_rows_and_refuses_what_does_not_fit() {
     assert_eq!(atlas.texel(999), (999 % 61, 999 / 61));
     assert_eq!(AtlasLayout::new(0, 16384, 16384).unwrap().height, 1, "an empty buffer still gets one row");
     // 2^28 samples (MAX_SAMPLES) fill a 16384² atlas exactly; one more does not fit.
-    let full = AtlasLayout::new(meshpaint::packed::MAX_SAMPLES, 16384, 16384).unwrap();
+    let full = AtlasLayout::new(meshpaint::packing::linear::MAX_SAMPLES, 16384, 16384).unwrap();
     assert_eq!(full.height, 16384);
     assert!(matches!(
-        AtlasLayout::new(meshpaint::packed::MAX_SAMPLES + 1, 16384, 16384),
+        AtlasLayout::new(meshpaint::packing::linear::MAX_SAMPLES + 1, 16384, 16384),
         Err(RenderError::AtlasTooLarge { .. })
     ));
     assert!(matches!(AtlasLayout::new(10, 0, 16384), Err(RenderError::InvalidAtlasWidth { .. })));

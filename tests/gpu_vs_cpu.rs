@@ -6,18 +6,18 @@
 //! These tests fail (never skip) when no GPU adapter is found.
 
 use meshpaint::camera::{BoundingSphere, OrbitCamera};
-use meshpaint::color::{ColorFormat, encode_srgb8};
-use meshpaint::document::Document;
-use meshpaint::import::import_gltf;
-use meshpaint::layout::{self, Resolution};
-use meshpaint::packed::PackedMesh;
-use meshpaint::picking::{BvhPreset, MeshBvh};
+use meshpaint::colors::format::{ColorFormat, encode_srgb8};
+use meshpaint::colors::layout::{self, Resolution};
+use meshpaint::io::document::Document;
+use meshpaint::mesh::import::import_gltf;
+use meshpaint::mesh::weld::weld_scene;
+use meshpaint::packing::linear::PackedMesh;
+use meshpaint::packing::sampler::{Filter, sample};
+use meshpaint::paint::picking::{BvhPreset, MeshBvh};
 use meshpaint::render::{
     BaselineMesh, DrawItem, FilterMode, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderSettings,
     Renderer, Shading,
 };
-use meshpaint::sampler::{Filter, sample};
-use meshpaint::weld::weld_scene;
 
 const SIZE: u32 = 256;
 

@@ -8,8 +8,8 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use glam::{Mat4, Vec3};
-use meshpaint::import::{ImportError, import_gltf, import_gltf_slice};
-use meshpaint::scene::Scene;
+use meshpaint::mesh::import::{ImportError, import_gltf, import_gltf_slice};
+use meshpaint::mesh::scene::Scene;
 
 fn manifest() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

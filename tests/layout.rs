@@ -7,8 +7,8 @@
 
 use std::collections::HashMap;
 
-use meshpaint::layout::*;
-use meshpaint::topology::Topology;
+use meshpaint::colors::layout::*;
+use meshpaint::mesh::topology::Topology;
 
 fn all_resolutions() -> impl Iterator<Item = Resolution> {
     (0..=MAX_LOG2_RESOLUTION).map(|k| Resolution::from_log2(k).unwrap())

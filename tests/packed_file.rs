@@ -6,12 +6,12 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use meshpaint::color::ColorFormat;
-use meshpaint::layout::{Resolution, edge_chain_len, interior_chain_len};
-use meshpaint::packed::{FaceRecord, PackedMesh, pack_word};
-use meshpaint::packed_file::{
+use meshpaint::colors::format::ColorFormat;
+use meshpaint::colors::layout::{Resolution, edge_chain_len, interior_chain_len};
+use meshpaint::packing::file::{
     MAGIC, PackedFileError, VERSION, from_bytes, looks_like_packed, read_file, to_bytes, write_file,
 };
+use meshpaint::packing::linear::{FaceRecord, PackedMesh, pack_word};
 
 // Header field offsets (docs/FORMAT.md).
 const VERSION_AT: usize = 8;

@@ -7,13 +7,13 @@
 
 mod common;
 use common::{Rng, octahedron};
-use meshpaint::color::{ColorFormat, Rgba, decode_rgba8_srgb, encode_rgba8_srgb};
-use meshpaint::layout::{self, Resolution};
-use meshpaint::packed::PackedMesh;
-use meshpaint::packer::{PackError, pack, unpack};
-use meshpaint::sampler::{Filter, MeshColorSource, packed_sample_index, sample};
-use meshpaint::store::{ColorStore, SampleRef};
-use meshpaint::topology::Topology;
+use meshpaint::colors::format::{ColorFormat, Rgba, decode_rgba8_srgb, encode_rgba8_srgb};
+use meshpaint::colors::layout::{self, Resolution};
+use meshpaint::colors::store::{ColorStore, SampleRef};
+use meshpaint::mesh::topology::Topology;
+use meshpaint::packing::linear::PackedMesh;
+use meshpaint::packing::packer::{PackError, pack, unpack};
+use meshpaint::packing::sampler::{Filter, MeshColorSource, packed_sample_index, sample};
 
 fn r(value: u64) -> Resolution {
     Resolution::new(value).unwrap()
@@ -345,7 +345,7 @@ fn srgb8_encoding_rounds_to_the_nearest_code_in_encoded_space() {
     let mut mismatches = 0;
     for k in 0..=200_000u32 {
         let linear = k as f32 / 200_000.0;
-        let got = meshpaint::color::encode_srgb8(linear);
+        let got = meshpaint::colors::format::encode_srgb8(linear);
         let want = reference(f64::from(linear));
         if got != want {
             // Only values within float noise of a rounding boundary may differ.
@@ -354,14 +354,14 @@ fn srgb8_encoding_rounds_to_the_nearest_code_in_encoded_space() {
         }
     }
     assert!(mismatches < 20, "{mismatches} boundary mismatches");
-    assert_eq!(meshpaint::color::encode_srgb8(f32::NAN), 0);
-    assert_eq!(meshpaint::color::encode_srgb8(-1.0), 0);
-    assert_eq!(meshpaint::color::encode_srgb8(7.0), 255);
+    assert_eq!(meshpaint::colors::format::encode_srgb8(f32::NAN), 0);
+    assert_eq!(meshpaint::colors::format::encode_srgb8(-1.0), 0);
+    assert_eq!(meshpaint::colors::format::encode_srgb8(7.0), 255);
 }
 
 #[test]
 fn store_mip_sampling_matches_packed_sampling_at_every_level_within_quantisation() {
-    use meshpaint::sampler::StoreMips;
+    use meshpaint::packing::sampler::StoreMips;
     let (positions, store) = mixed_octahedron_store(21);
     let mips = StoreMips::new(&store).unwrap();
     let packed8 = pack(&store, &positions, ColorFormat::Rgba8Srgb).unwrap();

@@ -4,13 +4,13 @@
 
 mod common;
 use common::{Rng, octahedron};
-use meshpaint::color::ColorFormat;
-use meshpaint::layout::{self, Resolution};
-use meshpaint::packed::PackedMesh;
-use meshpaint::paint_layout::PaintLayout;
-use meshpaint::sampler::MeshColorSource;
-use meshpaint::store::{ColorStore, SampleRef};
-use meshpaint::topology::Topology;
+use meshpaint::colors::format::ColorFormat;
+use meshpaint::colors::layout::{self, Resolution};
+use meshpaint::colors::store::{ColorStore, SampleRef};
+use meshpaint::mesh::topology::Topology;
+use meshpaint::packing::linear::PackedMesh;
+use meshpaint::packing::paint_layout::PaintLayout;
+use meshpaint::packing::sampler::MeshColorSource;
 
 /// Every lattice point of every face reads the store's colour from the mirror buffer.
 fn assert_mirror_matches(mirror: &PackedMesh, store: &ColorStore) {

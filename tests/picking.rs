@@ -7,7 +7,7 @@ use std::path::Path;
 
 use glam::DVec3;
 use meshpaint::camera::{BoundingSphere, OrbitCamera};
-use meshpaint::picking::{BvhKind, BvhPreset, MeshBvh, RayHit};
+use meshpaint::paint::picking::{BvhKind, BvhPreset, MeshBvh, RayHit};
 
 type Mesh = (Vec<[f32; 3]>, Vec<[u32; 3]>);
 
@@ -163,8 +163,8 @@ fn sliver_prism(length: f32, width: f32) -> Mesh {
 
 fn duck() -> Mesh {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Duck/Duck.glb");
-    let scene = meshpaint::import::import_gltf(&path).unwrap();
-    let welded = meshpaint::weld::weld_scene(&scene);
+    let scene = meshpaint::mesh::import::import_gltf(&path).unwrap();
+    let welded = meshpaint::mesh::weld::weld_scene(&scene);
     (welded.positions_world, welded.triangles)
 }
 
@@ -691,8 +691,8 @@ fn edge_cases_of_the_query_api() {
 #[ignore = "a measurement, not a test: run with --release --ignored --nocapture"]
 fn bench_bvh_kinds() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Bunny144k/bunny.glb");
-    let scene = meshpaint::import::import_gltf(&path).unwrap();
-    let welded = meshpaint::weld::weld_scene(&scene);
+    let scene = meshpaint::mesh::import::import_gltf(&path).unwrap();
+    let welded = meshpaint::mesh::weld::weld_scene(&scene);
     let mesh = (welded.positions_world, welded.triangles);
     let (_, radius) = mesh_center_and_radius(&mesh);
     let probe = build(&mesh);

@@ -7,10 +7,10 @@
 
 mod common;
 use common::{Rng, octahedron};
-use meshpaint::color::Rgba;
-use meshpaint::layout::{self, Resolution};
-use meshpaint::store::{ColorStore, SampleRef};
-use meshpaint::topology::Topology;
+use meshpaint::colors::format::Rgba;
+use meshpaint::colors::layout::{self, Resolution};
+use meshpaint::colors::store::{ColorStore, SampleRef};
+use meshpaint::mesh::topology::Topology;
 
 fn r(value: u64) -> Resolution {
     Resolution::new(value).unwrap()

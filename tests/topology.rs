@@ -4,11 +4,11 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use glam::{Mat4, Vec3};
-use meshpaint::layout::Resolution;
-use meshpaint::scene::{Instance, Scene, SourceMesh};
-use meshpaint::stats::MeshStats;
-use meshpaint::topology::{INVALID, Topology, TopologyError};
-use meshpaint::weld::{WeldedMesh, weld_scene};
+use meshpaint::colors::layout::Resolution;
+use meshpaint::colors::stats::MeshStats;
+use meshpaint::mesh::scene::{Instance, Scene, SourceMesh};
+use meshpaint::mesh::topology::{INVALID, Topology, TopologyError};
+use meshpaint::mesh::weld::{WeldedMesh, weld_scene};
 
 /// Brute force: edges as a map from sorted vertex pair to incident face count.
 fn brute_force_edges(triangles: &[[u32; 3]]) -> BTreeMap<(u32, u32), usize> {

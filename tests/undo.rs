@@ -3,15 +3,15 @@
 //! and edge resolution bit for bit, redo reapplies exactly, a new step clears redo, the memory
 //! cap drops the oldest steps, and a step stores only the samples that changed.
 
-use meshpaint::brush::{self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter};
-use meshpaint::brush::{ResolutionOp, Tool};
 use meshpaint::camera::{BoundingSphere, OrbitCamera};
-use meshpaint::color::Rgba;
-use meshpaint::layout::Resolution;
-use meshpaint::picking::{BvhPreset, MeshBvh};
-use meshpaint::store::{ColorStore, SampleRef};
-use meshpaint::topology::Topology;
-use meshpaint::undo::{SAMPLE_RECORD_BYTES, UndoError, UndoHistory};
+use meshpaint::colors::format::Rgba;
+use meshpaint::colors::layout::Resolution;
+use meshpaint::colors::store::{ColorStore, SampleRef};
+use meshpaint::mesh::topology::Topology;
+use meshpaint::paint::brush::{self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter};
+use meshpaint::paint::brush::{ResolutionOp, Tool};
+use meshpaint::paint::picking::{BvhPreset, MeshBvh};
+use meshpaint::paint::undo::{SAMPLE_RECORD_BYTES, UndoError, UndoHistory};
 
 const WIDTH: u32 = 800;
 const HEIGHT: u32 = 600;

@@ -1,4 +1,4 @@
-//! Autosave and recovery in the editor, on top of [`crate::autosave`]: a periodic recovery
+//! Autosave and recovery in the editor, on top of [`crate::io::autosave`]: a periodic recovery
 //! write on a worker thread while there are unsaved edits, the recovery offer (restore /
 //! discard) when a document with a newer recovery file opens, and the settings.
 //!
@@ -9,8 +9,8 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use crate::autosave::{self, Autosaver, RecoveryInfo, RecoveryWrite};
-use crate::color::ColorFormat;
+use crate::colors::format::ColorFormat;
+use crate::io::autosave::{self, Autosaver, RecoveryInfo, RecoveryWrite};
 
 use super::editor::{Editor, JobOutput, Severity};
 use super::loaded::{OpenDocument, Source, human_bytes};

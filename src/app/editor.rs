@@ -1,7 +1,7 @@
 //! The editor's state and its per-frame UI: everything between the window shell
 //! ([`super::window`]) and the library.
 //!
-//! The editor holds the open document (the [`crate::document::Document`] with its colour
+//! The editor holds the open document (the [`crate::io::document::Document`] with its colour
 //! store side by side with its [`crate::render::GpuMesh`]), the camera, the view settings,
 //! the mode, the job runner and the status line. [`Editor::ui`] draws one frame of panels
 //! and the 3D view's area; input is handled in one place, [`super::input`]. It needs no
@@ -14,8 +14,8 @@ use std::time::{Duration, Instant};
 use glam::DVec3;
 
 use crate::camera::OrbitCamera;
-use crate::color::ColorFormat;
-use crate::layout::Resolution;
+use crate::colors::format::ColorFormat;
+use crate::colors::layout::Resolution;
 use crate::render::{FilterMode, Overlays, RenderSettings, Shading};
 
 use super::file_dialog::{DialogOutcome, DialogPurpose, FileDialog};
@@ -267,11 +267,11 @@ pub struct Editor {
     /// Set when the user asked to quit.
     pub quit_requested: bool,
     /// The brush settings (kept between paint sessions).
-    pub brush: crate::brush::BrushSettings,
+    pub brush: crate::paint::brush::BrushSettings,
     /// Paint mode's state while it is on.
     pub paint: Option<super::paint::PaintSession>,
     /// Undo / redo of paint mode, one step per stroke (cleared when another document opens).
-    pub history: crate::undo::UndoHistory,
+    pub history: crate::paint::undo::UndoHistory,
     /// The GPU mesh holds the paint layout (level 0 only): the filter is limited to level 0.
     pub gpu_paint_layout: bool,
     /// Bytes uploaded to the GPU during the previous frame.
@@ -327,9 +327,9 @@ impl Editor {
             scene_generation: 0,
             viewport_pointer: None,
             quit_requested: false,
-            brush: crate::brush::BrushSettings::default(),
+            brush: crate::paint::brush::BrushSettings::default(),
             paint: None,
-            history: crate::undo::UndoHistory::new(crate::undo::DEFAULT_CAP_BYTES),
+            history: crate::paint::undo::UndoHistory::new(crate::paint::undo::DEFAULT_CAP_BYTES),
             gpu_paint_layout: false,
             upload_bytes_last_frame: 0,
             upload_bytes_this_frame: 0,

@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::color::ColorFormat;
+use crate::colors::format::ColorFormat;
 
 /// What the dialog is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

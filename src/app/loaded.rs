@@ -1,5 +1,5 @@
 //! The open document as the editor holds it: the [`Document`] (its editable
-//! [`crate::store::ColorStore`]) side by side with its [`GpuMesh`] and picking BVH, and
+//! [`crate::colors::store::ColorStore`]) side by side with its [`GpuMesh`] and picking BVH, and
 //! the work that makes one (open a file, the built-in scene) or writes one (save, export).
 //!
 //! Everything here runs on a job's worker thread ([`super::jobs`]); the GPU upload too
@@ -12,10 +12,10 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 
 use crate::camera::BoundingSphere;
-use crate::color::ColorFormat;
-use crate::document::{Document, SourceKind};
-use crate::layout::Resolution;
-use crate::picking::{BvhPreset, MeshBvh};
+use crate::colors::format::ColorFormat;
+use crate::colors::layout::Resolution;
+use crate::io::document::{Document, SourceKind};
+use crate::paint::picking::{BvhPreset, MeshBvh};
 use crate::render::{GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, Renderer};
 
 use super::editor::thousands;
@@ -106,7 +106,7 @@ pub fn load(source: &Source, resolution: Resolution, gpu: Option<&Gpu>, job: &Jo
     job.progress(0.05, "reading and importing");
     let document = match source {
         Source::BuiltIn => {
-            let scene = crate::import::import_gltf_slice(DEFAULT_SCENE_GLB, None, "Duck.glb")?;
+            let scene = crate::mesh::import::import_gltf_slice(DEFAULT_SCENE_GLB, None, "Duck.glb")?;
             Document::from_scene(scene, resolution, Path::new(DEFAULT_SCENE_NAME))?
         }
         Source::File(path) => Document::open(path, resolution)?,
@@ -183,7 +183,7 @@ pub fn write_packed(document: &Document, format: ColorFormat, path: &Path, job: 
     let packed = document.pack(format).with_context(|| format!("packing for {}", path.display()))?;
     let repack = started.elapsed();
     job.progress(0.6, "writing");
-    crate::packed_file::write_file(path, &packed)?;
+    crate::packing::file::write_file(path, &packed)?;
     let bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     job.progress(1.0, "done");
     Ok(Written {
@@ -198,7 +198,7 @@ pub fn write_packed(document: &Document, format: ColorFormat, path: &Path, job: 
 /// Writes `document` tessellated at each face's resolution as a vertex-colour .glb.
 pub fn write_gltf(document: &Document, path: &Path, job: &JobContext) -> Result<Written> {
     job.progress(0.1, "tessellating");
-    let summary = crate::export_gltf::write_tessellated_glb(path, &document.positions, &document.store)
+    let summary = crate::io::export_gltf::write_tessellated_glb(path, &document.positions, &document.store)
         .with_context(|| format!("exporting {}", path.display()))?;
     job.progress(1.0, "done");
     Ok(Written {

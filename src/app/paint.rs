@@ -4,21 +4,21 @@
 //! the brush cursor.
 //!
 //! Entering paint mode switches the GPU mesh to the paint layout
-//! ([`crate::paint_layout::PaintLayout`], level 0 only); leaving repacks the store into the
+//! ([`crate::packing::paint_layout::PaintLayout`], level 0 only); leaving repacks the store into the
 //! compact layout with MIP chains on a worker thread ([`Editor::leave_paint_mode`]).
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::brush::{
+use crate::colors::layout::Resolution;
+use crate::colors::store::ColorStore;
+use crate::io::document::Document;
+use crate::packing::paint_layout::PaintLayout;
+use crate::paint::brush::{
     self, BlendMode, BrushRadius, Falloff, FillScope, PaintView, Painter, ResolutionOp, StrokeUpdate, Tool,
 };
-use crate::document::Document;
-use crate::layout::Resolution;
-use crate::paint_layout::PaintLayout;
+use crate::paint::undo::UndoHistory;
 use crate::render::{GpuMesh, MeshUploadOptions};
-use crate::store::ColorStore;
-use crate::undo::UndoHistory;
 
 use super::editor::{Editor, JobOutput, Mode, Severity, thousands};
 use super::loaded::human_bytes;
@@ -402,7 +402,7 @@ impl Editor {
         match picked {
             Some(color) => {
                 self.brush.color = color;
-                let [r, g, b, _] = color.map(crate::color::encode_srgb8);
+                let [r, g, b, _] = color.map(crate::colors::format::encode_srgb8);
                 self.set_status(Severity::Info, format!("Picked colour #{r:02x}{g:02x}{b:02x}"));
             }
             None => self.set_status(Severity::Info, "Eyedropper: nothing under the cursor."),
@@ -568,7 +568,7 @@ impl Editor {
             let radius = self.brush_radius_points(None);
             painter.circle_stroke(pos, radius, shadow);
             painter.circle_stroke(pos, radius, stroke);
-            let [r, g, b, _] = self.brush.color.map(crate::color::encode_srgb8);
+            let [r, g, b, _] = self.brush.color.map(crate::colors::format::encode_srgb8);
             painter.circle_filled(pos, 2.5, egui::Color32::from_rgb(r, g, b));
         }
     }
@@ -612,7 +612,7 @@ impl Editor {
             {
                 brush.color = color.to_rgba_unmultiplied();
             }
-            let [r, g, b, _] = brush.color.map(crate::color::encode_srgb8);
+            let [r, g, b, _] = brush.color.map(crate::colors::format::encode_srgb8);
             ui.label(egui::RichText::new(format!("#{r:02x}{g:02x}{b:02x}")).monospace().weak());
         });
         ui.horizontal(|ui| {

@@ -1,7 +1,7 @@
 //! The editor's panels: menu bar, side panel (file, view, scene), status line, help
 //! window and the 3D view's area. [`Editor::ui`] lays out one frame.
 
-use crate::layout::Resolution;
+use crate::colors::layout::Resolution;
 use crate::render::{FilterMode, RenderSettings, Shading};
 
 use super::editor::{Action, Editor, Severity, thousands};
@@ -317,7 +317,7 @@ impl Editor {
                 painter.image(texture, rect, uv, egui::Color32::WHITE);
             }
             _ => {
-                let [r, g, b, _] = RenderSettings::DEFAULT_BACKGROUND.map(crate::color::encode_srgb8);
+                let [r, g, b, _] = RenderSettings::DEFAULT_BACKGROUND.map(crate::colors::format::encode_srgb8);
                 painter.rect_filled(rect, 0.0, egui::Color32::from_rgb(r, g, b));
                 let text = if self.jobs.is_busy() {
                     "Loading…"

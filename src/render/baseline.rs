@@ -10,8 +10,8 @@ use wgpu::util::DeviceExt;
 
 use super::{GpuContext, RenderError, Renderer};
 use crate::camera::BoundingSphere;
-use crate::color::{linear_to_srgb, srgb_to_linear};
-use crate::scene::Texture;
+use crate::colors::format::{linear_to_srgb, srgb_to_linear};
+use crate::mesh::scene::Texture;
 
 /// One vertex of the baseline's vertex buffer (three per face: faces keep their own UVs).
 ///
@@ -97,7 +97,7 @@ pub struct BaselineMesh {
 
 impl BaselineMesh {
     /// Uploads a mesh for the baseline: `positions` (world), `triangles` (vertex ids),
-    /// `corner_uvs` (one UV per face corner, e.g. [`crate::weld::WeldedMesh::corner_uvs`]),
+    /// `corner_uvs` (one UV per face corner, e.g. [`crate::mesh::weld::WeldedMesh::corner_uvs`]),
     /// the base-colour `texture` (RGBA8 sRGB; mipmaps are generated here) and the material's
     /// `base_color_factor` (use `[1.0; 4]` for none).
     pub fn new(

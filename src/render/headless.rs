@@ -8,12 +8,12 @@ use thiserror::Error;
 use super::{BaselineMesh, DrawItem, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderError};
 use super::{FilterMode, Overlays, RenderSettings, Renderer, Shading};
 use crate::camera::{BoundingSphere, OrbitCamera};
-use crate::color::ColorFormat;
-use crate::document::{Document, DocumentError, SourceKind};
-use crate::import::{ImportError, import_gltf};
-use crate::layout::Resolution;
-use crate::packer::PackError;
-use crate::weld::weld_scene;
+use crate::colors::format::ColorFormat;
+use crate::colors::layout::Resolution;
+use crate::io::document::{Document, DocumentError, SourceKind};
+use crate::mesh::import::{ImportError, import_gltf};
+use crate::mesh::weld::weld_scene;
+use crate::packing::packer::PackError;
 
 /// Errors of [`render_file`].
 #[derive(Debug, Error)]

@@ -13,12 +13,12 @@ use glam::DVec3;
 
 use super::{GpuContext, RenderError, Renderer};
 use crate::camera::BoundingSphere;
-use crate::color::ColorFormat;
-use crate::packed::{FaceRecord, PackedMesh};
+use crate::colors::format::ColorFormat;
+use crate::packing::linear::{FaceRecord, PackedMesh};
 
 /// The default atlas width: `min(16384, max_texture_dimension_2d)`.
 ///
-/// A 16384² atlas holds `2^28` samples, [`crate::packed::MAX_SAMPLES`] exactly.
+/// A 16384² atlas holds `2^28` samples, [`crate::packing::linear::MAX_SAMPLES`] exactly.
 pub fn default_atlas_width(limits: &wgpu::Limits) -> u32 {
     limits.max_texture_dimension_2d.min(16384)
 }

@@ -16,15 +16,15 @@
 //! - **Colour atlas.** The colour buffer (all samples with their MIP chains) is a 2D
 //!   texture of width `W` used as an array: sample `index` is texel `(index % W, index / W)`.
 //!   One storage binding is limited to 128 MiB on lavapipe and WebGPU defaults while a
-//!   16384² atlas holds `2^28` samples, exactly [`crate::packed::MAX_SAMPLES`]. RGBA8 sRGB
+//!   16384² atlas holds `2^28` samples, exactly [`crate::packing::linear::MAX_SAMPLES`]. RGBA8 sRGB
 //!   samples go into an `Rgba8UnormSrgb` texture, so `textureLoad` returns linear colour.
 //! - **Render origin.** Positions are uploaded relative to the mesh's bounding-sphere
 //!   centre, subtracted in `f64` on the CPU, and the camera matrix is built relative to
 //!   the same origin ([`crate::camera::OrbitCamera::clip_from_world_relative`]): a mesh at
 //!   `1e6` renders without jitter.
-//! - **Exactness.** `shaders/mesh_colors.wgsl` mirrors [`crate::sampler::packed_sample_index`]
-//!   and [`crate::layout::linear_samples_uv`] operation for operation; `tests/gpu_render.rs`
-//!   compares GPU pixels with [`crate::sampler::sample`].
+//! - **Exactness.** `shaders/mesh_colors.wgsl` mirrors [`crate::packing::sampler::packed_sample_index`]
+//!   and [`crate::colors::layout::linear_samples_uv`] operation for operation; `tests/gpu_render.rs`
+//!   compares GPU pixels with [`crate::packing::sampler::sample`].
 //! - **Colour.** Samples are linear; shaders output linear colour into an `Rgba8UnormSrgb`
 //!   target (or an sRGB view of a window surface), which encodes it.
 //!
@@ -33,7 +33,6 @@
 //! (render, copy, read back into an [`image::RgbaImage`]).
 
 mod baseline;
-mod bench;
 mod context;
 mod headless;
 mod mesh_gpu;
@@ -41,7 +40,6 @@ mod renderer;
 mod uniforms;
 
 pub use baseline::{BaselineMesh, BaselineVertex, mip_chain_linear};
-pub use bench::{BenchRenderError, ModeTiming, RenderBench, bench_render};
 pub use context::{GpuContext, backends_from_env};
 pub use headless::{RenderFileError, RenderRequest, RenderedFile, default_camera, render_file};
 pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshUploadOptions, atlas_texture_format, default_atlas_width};

@@ -6,7 +6,7 @@ use image::RgbaImage;
 use super::uniforms::FrameUniforms;
 use super::{BaselineMesh, BaselineVertex, DEPTH_FORMAT, GpuContext, GpuMesh, RenderError};
 use crate::camera::OrbitCamera;
-use crate::color::Rgba;
+use crate::colors::format::Rgba;
 
 const MESH_COLORS_WGSL: &str = include_str!("../../shaders/mesh_colors.wgsl");
 const UV_BASELINE_WGSL: &str = include_str!("../../shaders/uv_baseline.wgsl");

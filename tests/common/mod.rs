@@ -1,8 +1,8 @@
 //! Helpers shared by the integration tests: a deterministic random source and small meshes.
 #![allow(dead_code)] // each test file uses a different subset
 
-use meshpaint::color::Rgba;
-use meshpaint::topology::Topology;
+use meshpaint::colors::format::Rgba;
+use meshpaint::mesh::topology::Topology;
 
 /// xorshift64: deterministic, seedable, good enough to scatter test inputs.
 pub struct Rng(pub u64);

@@ -9,16 +9,16 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-use crate::color::{ColorFormat, Rgba};
-use crate::import::{ImportError, import_gltf};
-use crate::layout::Resolution;
-use crate::packed::PackedMesh;
-use crate::packed_file::{self, PackedFileError};
-use crate::packer::{self, PackError};
-use crate::scene::Scene;
-use crate::store::ColorStore;
-use crate::topology::{Topology, TopologyError};
-use crate::weld::weld_scene;
+use crate::colors::format::{ColorFormat, Rgba};
+use crate::colors::layout::Resolution;
+use crate::colors::store::ColorStore;
+use crate::mesh::import::{ImportError, import_gltf};
+use crate::mesh::scene::Scene;
+use crate::mesh::topology::{Topology, TopologyError};
+use crate::mesh::weld::weld_scene;
+use crate::packing::file::{self as packed_file, PackedFileError};
+use crate::packing::linear::PackedMesh;
+use crate::packing::packer::{self, PackError};
 
 /// Errors of opening or saving a document; each names the file.
 #[derive(Debug, Error)]
@@ -154,7 +154,7 @@ impl Document {
     /// Opens `path`: a packed file (by magic) or glTF at uniform `gltf_resolution`.
     ///
     /// A glTF mesh whose materials carry a base-colour texture or a non-white factor is
-    /// baked from them ([`crate::bake::bake_texture`]); otherwise it gets
+    /// baked from them ([`crate::io::bake::bake_texture`]); otherwise it gets
     /// [`position_color`].
     pub fn open(path: &Path, gltf_resolution: Resolution) -> Result<Self, DocumentError> {
         let mut head = [0u8; 8];
@@ -173,16 +173,16 @@ impl Document {
     }
 
     /// A document from a glTF scene already in memory (e.g. a model embedded in the binary and
-    /// read with [`crate::import::import_gltf_slice`]) at uniform `gltf_resolution`, coloured
+    /// read with [`crate::mesh::import::import_gltf_slice`]) at uniform `gltf_resolution`, coloured
     /// as [`Document::open`] colours glTF files; `name` stands for the file in errors.
     pub fn from_scene(scene: Scene, gltf_resolution: Resolution, name: &Path) -> Result<Self, DocumentError> {
         let welded = weld_scene(&scene);
         let topology = Topology::build(welded.positions_world.len() as u32, &welded.triangles)
             .map_err(|source| DocumentError::Topology { path: name.to_owned(), source })?;
         let mut store = ColorStore::uniform(topology, gltf_resolution, [1.0; 4]);
-        let has_base_color = crate::bake::has_base_color(&welded, &scene);
+        let has_base_color = crate::io::bake::has_base_color(&welded, &scene);
         if has_base_color {
-            crate::bake::bake_texture(&mut store, &welded, &scene);
+            crate::io::bake::bake_texture(&mut store, &welded, &scene);
         } else if welded.vertex_colors.is_empty() {
             fill_with_position_colors(&mut store, &welded.positions_world);
         }

@@ -10,9 +10,9 @@
 //!    repeats its last level.
 //! 2. **Edges**: each edge with `R_e > 1` owns its MIP chain (levels `0..log2 R_e`, level
 //!    `l` holding `(R_e >> l) − 1` samples in canonical direction, at offset
-//!    [`crate::layout::edge_level_offset`]), chains in edge-id order.
+//!    [`crate::colors::layout::edge_level_offset`]), chains in edge-id order.
 //! 3. **Interiors**: each face with `R >= 4` owns its interior MIP chain (level offsets
-//!    [`crate::layout::interior_level_offset`]), chains in face order.
+//!    [`crate::colors::layout::interior_level_offset`]), chains in face order.
 //!
 //! # Face records (16 bytes)
 //!
@@ -31,8 +31,8 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::color::{ColorFormat, Rgba};
-use crate::layout::Resolution;
+use crate::colors::format::{ColorFormat, Rgba};
+use crate::colors::layout::Resolution;
 
 /// Largest colour-buffer size in samples: bases are 28-bit.
 pub const MAX_SAMPLES: u64 = 1 << 28;

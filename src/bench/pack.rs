@@ -5,10 +5,10 @@
 
 use std::time::{Duration, Instant};
 
-use crate::color::ColorFormat;
-use crate::document::Document;
-use crate::packed::PackedMesh;
-use crate::packer::PackError;
+use crate::colors::format::ColorFormat;
+use crate::io::document::Document;
+use crate::packing::linear::PackedMesh;
+use crate::packing::packer::PackError;
 
 /// Best and median of repeated timings.
 #[derive(Debug, Clone, Copy, PartialEq)]

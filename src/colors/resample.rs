@@ -22,7 +22,7 @@
 //! refine-then-reduce restores the original samples bit for bit. The MIP chains use the
 //! thesis' averaging filters instead (eq. 2.5/2.6, `packer.rs`): they must never ring.
 
-use crate::color::Rgba;
+use crate::colors::format::Rgba;
 
 /// Per-channel `0.5·a + 0.5·b`; symmetric in `a` and `b` bit for bit.
 pub fn midpoint(a: Rgba, b: Rgba) -> Rgba {

@@ -13,15 +13,15 @@
 //!   reads the edge with stride `R_e / R_f`, so every face sees the same colour at a
 //!   shared sample position;
 //! - raising `R_f` interpolates the current signal (old samples unchanged), lowering it
-//!   filters ([`crate::resample`]), and raising then lowering restores the samples exactly;
+//!   filters ([`crate::colors::resample`]), and raising then lowering restores the samples exactly;
 //! - every write and every resolution change is recorded as dirty until [`ColorStore::take_dirty`].
 
 use thiserror::Error;
 
-use crate::color::Rgba;
-use crate::layout::{self, Resolution, SampleLocation};
-use crate::resample::{Lattice, reduce_polyline, refine_polyline};
-use crate::topology::Topology;
+use crate::colors::format::Rgba;
+use crate::colors::layout::{self, Resolution, SampleLocation};
+use crate::colors::resample::{Lattice, reduce_polyline, refine_polyline};
+use crate::mesh::topology::Topology;
 
 /// Errors of store operations.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -182,7 +182,7 @@ impl ColorStore {
                     .unwrap_or(Resolution::ONE)
             })
             .collect();
-        let mut vertex_owner_face = vec![crate::topology::INVALID; topology.vertex_count as usize];
+        let mut vertex_owner_face = vec![crate::mesh::topology::INVALID; topology.vertex_count as usize];
         for (face, corners) in topology.face_vertices.iter().enumerate().rev() {
             for &v in corners {
                 vertex_owner_face[v as usize] = face as u32;

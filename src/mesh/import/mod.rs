@@ -45,7 +45,7 @@ use gltf::json::accessor::{ComponentType, Type};
 use gltf::json::mesh::{Mode, Semantic};
 use gltf::json::validation::Checked;
 
-use crate::scene::{Instance, Material, Scene, SourceMesh, Texture};
+use crate::mesh::scene::{Instance, Material, Scene, SourceMesh, Texture};
 
 /// Errors of the glTF importer. Every message names the file and the problem.
 #[derive(Debug, thiserror::Error)]

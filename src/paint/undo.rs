@@ -40,9 +40,9 @@ use std::collections::VecDeque;
 
 use thiserror::Error;
 
-use crate::color::Rgba;
-use crate::layout::Resolution;
-use crate::store::{ColorStore, SampleRef, StoreError};
+use crate::colors::format::Rgba;
+use crate::colors::layout::Resolution;
+use crate::colors::store::{ColorStore, SampleRef, StoreError};
 
 /// The default memory cap of an [`UndoHistory`]: 512 MiB.
 pub const DEFAULT_CAP_BYTES: usize = 512 << 20;

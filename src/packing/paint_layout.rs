@@ -2,7 +2,7 @@
 //! own block with slack, so an edit uploads only what changed (see docs/PAINT_MODE.md).
 //!
 //! Outside paint mode the GPU holds the compact packed layout with MIP chains
-//! ([`crate::packer`]). Repacking that after every dab would upload the whole mesh, and a
+//! ([`crate::packing::packer`]). Repacking that after every dab would upload the whole mesh, and a
 //! resolution change would shift every later chain. In paint mode the colour buffer instead
 //! holds
 //!
@@ -21,10 +21,10 @@
 //! exhausted, `sync` says so and the caller re-uploads everything (`grown`); capacity
 //! doubles each time, so that is rare.
 
-use crate::color::{ColorFormat, Rgba};
-use crate::layout::Resolution;
-use crate::packed::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
-use crate::store::{ColorStore, DirtyElements};
+use crate::colors::format::{ColorFormat, Rgba};
+use crate::colors::layout::Resolution;
+use crate::colors::store::{ColorStore, DirtyElements};
+use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
 
 /// A block of the colour buffer: `base .. base + capacity`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -1,7 +1,7 @@
 //! The numbers `meshpaint info` reports about a mesh colored at a uniform resolution.
 
-use crate::layout::{Resolution, uniform_counts};
-use crate::topology::Topology;
+use crate::colors::layout::{Resolution, uniform_counts};
+use crate::mesh::topology::Topology;
 
 /// Counts of a welded mesh and its mesh-colors sample budget at one resolution.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

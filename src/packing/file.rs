@@ -7,7 +7,7 @@
 //! offset 0     header (128 bytes, zero-padded to 256)
 //! offset 256·k positions     vertex_count × [f32; 3]
 //! offset 256·k indices       face_count × [u32; 3]
-//! offset 256·k face records  face_count × 4 u32 (see crate::packed)
+//! offset 256·k face records  face_count × 4 u32 (see crate::packing::linear)
 //! offset 256·k colours       sample_count × bytes_per_sample(format)
 //! ```
 //!
@@ -36,14 +36,14 @@
 //!    that make any GPU read derived from the records safe).
 //!
 //! Deeper layout consistency (e.g. two faces agreeing on a shared edge's chain base) is
-//! the unpacker's job ([`crate::packer`]), not this module's.
+//! the unpacker's job ([`crate::packing::packer`]), not this module's.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::color::ColorFormat;
-use crate::layout::{MAX_LOG2_RESOLUTION, Resolution, edge_chain_len, interior_chain_len};
-use crate::packed::{FaceRecord, MAX_SAMPLES, PackedMesh, unpack_word};
+use crate::colors::format::ColorFormat;
+use crate::colors::layout::{MAX_LOG2_RESOLUTION, Resolution, edge_chain_len, interior_chain_len};
+use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, unpack_word};
 
 /// The first 8 bytes of every packed file.
 pub const MAGIC: [u8; 8] = *b"MESHPAK\0";

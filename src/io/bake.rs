@@ -1,7 +1,7 @@
 //! Texture conversion: a glTF base-colour texture becomes mesh colors.
 //!
 //! Every stored sample is evaluated once, in its *owner* face (the lowest face id that
-//! contains it, see [`crate::store::SampleSite`]): the owner's corner UVs are interpolated
+//! contains it, see [`crate::colors::store::SampleSite`]): the owner's corner UVs are interpolated
 //! with the sample's barycentric coordinates and the owner's material is evaluated there,
 //! `base_color_factor × texture` in linear light. Across a UV seam the two faces of an edge
 //! map it to different texels; the owner's mapping wins, so the result is deterministic.
@@ -30,10 +30,10 @@
 //! where `R` is the resolution the sample lives at (the face's, or the edge's for edge
 //! samples). Pyramids are built once per texture and only for textures in use.
 
-use crate::color::{Rgba, srgb_to_linear};
-use crate::scene::{Scene, Texture};
-use crate::store::{ColorStore, SampleRef, SampleSite};
-use crate::weld::WeldedMesh;
+use crate::colors::format::{Rgba, srgb_to_linear};
+use crate::colors::store::{ColorStore, SampleRef, SampleSite};
+use crate::mesh::scene::{Scene, Texture};
+use crate::mesh::weld::WeldedMesh;
 
 /// One level of a [`TexturePyramid`]: linear RGBA texels, rows top to bottom.
 #[derive(Debug, Clone, PartialEq)]
@@ -133,7 +133,7 @@ impl TexturePyramid {
             return a;
         }
         let b = self.levels.get(upper).map_or(a, |l| l.sample_bilinear(uv));
-        crate::color::lerp(a, b, t)
+        crate::colors::format::lerp(a, b, t)
     }
 }
 

@@ -24,11 +24,11 @@ use std::time::{Duration, Instant, SystemTime};
 
 use thiserror::Error;
 
-use crate::color::ColorFormat;
-use crate::document::Document;
-use crate::packed::PackedMesh;
-use crate::packed_file::{self, PackedFileError};
-use crate::packer::PackError;
+use crate::colors::format::ColorFormat;
+use crate::io::document::Document;
+use crate::packing::file::{self as packed_file, PackedFileError};
+use crate::packing::linear::PackedMesh;
+use crate::packing::packer::PackError;
 
 /// The colour format of recovery files: bit-exact linear floats.
 pub const RECOVERY_FORMAT: ColorFormat = ColorFormat::Rgba32F;
@@ -205,7 +205,7 @@ pub fn remove_stale_temp_files(path: &Path) -> Result<usize, AutosaveError> {
 }
 
 /// Decides when to autosave: when the colours changed since the last autosave (a generation
-/// counter, e.g. [`crate::undo::UndoHistory::generation`]) and `interval` has passed since
+/// counter, e.g. [`crate::paint::undo::UndoHistory::generation`]) and `interval` has passed since
 /// the last autosave (or since the first change after it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Autosaver {

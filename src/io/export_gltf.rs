@@ -24,7 +24,7 @@
 //!   colours as diffuse colour; no `NORMAL` (glTF viewers then use flat normals).
 //!
 //! A glTF viewer interpolates `COLOR_0` linearly across each sub-triangle, which is exactly
-//! meshpaint's linear filter ([`crate::sampler`], thesis eq. 2.4).
+//! meshpaint's linear filter ([`crate::packing::sampler`], thesis eq. 2.4).
 //!
 //! Vertices are numbered in order of first use along the index order above, so the same
 //! store gives the same bytes.
@@ -47,8 +47,8 @@ use gltf::json::validation::Checked::Valid;
 use gltf::json::validation::USize64;
 use thiserror::Error;
 
-use crate::layout::{self, Resolution};
-use crate::store::{ColorStore, SampleRef};
+use crate::colors::layout::{self, Resolution};
+use crate::colors::store::{ColorStore, SampleRef};
 
 /// The value of `asset.generator` in exported files.
 pub const GENERATOR: &str = "meshpaint";

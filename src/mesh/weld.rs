@@ -10,7 +10,7 @@ use std::collections::HashMap;
 
 use glam::{Mat3, Mat4, Vec3};
 
-use crate::scene::Scene;
+use crate::mesh::scene::Scene;
 
 /// One indexed triangle mesh, every instance of the scene concatenated, in world space.
 #[derive(Debug, Clone, Default, PartialEq)]

@@ -15,13 +15,13 @@
 use std::time::Instant;
 
 use crate::camera::OrbitCamera;
-use crate::color::ColorFormat;
-use crate::document::{Document, bounds};
-use crate::import::import_gltf;
-use crate::scene::Texture;
-use crate::weld::weld_scene;
+use crate::colors::format::ColorFormat;
+use crate::io::document::{Document, bounds};
+use crate::mesh::import::import_gltf;
+use crate::mesh::scene::Texture;
+use crate::mesh::weld::weld_scene;
 
-use super::{
+use crate::render::{
     BaselineMesh, DrawItem, FilterMode, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderError,
     RenderSettings, RenderTarget, Renderer, Shading, default_camera,
 };
@@ -247,5 +247,5 @@ pub enum BenchRenderError {
     Render(#[from] RenderError),
     /// Packing the document failed.
     #[error(transparent)]
-    Pack(#[from] crate::packer::PackError),
+    Pack(#[from] crate::packing::packer::PackError),
 }

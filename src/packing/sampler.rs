@@ -11,12 +11,12 @@
 //!
 //! The arithmetic is `f32` in the order the shaders use.
 
-use crate::color::ColorFormat;
-use crate::color::Rgba;
-use crate::layout::{self, Resolution, SampleLocation};
-use crate::packed::PackedMesh;
-use crate::packer::{PackError, pack};
-use crate::store::ColorStore;
+use crate::colors::format::ColorFormat;
+use crate::colors::format::Rgba;
+use crate::colors::layout::{self, Resolution, SampleLocation};
+use crate::colors::store::ColorStore;
+use crate::packing::linear::PackedMesh;
+use crate::packing::packer::{PackError, pack};
 
 /// How colours between samples are reconstructed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -26,11 +26,11 @@
 
 use thiserror::Error;
 
-use crate::color::{ColorFormat, Rgba};
-use crate::layout::{self, Resolution};
-use crate::packed::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
-use crate::store::{ColorStore, SampleRef};
-use crate::topology::{Topology, TopologyError};
+use crate::colors::format::{ColorFormat, Rgba};
+use crate::colors::layout::{self, Resolution};
+use crate::colors::store::{ColorStore, SampleRef};
+use crate::mesh::topology::{Topology, TopologyError};
+use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
 
 /// Errors of packing and unpacking.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]

@@ -1,0 +1,10 @@
+//! Measurements behind `meshpaint bench …`: every figure we report comes from here, and
+//! each measures what the editor really does.
+
+pub mod pack;
+pub mod paint;
+pub mod render;
+
+pub use pack::{Timing, bench_pack};
+pub use paint::{PaintBenchOptions, bench_paint};
+pub use render::{BenchRenderError, ModeTiming, RenderBench, bench_render};

@@ -1,0 +1,215 @@
+//! `meshpaint bench paint`: BVH presets, pick latency, dab throughput per brush size and
+//! tool, the bytes each dab uploads and the repack time, on the editor's own code paths.
+//!
+//! Upload bytes come from [`PaintLayout::sync`] and [`PaintLayout::encode_range`], exactly
+//! what the editor's paint mode sends to the GPU after a dab (samples and patched face
+//! records), not from a formula of our own.
+
+use std::time::Instant;
+
+use glam::DVec3;
+
+use crate::bench::pack::Timing;
+use crate::camera::OrbitCamera;
+use crate::colors::format::ColorFormat;
+use crate::colors::store::ColorStore;
+use crate::io::document::Document;
+use crate::packing::linear::FaceRecord;
+use crate::packing::paint_layout::PaintLayout;
+use crate::paint::brush::{BlendMode, BrushError, BrushSettings, Falloff, PaintView, Painter, Tool, samples_within};
+use crate::paint::picking::{BvhPreset, MeshBvh};
+use crate::paint::undo::UndoHistory;
+
+/// Options of [`bench_paint`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaintBenchOptions {
+    /// Viewport size, pixels.
+    pub viewport_px: [u32; 2],
+    /// Target footprints, samples per dab.
+    pub target_samples: Vec<u64>,
+    /// Timed dabs per brush size (best and median reported).
+    pub dabs: usize,
+    /// Picks timed per preset.
+    pub picks: usize,
+    /// Repack repetitions.
+    pub pack_runs: usize,
+}
+
+impl Default for PaintBenchOptions {
+    fn default() -> Self {
+        PaintBenchOptions {
+            viewport_px: [1280, 720],
+            target_samples: vec![1_000, 10_000, 100_000],
+            dabs: 30,
+            picks: 2000,
+            pack_runs: 3,
+        }
+    }
+}
+
+/// Measures picking and painting on `document` (see `meshpaint bench paint`): BVH build and
+/// pick time per preset, dab time and throughput for brushes covering the target sample
+/// counts, bytes a dab would upload, and the repack time. One thread. Returns JSON.
+pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<serde_json::Value, BrushError> {
+    let positions = &document.positions;
+    let triangles = &document.store.topology().face_vertices;
+    let [width, height] = options.viewport_px;
+    let camera = OrbitCamera::framing(crate::camera::BoundingSphere::of_points(positions), 30.0, 20.0);
+    // Pixels on the mesh, on a grid over the viewport (for picks).
+    let reference = MeshBvh::build(positions, triangles, BvhPreset::FastBuild);
+    let grid = 64u32;
+    let mut on_mesh = Vec::new();
+    for gy in 0..grid {
+        for gx in 0..grid {
+            let cursor = [(f64::from(gx) + 0.5) * f64::from(width) / f64::from(grid), {
+                (f64::from(gy) + 0.5) * f64::from(height) / f64::from(grid)
+            }];
+            let (origin, direction) = camera.ray_through_pixel(cursor[0], cursor[1], width, height);
+            if reference.cast(origin, direction, f64::INFINITY).is_some() {
+                on_mesh.push((origin, direction));
+            }
+        }
+    }
+    let mut presets = Vec::new();
+    for preset in BvhPreset::ALL {
+        let (build, bvh) = Timing::measure(1, || MeshBvh::build(positions, triangles, preset));
+        let (pick, hits) = Timing::measure(3, || {
+            let mut hits = 0u32;
+            for k in 0..options.picks {
+                if let Some((origin, direction)) = on_mesh.get(k % on_mesh.len().max(1)) {
+                    hits += u32::from(bvh.cast(*origin, *direction, f64::INFINITY).is_some());
+                }
+            }
+            hits
+        });
+        let picks = options.picks.max(1) as f64;
+        presets.push(serde_json::json!({
+            "preset": preset.name(),
+            "build_seconds": build.best_seconds,
+            "pick_seconds_best": pick.best_seconds / picks,
+            "pick_seconds_median": pick.median_seconds / picks,
+            "picks": options.picks,
+            "hits": hits,
+        }));
+    }
+
+    // Pick latency through the whole cursor path (pixel → ray → BVH), default preset.
+    let bvh = reference;
+    let mut store = document.store.clone();
+    let base = document.store.clone();
+    let view = PaintView { positions, bvh: &bvh, camera: &camera, viewport_px: options.viewport_px, base: Some(&base) };
+    let centre_px = [f64::from(width) * 0.5, f64::from(height) * 0.5];
+    let (pick_timing, hit) = Timing::measure(options.picks.max(1), || view.pick(centre_px));
+    let center = hit.map(|hit| DVec3::from_array(hit.position_world)).unwrap_or(DVec3::from_array(camera.target));
+
+    let mut painter = Painter::new(positions);
+    let mut brushes = Vec::new();
+    let scene_radius = camera.scene_radius.max(1e-12);
+    for &target in &options.target_samples {
+        // Radius by bisection on the measured footprint.
+        let (mut lo, mut hi) = (0.0f64, scene_radius * 2.0);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if samples_within(&view, &store, center, mid) < target {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let radius = hi;
+        let mut row = serde_json::json!({ "target_samples": target, "radius_world": radius,
+            "radius_px": radius / view.world_per_px_at(center).max(f64::MIN_POSITIVE) });
+        let (query, faces) = Timing::measure(options.dabs.max(5), || view.bvh.faces_in_sphere(center, radius));
+        row["sphere_query"] = serde_json::json!({ "faces": faces.len(), "timing": query.to_json() });
+        // (name, tool, culling, occlusion, one undo step per dab)
+        let variants = [
+            ("paint_first_dab", Tool::Paint, false, false, true),
+            ("paint_in_stroke", Tool::Paint, false, false, false),
+            ("paint_culling_in_stroke", Tool::Paint, true, false, false),
+            ("paint_culling_occlusion_in_stroke", Tool::Paint, true, true, false),
+            ("blur_in_stroke", Tool::Blur, false, false, false),
+        ];
+        for (name, tool, culling, occlusion, step_per_dab) in variants {
+            if (occlusion || tool == Tool::Blur) && target > 20_000 {
+                continue;
+            }
+            let settings = BrushSettings {
+                tool,
+                blend: BlendMode::Mix,
+                strength: 0.5,
+                falloff: Falloff::Smooth,
+                occlusion,
+                backface_culling: culling,
+                mirror_x: false,
+                ..BrushSettings::default()
+            };
+            let mut history = UndoHistory::new(crate::paint::undo::DEFAULT_CAP_BYTES);
+            store.take_dirty();
+            let mut times = Vec::new();
+            let (mut covered, mut upload_bytes) = (0, 0);
+            let mut layout = PaintLayout::new(&store);
+            if !step_per_dab {
+                history.begin_step(&store, "bench")?;
+            }
+            for k in 0..options.dabs.max(1) {
+                let color = if k % 2 == 0 { [0.9, 0.2, 0.1, 1.0] } else { [0.1, 0.3, 0.9, 1.0] };
+                painter.set_settings(BrushSettings { color, ..settings });
+                if step_per_dab {
+                    history.begin_step(&store, "bench")?;
+                }
+                let started = Instant::now();
+                let stats = painter.dab_at(&view, &mut store, &mut history, center, radius)?;
+                times.push(started.elapsed().as_secs_f64());
+                if step_per_dab {
+                    history.end_step();
+                }
+                covered = stats.samples_covered;
+                upload_bytes = upload_like_the_editor(&mut layout, &mut store);
+            }
+            history.end_step();
+            times.sort_by(f64::total_cmp);
+            let (best, median) = (times[0], times[times.len() / 2]);
+            row[name] = serde_json::json!({
+                "samples_covered": covered,
+                "dab_seconds_best": best,
+                "dab_seconds_median": median,
+                "samples_per_second_best": covered as f64 / best,
+                "samples_per_second_median": covered as f64 / median,
+                "upload_bytes_rgba8": upload_bytes,
+                "dabs": times.len(),
+                "undo_bytes": history.bytes_used(),
+            });
+        }
+        brushes.push(row);
+    }
+    let (pack_timing, packed) = Timing::measure(options.pack_runs, || document.pack(ColorFormat::Rgba8Srgb));
+    let packed_bytes = packed.map(|p| p.face_record_bytes() + p.color_bytes()).unwrap_or(0);
+    Ok(serde_json::json!({
+        "bench": "paint",
+        "triangles": document.store.topology().face_count(),
+        "samples": document.store.sample_count(),
+        "threads": 1,
+        "viewport_px": options.viewport_px,
+        "bvh_presets": presets,
+        "pick_latency": pick_timing.to_json(),
+        "brushes": brushes,
+        "repack_rgba8": {
+            "timing": pack_timing.to_json(),
+            "bytes": packed_bytes,
+            "threads": crate::packing::packer::pack_threads(),
+        },
+    }))
+}
+
+/// Bytes the editor's paint mode uploads for the store's dirty elements (RGBA8): the
+/// encoded sample ranges of the plan and the patched face records.
+fn upload_like_the_editor(layout: &mut PaintLayout, store: &mut ColorStore) -> u64 {
+    let dirty = store.take_dirty();
+    let plan = layout.sync(store, &dirty);
+    let samples: u64 = plan
+        .sample_ranges
+        .iter()
+        .map(|&(first, count)| layout.encode_range(store, &dirty, first, count, ColorFormat::Rgba8Srgb).len() as u64)
+        .sum();
+    samples + plan.faces.len() as u64 * std::mem::size_of::<FaceRecord>() as u64
+}

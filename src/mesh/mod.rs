@@ -1,0 +1,13 @@
+//! Meshes: what is read from a file, welded into one indexed mesh, and its topology.
+//!
+//! `file ─ import ─▶ Scene ─ weld ─▶ WeldedMesh ─ topology ─▶ Topology`
+
+pub mod import;
+pub mod scene;
+pub mod topology;
+pub mod weld;
+
+pub use import::{ImportError, import_gltf};
+pub use scene::Scene;
+pub use topology::Topology;
+pub use weld::{WeldedMesh, weld_scene};

@@ -1,0 +1,21 @@
+//! From the store to linear buffers and back: the packed layout (face records and the
+//! colour buffer with MIP chains), the packer, the CPU reference sampler over the MIP
+//! chains, the paint-mode block layout and the packed file format.
+//!
+//! | file | holds |
+//! |---|---|
+//! | [`linear`] | the linear GPU layout: 16-byte face records, colour buffer with MIP chains |
+//! | [`packer`] | store → linear (MIP chains, eq. 2.5/2.6) and linear → store |
+//! | [`paint_layout`] | paint mode: level 0 in blocks with slack; dirty ranges and patched records |
+//! | [`sampler`] | the CPU reference sampler (nearest, linear, MIP level) on the store and on packed buffers: the truth the GPU is tested against |
+//! | [`file`] | the packed file format (docs/FORMAT.md): writer and hostile-input-proof reader |
+
+pub mod file;
+pub mod linear;
+pub mod packer;
+pub mod paint_layout;
+pub mod sampler;
+
+pub use linear::{FaceRecord, PackedMesh};
+pub use packer::{PackError, pack};
+pub use paint_layout::PaintLayout;

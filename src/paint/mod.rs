@@ -1,0 +1,9 @@
+//! Painting: BVH picking, the brushes and their tools, and undo / redo per stroke.
+
+pub mod brush;
+pub mod picking;
+pub mod undo;
+
+pub use brush::{BrushSettings, Painter};
+pub use picking::{BvhPreset, MeshBvh};
+pub use undo::UndoHistory;
