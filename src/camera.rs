@@ -59,6 +59,22 @@ pub struct OrbitCamera {
     pub scene_radius: f64,
 }
 
+/// Camera yaw of a newly opened document and of `meshpaint render`, degrees.
+pub const DEFAULT_YAW_DEGREES: f64 = 30.0;
+/// Camera pitch of a newly opened document and of `meshpaint render`, degrees.
+pub const DEFAULT_PITCH_DEGREES: f64 = 20.0;
+
+/// The camera a document opens with: [`OrbitCamera::framing`] of its bounding `sphere` at
+/// `yaw`/`pitch` (degrees), with `distance` (when finite and positive) overriding the framing
+/// distance.
+pub fn default_camera(sphere: BoundingSphere, yaw: f64, pitch: f64, distance: Option<f64>) -> OrbitCamera {
+    let mut camera = OrbitCamera::framing(sphere, yaw, pitch);
+    if let Some(distance) = distance.filter(|d| d.is_finite() && *d > 0.0) {
+        camera.distance = distance;
+    }
+    camera
+}
+
 impl OrbitCamera {
     /// Default vertical field of view.
     pub const DEFAULT_FOV_Y_DEGREES: f64 = 40.0;

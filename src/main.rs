@@ -381,7 +381,9 @@ enum RenderShading {
 }
 
 fn render(args: RenderArgs) -> Result<()> {
-    use meshpaint::render::{FilterMode, Overlays, RenderRequest, Shading};
+    use meshpaint::camera::default_camera;
+    use meshpaint::io::document::{Source, open_for_display};
+    use meshpaint::render::{DrawItem, FilterMode, Gpu, Overlays, RenderSettings, Shading};
     let filter = match (args.filter, args.level) {
         (RenderFilter::Nearest, None) => FilterMode::Nearest,
         (RenderFilter::Nearest, Some(level)) => FilterMode::NearestMipLevel(level),
@@ -394,34 +396,48 @@ fn render(args: RenderArgs) -> Result<()> {
     if let Some(distance) = args.distance {
         anyhow::ensure!(distance.is_finite() && distance > 0.0, "--distance must be a positive number");
     }
-    let request = RenderRequest {
-        path: args.file.clone(),
-        resolution: Resolution::new(args.resolution).context("--resolution")?,
-        width: args.width,
-        height: args.height,
-        filter,
-        shading: match args.shading {
+    let settings = |bounds| {
+        let mut settings = RenderSettings::new(default_camera(bounds, args.yaw, args.pitch, args.distance));
+        settings.filter = filter;
+        settings.shading = match args.shading {
             RenderShading::Unlit => Shading::Unlit,
             RenderShading::Lit => Shading::Lit,
-        },
-        overlays: Overlays { wireframe: args.wireframe, heatmap: args.heatmap },
-        yaw_degrees: args.yaw,
-        pitch_degrees: args.pitch,
-        distance: args.distance,
-        baseline_uv: args.baseline_uv,
+        };
+        settings.overlays = Overlays { wireframe: args.wireframe, heatmap: args.heatmap };
+        settings
     };
     let started = std::time::Instant::now();
-    let rendered = meshpaint::render::render_file(&request)?;
-    rendered.image.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
+    let gpu = Gpu::new_headless()?;
+    let (image, triangles, samples) = if args.baseline_uv {
+        let scene = meshpaint::mesh::import::import_gltf(&args.file)?;
+        let mesh = gpu.upload_baseline(&scene)?.with_context(|| {
+            format!(
+                "{}: --baseline-uv needs a glTF file with a base-colour texture, and no material has one",
+                args.file.display()
+            )
+        })?;
+        let image = gpu.render_image(DrawItem::Baseline(&mesh), &settings(mesh.bounds), args.width, args.height)?;
+        (image, mesh.vertex_count / 3, 0)
+    } else {
+        let resolution = Resolution::new(args.resolution).context("--resolution")?;
+        let displayed = open_for_display(&Source::File(args.file.clone()), resolution, &mut |_, _| {})?;
+        for warning in &displayed.document.warnings {
+            log::warn!("{}: {warning}", args.file.display());
+        }
+        let mesh = gpu.upload(&displayed.packed)?;
+        let image = gpu.render_image(DrawItem::MeshColors(&mesh), &settings(mesh.bounds), args.width, args.height)?;
+        (image, mesh.face_count, mesh.atlas.samples)
+    };
+    image.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
     eprintln!(
         "{} → {}: {}×{}, {} triangles, {} samples, {} ({:.2} s)",
         args.file.display(),
         args.output.display(),
         args.width,
         args.height,
-        rendered.triangles,
-        rendered.samples,
-        rendered.adapter,
+        triangles,
+        samples,
+        gpu.describe(),
         started.elapsed().as_secs_f64()
     );
     Ok(())
@@ -600,7 +616,8 @@ fn paint(args: PaintArgs) -> Result<()> {
 
     let started = std::time::Instant::now();
     let mut document = open(&args.file, args.resolution)?;
-    let camera = meshpaint::render::default_camera(&document.positions, args.yaw, args.pitch, args.distance);
+    let bounds = meshpaint::camera::BoundingSphere::of_points(&document.positions);
+    let camera = meshpaint::camera::default_camera(bounds, args.yaw, args.pitch, args.distance);
     let bvh = meshpaint::paint::picking::MeshBvh::build(
         &document.positions,
         &document.store.topology().face_vertices,

@@ -8,8 +8,8 @@ use std::time::Duration;
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use meshpaint::app::editor::{Action, Editor, Mode, Severity};
-use meshpaint::app::loaded::Source;
+use meshpaint::app::{Action, Editor, Mode, Severity};
+use meshpaint::io::document::Source;
 use meshpaint::render::{FilterMode, Shading};
 
 const JOB_TIMEOUT: Duration = Duration::from_secs(60);

@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 
 use image::RgbImage;
 use meshpaint::app::editor::Editor;
-use meshpaint::app::loaded::Source;
+use meshpaint::io::document::Source;
 use meshpaint::render::{DrawItem, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, Renderer};
 
 fn crate_path(relative: &str) -> PathBuf {

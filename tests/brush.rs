@@ -891,7 +891,7 @@ fn strokes_and_colours_parse() {
 // ---------------------------------------------------------------- headless replay (CLI)
 
 /// `meshpaint paint` replays a stroke through the same camera, picking and brush code as the
-/// library: its output equals a replay done here with `render::default_camera`.
+/// library: its output equals a replay done here with `camera::default_camera`.
 #[test]
 fn the_paint_command_replays_strokes_like_the_library() {
     let dir = std::env::temp_dir().join(format!("meshpaint-brush-cli-{}", std::process::id()));
@@ -909,7 +909,12 @@ fn the_paint_command_replays_strokes_like_the_library() {
     let from_cli = meshpaint::packing::file::read_file(&output).unwrap();
 
     let mut document = meshpaint::io::document::Document::open(&input, r(4)).unwrap();
-    let camera = meshpaint::render::default_camera(&document.positions, 40.0, -10.0, None);
+    let camera = meshpaint::camera::default_camera(
+        meshpaint::camera::BoundingSphere::of_points(&document.positions),
+        40.0,
+        -10.0,
+        None,
+    );
     let bvh = MeshBvh::build(&document.positions, &document.store.topology().face_vertices, BvhPreset::FastBuild);
     let base = document.store.clone();
     let view = PaintView {

@@ -647,7 +647,8 @@ fn image_difference(a: &RgbaImage, b: &RgbaImage, background: [u8; 4]) -> (f64, 
 /// trilinear) draw the Duck alike: same silhouette, small mean colour difference.
 #[test]
 fn mesh_colors_and_the_uv_baseline_look_alike() {
-    use meshpaint::render::{BaselineMesh, default_camera};
+    use meshpaint::camera::{BoundingSphere, default_camera};
+    use meshpaint::render::BaselineMesh;
     let gpu = gpu();
     let path = model("Duck/Duck.glb");
     let document = meshpaint::io::document::Document::open(&path, r(16)).unwrap();
@@ -667,7 +668,8 @@ fn mesh_colors_and_the_uv_baseline_look_alike() {
         material.base_color_factor,
     )
     .unwrap();
-    let mut settings = RenderSettings::new(default_camera(&document.positions, 30.0, 20.0, None));
+    let mut settings =
+        RenderSettings::new(default_camera(BoundingSphere::of_points(&document.positions), 30.0, 20.0, None));
     settings.background = [0.0; 4];
     for shading in [Shading::Unlit, Shading::Lit] {
         settings.shading = shading;

@@ -9,147 +9,28 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use glam::DVec3;
 
-use crate::camera::OrbitCamera;
+use crate::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera};
 use crate::colors::format::ColorFormat;
 use crate::colors::layout::Resolution;
-use crate::render::{FilterMode, Overlays, RenderSettings, Shading};
+use crate::render::{FilterMode, RenderSettings};
 
+use crate::io::document::Source;
+use crate::render::Gpu;
+
+use super::autosave::{AutosaveState, Autosaved};
+use super::document::{self, OpenDocument, Written};
 use super::file_dialog::{DialogOutcome, DialogPurpose, FileDialog};
-use super::jobs::{Finished, Jobs, Waker};
-use super::loaded::{self, Gpu, OpenDocument, Source, Written};
+use super::jobs::{Finished, JobKind, Jobs, Waker, WriteKind};
+use super::paint_session::{PaintSession, Repacked};
+use super::state::{FrameStats, Mode, Severity, Status, ViewSettings, ViewportInfo};
+use super::text::{error_text, thousands};
 
-/// Camera yaw of a newly opened document, degrees (as `meshpaint render`).
-pub const DEFAULT_YAW_DEGREES: f64 = 30.0;
-/// Camera pitch of a newly opened document, degrees (as `meshpaint render`).
-pub const DEFAULT_PITCH_DEGREES: f64 = 20.0;
 /// Uniform resolution given to glTF files when they are opened, unless changed in the UI.
 pub const DEFAULT_IMPORT_RESOLUTION: u64 = 8;
-
-/// What the editor is doing with the pointer in the 3D view. Paint mode (Tab) slots in
-/// here: its tools get the pointer in [`super::input::viewport_input`], edit the document's
-/// store and upload dirty samples to its GPU mesh.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Mode {
-    /// Look at the mesh: navigation only.
-    #[default]
-    View,
-    /// Paint on the mesh: the left button paints with the brush ([`super::paint`]).
-    Paint,
-}
-
-impl Mode {
-    /// Name for the status line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Mode::View => "View",
-            Mode::Paint => "Paint",
-        }
-    }
-}
-
-/// How bad a status message is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Severity {
-    /// Progress and results.
-    Info,
-    /// Something worked, with caveats.
-    Warning,
-    /// Something failed; nothing was changed.
-    Error,
-}
-
-/// The status line's message.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Status {
-    /// The message.
-    pub text: String,
-    /// Its severity.
-    pub severity: Severity,
-}
-
-/// Everything that decides how the 3D view looks, besides the camera.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ViewSettings {
-    /// Mesh-colors reconstruction filter.
-    pub filter: FilterMode,
-    /// Lit or unlit.
-    pub shading: Shading,
-    /// Wireframe and resolution heat map.
-    pub overlays: Overlays,
-    /// Redraw every frame (to measure fps) instead of only when something changes.
-    pub continuous_redraw: bool,
-}
-
-impl Default for ViewSettings {
-    fn default() -> Self {
-        ViewSettings {
-            filter: FilterMode::Trilinear,
-            shading: Shading::Lit,
-            overlays: Overlays::default(),
-            continuous_redraw: false,
-        }
-    }
-}
-
-/// Every command the UI offers: shortcuts and menus map to these
-/// ([`super::input::SHORTCUTS`]), and [`Editor::perform`] carries them out.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Action {
-    /// Show the Open dialog.
-    Open,
-    /// Save the project (packed file); asks for a name the first time.
-    Save,
-    /// Save under a new name.
-    SaveAs,
-    /// Export a tessellated vertex-colour .glb.
-    ExportGltf,
-    /// Export the packed buffers in a chosen colour format.
-    ExportPacked,
-    /// Frame the whole mesh.
-    FrameAll,
-    /// Centre on the surface point under the cursor and move halfway towards it.
-    FrameUnderCursor,
-    /// Look from the front (+Z).
-    ViewFront,
-    /// Look from the back (−Z).
-    ViewBack,
-    /// Look from the right (+X).
-    ViewRight,
-    /// Look from the left (−X).
-    ViewLeft,
-    /// Look from above.
-    ViewTop,
-    /// Look from below.
-    ViewBottom,
-    /// Toggle the wireframe overlay.
-    ToggleWireframe,
-    /// Toggle the resolution heat map.
-    ToggleHeatmap,
-    /// Toggle lit / unlit shading.
-    ToggleShading,
-    /// Cycle the filter: nearest, linear, trilinear.
-    CycleFilter,
-    /// Show or hide the shortcut help window.
-    ToggleHelp,
-    /// Close the application.
-    Quit,
-    /// Enter or leave paint mode.
-    TogglePaintMode,
-    /// Undo the last stroke (paint mode).
-    Undo,
-    /// Redo the last undone stroke (paint mode).
-    Redo,
-    /// Pick the colour under the cursor into the brush (paint mode).
-    Eyedropper,
-    /// Set the brush radius by moving the mouse (paint mode).
-    RadiusGesture,
-    /// Set the brush strength by moving the mouse (paint mode).
-    StrengthGesture,
-}
 
 /// What a job produced.
 #[derive(Debug)]
@@ -159,74 +40,9 @@ pub enum JobOutput {
     /// A file was written.
     Written(Written, WriteKind),
     /// The store was repacked after paint mode.
-    Repacked(Box<super::paint::Repacked>),
+    Repacked(Box<Repacked>),
     /// A recovery file was written.
-    Autosaved(super::autosave_ui::Autosaved),
-}
-
-/// Which kind of file a write job produced.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum WriteKind {
-    /// The project (packed file) was saved.
-    Save,
-    /// Packed buffers were exported.
-    ExportPacked,
-    /// A .glb was exported.
-    ExportGltf,
-}
-
-/// The 3D view's area this frame, as the last [`Editor::ui`] laid it out.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ViewportInfo {
-    /// The area in points.
-    pub rect: egui::Rect,
-    /// Physical pixels per point.
-    pub pixels_per_point: f32,
-}
-
-impl ViewportInfo {
-    /// The area's size in physical pixels (at least 1×1).
-    pub fn size_px(&self) -> [u32; 2] {
-        let w = (self.rect.width() * self.pixels_per_point).round().max(1.0) as u32;
-        let h = (self.rect.height() * self.pixels_per_point).round().max(1.0) as u32;
-        [w, h]
-    }
-
-    /// The area's top-left corner in physical pixels.
-    pub fn min_px(&self) -> [i32; 2] {
-        [
-            (self.rect.min.x * self.pixels_per_point).round() as i32,
-            (self.rect.min.y * self.pixels_per_point).round() as i32,
-        ]
-    }
-}
-
-/// Frame timing for the scene panel.
-#[derive(Debug, Clone, Default)]
-pub struct FrameStats {
-    /// Frames drawn in the current one-second window.
-    frames: u32,
-    window_start: Option<Instant>,
-    /// Frames per second over the last full second of redrawing.
-    pub fps: f32,
-    /// CPU time of the last frame (UI, 3D and egui recording, submit), milliseconds.
-    pub frame_ms: f32,
-}
-
-impl FrameStats {
-    /// Records one drawn frame that took `cpu_time`.
-    pub fn record(&mut self, cpu_time: Duration) {
-        let now = Instant::now();
-        self.frame_ms = cpu_time.as_secs_f32() * 1000.0;
-        let start = *self.window_start.get_or_insert(now);
-        self.frames += 1;
-        let elapsed = now.duration_since(start).as_secs_f32();
-        if elapsed >= 1.0 {
-            self.fps = self.frames as f32 / elapsed;
-            self.frames = 0;
-            self.window_start = Some(now);
-        }
-    }
+    Autosaved(Autosaved),
 }
 
 /// The editor.
@@ -269,7 +85,7 @@ pub struct Editor {
     /// The brush settings (kept between paint sessions).
     pub brush: crate::paint::brush::BrushSettings,
     /// Paint mode's state while it is on.
-    pub paint: Option<super::paint::PaintSession>,
+    pub paint: Option<PaintSession>,
     /// Undo / redo of paint mode, one step per stroke (cleared when another document opens).
     pub history: crate::paint::undo::UndoHistory,
     /// The GPU mesh holds the paint layout (level 0 only): the filter is limited to level 0.
@@ -283,7 +99,7 @@ pub struct Editor {
     /// The resolution of "Set R for all".
     pub resolution_for_all: Resolution,
     /// Autosave settings and state.
-    pub autosave: super::autosave_ui::AutosaveState,
+    pub autosave: AutosaveState,
     /// A load error to report once the built-in scene has replaced a failed start-up file.
     fallback_error: Option<String>,
     /// Where file dialogs start.
@@ -335,7 +151,7 @@ impl Editor {
             upload_bytes_this_frame: 0,
             edit_generation: 0,
             resolution_for_all: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
-            autosave: super::autosave_ui::AutosaveState::default(),
+            autosave: AutosaveState::default(),
             fallback_error: None,
             last_directory: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
         }
@@ -380,8 +196,9 @@ impl Editor {
             self.last_directory = parent.to_owned();
         }
         let label = format!("Opening {name}");
-        let started = self.jobs.start(label.clone(), move |job| {
-            loaded::load(&source, resolution, gpu.as_deref(), job)
+        let kind = JobKind::Open { built_in: source == Source::BuiltIn };
+        let started = self.jobs.start(kind, label.clone(), move |job| {
+            document::load(&source, resolution, gpu.as_deref(), job)
                 .map(|document| JobOutput::Loaded(Box::new(document)))
                 .map_err(|error| error_text(&error))
         });
@@ -411,10 +228,10 @@ impl Editor {
             WriteKind::ExportPacked => format!("Exporting packed buffers to {}", path.display()),
             WriteKind::ExportGltf => format!("Exporting glTF to {}", path.display()),
         };
-        let started = self.jobs.start(label.clone(), move |job| {
+        let started = self.jobs.start(JobKind::Write(kind), label.clone(), move |job| {
             let written = match kind {
-                WriteKind::Save | WriteKind::ExportPacked => loaded::write_packed(&document, format, &path, job),
-                WriteKind::ExportGltf => loaded::write_gltf(&document, &path, job),
+                WriteKind::Save | WriteKind::ExportPacked => document::write_packed(&document, format, &path, job),
+                WriteKind::ExportGltf => document::write_gltf(&document, &path, job),
             };
             written.map(|written| JobOutput::Written(written, kind)).map_err(|error| error_text(&error))
         });
@@ -426,23 +243,23 @@ impl Editor {
 
     /// Applies a finished job, if any (called every frame).
     pub fn poll_jobs(&mut self) {
-        if let Some((label, finished)) = self.jobs.poll() {
-            self.finish_job(label, finished);
+        if let Some((kind, finished)) = self.jobs.poll() {
+            self.finish_job(kind, finished);
         }
     }
 
     /// Waits up to `timeout` for the running job and applies it (tests, scripted runs).
     pub fn wait_for_job(&mut self, timeout: Duration) -> bool {
         match self.jobs.wait(timeout) {
-            Some((label, finished)) => {
-                self.finish_job(label, finished);
+            Some((kind, finished)) => {
+                self.finish_job(kind, finished);
                 true
             }
             None => !self.jobs.is_busy(),
         }
     }
 
-    fn finish_job(&mut self, label: String, finished: Finished<JobOutput>) {
+    fn finish_job(&mut self, kind: JobKind, finished: Finished<JobOutput>) {
         match finished {
             Finished::Done { value: JobOutput::Loaded(document), elapsed } => {
                 let mut document = *document;
@@ -497,7 +314,7 @@ impl Editor {
                     }
                 }
                 if kind == WriteKind::Save {
-                    self.saved_document();
+                    self.autosave.saved(self.document.as_ref(), self.edit_generation);
                 }
                 let verb = match kind {
                     WriteKind::Save => "Saved",
@@ -509,17 +326,17 @@ impl Editor {
                 );
             }
             Finished::Done { value: JobOutput::Repacked(repacked), elapsed } => self.finish_repack(*repacked, elapsed),
-            Finished::Done { value: JobOutput::Autosaved(autosaved), .. } => self.finish_autosave(autosaved),
-            Finished::Failed(message) if label.starts_with(super::autosave_ui::AUTOSAVE_LABEL) => {
+            Finished::Done { value: JobOutput::Autosaved(autosaved), .. } => self.autosave.finished(&autosaved),
+            Finished::Failed(message) if kind == JobKind::Autosave => {
                 self.autosave.failed();
                 self.set_status(Severity::Warning, format!("Autosave failed: {message}"));
             }
             Finished::Failed(message) => {
-                if label == "Repacking" {
+                if kind == JobKind::Repack {
                     self.gpu_paint_layout = true;
                 }
-                let is_open = label.starts_with("Opening");
-                if is_open && self.document.is_none() && !label.ends_with(loaded::DEFAULT_SCENE_NAME) {
+                let is_open = matches!(kind, JobKind::Open { .. });
+                if kind == (JobKind::Open { built_in: false }) && self.document.is_none() {
                     // Nothing was open (a bad file on the command line): show the Duck.
                     self.fallback_error = Some(format!("Could not open: {message}"));
                     self.set_status(Severity::Error, format!("Could not open: {message}"));
@@ -536,53 +353,33 @@ impl Editor {
         }
     }
 
-    /// Carries out `action`.
-    pub fn perform(&mut self, action: Action) {
-        match action {
-            Action::Open => self.open_dialog(DialogPurpose::Open),
-            Action::Save => match self.document.as_ref().and_then(|d| Some((d.project_path.clone()?, d.format))) {
-                Some((path, format)) => self.save_to(path, format),
-                None => self.open_dialog(DialogPurpose::SaveAs),
-            },
-            Action::SaveAs => self.open_dialog(DialogPurpose::SaveAs),
-            Action::ExportGltf => self.open_dialog(DialogPurpose::ExportGltf),
-            Action::ExportPacked => self.open_dialog(DialogPurpose::ExportPacked),
-            Action::FrameAll => self.frame_all(),
-            Action::FrameUnderCursor => {
-                if let Some(pos) = self.viewport_pointer {
-                    self.frame_under(pos);
-                }
-            }
-            Action::ViewFront => self.set_view_angles(0.0, 0.0),
-            Action::ViewBack => self.set_view_angles(180.0, 0.0),
-            Action::ViewRight => self.set_view_angles(90.0, 0.0),
-            Action::ViewLeft => self.set_view_angles(-90.0, 0.0),
-            Action::ViewTop => self.set_view_angles(0.0, 89.0),
-            Action::ViewBottom => self.set_view_angles(0.0, -89.0),
-            Action::ToggleWireframe => self.view.overlays.wireframe = !self.view.overlays.wireframe,
-            Action::ToggleHeatmap => self.view.overlays.heatmap = !self.view.overlays.heatmap,
-            Action::ToggleShading => {
-                self.view.shading = match self.view.shading {
-                    Shading::Lit => Shading::Unlit,
-                    Shading::Unlit => Shading::Lit,
-                }
-            }
-            Action::CycleFilter => {
-                self.view.filter = match self.view.filter {
-                    FilterMode::Nearest | FilterMode::NearestMipLevel(_) => FilterMode::Linear,
-                    FilterMode::Linear | FilterMode::MipLevel(_) => FilterMode::Trilinear,
-                    FilterMode::Trilinear => FilterMode::Nearest,
-                }
-            }
-            Action::ToggleHelp => self.show_help = !self.show_help,
-            Action::Quit => self.quit_requested = true,
-            Action::TogglePaintMode => self.toggle_paint_mode(),
-            Action::Undo => self.undo(),
-            Action::Redo => self.redo(),
-            Action::Eyedropper => self.eyedropper(),
-            Action::RadiusGesture => self.start_gesture(super::paint::GestureKind::Radius),
-            Action::StrengthGesture => self.start_gesture(super::paint::GestureKind::Strength),
+    /// Applies a finished repack (if the document is still the one packed).
+    pub(crate) fn finish_repack(&mut self, repacked: Repacked, elapsed: Duration) {
+        let Some(open) = self.document.as_mut() else {
+            return;
+        };
+        if !Arc::ptr_eq(&open.document, &repacked.document) || self.mode == Mode::Paint {
+            log::info!("a repack finished for a document that changed since; ignored");
+            return;
         }
+        if let Some(mesh) = repacked.gpu_mesh {
+            open.gpu_mesh = Some(mesh);
+        }
+        open.samples_with_mips = repacked.samples_with_mips;
+        open.packed_bytes = repacked.packed_bytes;
+        open.samples = open.document.store.sample_count();
+        open.last_repack = repacked.pack_time;
+        self.gpu_paint_layout = false;
+        self.scene_generation += 1;
+        self.set_status(
+            Severity::Info,
+            format!(
+                "Repacked: {} samples with MIP chains in {:.1} ms ({:.2} s with the upload)",
+                thousands(repacked.samples_with_mips),
+                repacked.pack_time.as_secs_f64() * 1000.0,
+                elapsed.as_secs_f64()
+            ),
+        );
     }
 
     /// Shows the file dialog for `purpose` (refused while a job runs).
@@ -698,32 +495,4 @@ impl Editor {
             None => "meshpaint".to_owned(),
         }
     }
-}
-
-/// The error and its causes on one line, skipping causes the message already quotes.
-pub fn error_text(error: &anyhow::Error) -> String {
-    let mut message = String::new();
-    for cause in error.chain() {
-        let text = cause.to_string();
-        if !message.contains(&text) {
-            if !message.is_empty() {
-                message.push_str(": ");
-            }
-            message.push_str(&text);
-        }
-    }
-    message
-}
-
-/// `1234567` → `1,234,567`.
-pub fn thousands(value: u64) -> String {
-    let digits = value.to_string();
-    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
 }

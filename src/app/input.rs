@@ -7,7 +7,12 @@
 
 use egui::{Key, Modifiers, PointerButton};
 
-use super::editor::{Action, Editor, Mode};
+use crate::render::{FilterMode, Shading};
+
+use super::editor::Editor;
+use super::file_dialog::DialogPurpose;
+use super::paint_session::GestureKind;
+use super::state::{Action, Mode};
 
 /// In which mode a shortcut works.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -152,13 +157,62 @@ pub fn shortcut_text(action: Action) -> Option<&'static str> {
     SHORTCUTS.iter().find(|s| s.action == action).map(|s| s.keys)
 }
 
+/// Carries out `action` on `editor`: the one place every menu entry and shortcut ends.
+pub fn perform(editor: &mut Editor, action: Action) {
+    match action {
+        Action::Open => editor.open_dialog(DialogPurpose::Open),
+        Action::Save => match editor.document.as_ref().and_then(|d| Some((d.project_path.clone()?, d.format))) {
+            Some((path, format)) => editor.save_to(path, format),
+            None => editor.open_dialog(DialogPurpose::SaveAs),
+        },
+        Action::SaveAs => editor.open_dialog(DialogPurpose::SaveAs),
+        Action::ExportGltf => editor.open_dialog(DialogPurpose::ExportGltf),
+        Action::ExportPacked => editor.open_dialog(DialogPurpose::ExportPacked),
+        Action::FrameAll => editor.frame_all(),
+        Action::FrameUnderCursor => {
+            if let Some(pos) = editor.viewport_pointer {
+                editor.frame_under(pos);
+            }
+        }
+        Action::ViewFront => editor.set_view_angles(0.0, 0.0),
+        Action::ViewBack => editor.set_view_angles(180.0, 0.0),
+        Action::ViewRight => editor.set_view_angles(90.0, 0.0),
+        Action::ViewLeft => editor.set_view_angles(-90.0, 0.0),
+        Action::ViewTop => editor.set_view_angles(0.0, 89.0),
+        Action::ViewBottom => editor.set_view_angles(0.0, -89.0),
+        Action::ToggleWireframe => editor.view.overlays.wireframe = !editor.view.overlays.wireframe,
+        Action::ToggleHeatmap => editor.view.overlays.heatmap = !editor.view.overlays.heatmap,
+        Action::ToggleShading => {
+            editor.view.shading = match editor.view.shading {
+                Shading::Lit => Shading::Unlit,
+                Shading::Unlit => Shading::Lit,
+            }
+        }
+        Action::CycleFilter => {
+            editor.view.filter = match editor.view.filter {
+                FilterMode::Nearest | FilterMode::NearestMipLevel(_) => FilterMode::Linear,
+                FilterMode::Linear | FilterMode::MipLevel(_) => FilterMode::Trilinear,
+                FilterMode::Trilinear => FilterMode::Nearest,
+            }
+        }
+        Action::ToggleHelp => editor.show_help = !editor.show_help,
+        Action::Quit => editor.quit_requested = true,
+        Action::TogglePaintMode => editor.toggle_paint_mode(),
+        Action::Undo => editor.undo(),
+        Action::Redo => editor.redo(),
+        Action::Eyedropper => editor.eyedropper(),
+        Action::RadiusGesture => editor.start_gesture(GestureKind::Radius),
+        Action::StrengthGesture => editor.start_gesture(GestureKind::Strength),
+    }
+}
+
 /// Keyboard shortcuts and dropped files, for the whole window. Keys go to a focused text
 /// field (the file dialog) rather than to shortcuts; F1 always works.
 pub fn global_input(editor: &mut Editor, ctx: &egui::Context) {
     let dropped: Vec<std::path::PathBuf> =
         ctx.input(|i| i.raw.dropped_files.iter().map(|file| file.path().to_owned()).collect());
     if let Some(path) = dropped.into_iter().next() {
-        editor.open(super::loaded::Source::File(path));
+        editor.open(crate::io::document::Source::File(path));
     }
     if editor.gesture_input(ctx) {
         return;
@@ -184,7 +238,7 @@ pub fn global_input(editor: &mut Editor, ctx: &egui::Context) {
         }
     }
     for action in actions {
-        editor.perform(action);
+        perform(editor, action);
     }
 }
 

@@ -12,6 +12,33 @@ use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+/// What a job does: the editor applies a finished job by its kind, never by its label.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum JobKind {
+    /// Opening a document (`built_in`: the built-in scene, the fallback of a failed start).
+    Open {
+        /// Whether the built-in scene is being opened.
+        built_in: bool,
+    },
+    /// Writing a file.
+    Write(WriteKind),
+    /// Repacking the store after paint mode.
+    Repack,
+    /// Writing a recovery file.
+    Autosave,
+}
+
+/// Which kind of file a write job produced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WriteKind {
+    /// The project (packed file) was saved.
+    Save,
+    /// Packed buffers were exported.
+    ExportPacked,
+    /// A .glb was exported.
+    ExportGltf,
+}
+
 /// A callback that wakes the UI thread (a repaint request); called from the worker.
 pub type Waker = Arc<dyn Fn() + Send + Sync>;
 
@@ -59,6 +86,7 @@ impl JobContext {
 
 /// A job that is running.
 struct Running<T> {
+    kind: JobKind,
     label: String,
     started: Instant,
     progress: Arc<Progress>,
@@ -108,10 +136,11 @@ impl<T: Send + 'static> Jobs<T> {
         Some((&job.label, job.progress.fraction(), job.progress.stage(), job.started.elapsed()))
     }
 
-    /// Starts `work` on a worker thread under `label`; refused (returns the label back as
-    /// an error message) while another job runs.
+    /// Starts `work` of `kind` on a worker thread under `label` (shown on the status line);
+    /// refused (returns the label back as an error message) while another job runs.
     pub fn start(
         &mut self,
+        kind: JobKind,
         label: impl Into<String>,
         work: impl FnOnce(&JobContext) -> Result<T, String> + Send + 'static,
     ) -> Result<(), String> {
@@ -139,12 +168,12 @@ impl<T: Send + 'static> Jobs<T> {
         if let Err(error) = spawned {
             return Err(format!("cannot start a worker thread for “{label}”: {error}"));
         }
-        self.running = Some(Running { label, started: Instant::now(), progress, receiver });
+        self.running = Some(Running { kind, label, started: Instant::now(), progress, receiver });
         Ok(())
     }
 
     /// The running job's outcome if it has finished (the runner is then free again).
-    pub fn poll(&mut self) -> Option<(String, Finished<T>)> {
+    pub fn poll(&mut self) -> Option<(JobKind, Finished<T>)> {
         let job = self.running.as_ref()?;
         let outcome = match job.receiver.try_recv() {
             Ok(Ok(value)) => Finished::Done { value, elapsed: job.started.elapsed() },
@@ -153,11 +182,11 @@ impl<T: Send + 'static> Jobs<T> {
             Err(TryRecvError::Disconnected) => Finished::Failed("the worker thread stopped without an answer".into()),
         };
         let job = self.running.take()?;
-        Some((job.label, outcome))
+        Some((job.kind, outcome))
     }
 
     /// Blocks until the running job finishes (tests and shutdown), at most `timeout`.
-    pub fn wait(&mut self, timeout: Duration) -> Option<(String, Finished<T>)> {
+    pub fn wait(&mut self, timeout: Duration) -> Option<(JobKind, Finished<T>)> {
         let deadline = Instant::now() + timeout;
         loop {
             self.running.as_ref()?;

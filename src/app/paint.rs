@@ -8,80 +8,21 @@
 //! compact layout with MIP chains on a worker thread ([`Editor::leave_paint_mode`]).
 
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use crate::colors::layout::Resolution;
 use crate::colors::store::ColorStore;
-use crate::io::document::Document;
 use crate::packing::paint_layout::PaintLayout;
 use crate::paint::brush::{
     self, BlendMode, BrushRadius, Falloff, FillScope, PaintView, Painter, ResolutionOp, StrokeUpdate, Tool,
 };
 use crate::paint::undo::UndoHistory;
-use crate::render::{GpuMesh, MeshUploadOptions};
 
-use super::editor::{Editor, JobOutput, Mode, Severity, thousands};
-use super::loaded::human_bytes;
-
-/// Points of pointer travel for strength 0 → 1 in the Shift+F gesture.
-pub const STRENGTH_GESTURE_POINTS: f32 = 200.0;
-
-/// Which brush value an interactive gesture changes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum GestureKind {
-    /// The radius (F).
-    Radius,
-    /// The strength (Shift+F).
-    Strength,
-}
-
-/// An interactive radius / strength gesture in progress: the value follows the pointer's
-/// distance from `center`; a click or Enter confirms, Esc or a right click cancels.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Gesture {
-    /// What it changes.
-    pub kind: GestureKind,
-    /// The circle's centre, points.
-    pub center: egui::Pos2,
-    /// The settings before the gesture (restored on cancel).
-    pub before: brush::BrushSettings,
-}
-
-/// The state of paint mode while it is on.
-#[derive(Debug)]
-pub struct PaintSession {
-    /// Where every element's samples live in the GPU colour buffer.
-    pub layout: PaintLayout,
-    /// The colours when paint mode was entered (Erase to base).
-    pub base: ColorStore,
-    /// The brush engine.
-    pub painter: Painter,
-    /// A radius / strength gesture in progress.
-    pub gesture: Option<Gesture>,
-    /// The pointer's last position over the 3D view, points (fill connected, eyedropper).
-    pub last_pointer: Option<egui::Pos2>,
-    /// The primary button went down to confirm a gesture: no stroke until it is released.
-    pub swallow_primary: bool,
-    /// Bytes uploaded by the current (or last) stroke.
-    pub stroke_upload_bytes: u64,
-    /// Samples changed by the current (or last) stroke.
-    pub stroke_samples_changed: u64,
-}
-
-/// The result of a repack job (leaving paint mode).
-#[derive(Debug)]
-pub struct Repacked {
-    /// The document that was packed (applied only if it is still the open one).
-    pub document: Arc<Document>,
-    /// The compact buffers on the GPU (`None` without a GPU).
-    pub gpu_mesh: Option<GpuMesh>,
-    /// Samples with MIP chains.
-    pub samples_with_mips: u64,
-    /// Bytes of face records and colours.
-    pub packed_bytes: u64,
-    /// How long packing took.
-    pub pack_time: Duration,
-}
+use super::editor::{Editor, JobOutput};
+use super::jobs::JobKind;
+use super::paint_session::{Gesture, GestureKind, PaintSession, Repacked, STRENGTH_GESTURE_POINTS};
+use super::state::{Mode, Severity};
+use super::text::{human_bytes, thousands};
 
 /// The egui colour of a linear straight-alpha colour.
 fn to_egui(color: [f32; 4]) -> egui::Rgba {
@@ -114,7 +55,7 @@ impl Editor {
         let layout = PaintLayout::new(&document.store);
         if let Some(gpu) = &self.gpu {
             let packed = layout.packed(&document.store, &document.positions, open.format);
-            match GpuMesh::upload(&gpu.ctx, &gpu.renderer, &packed, &MeshUploadOptions::default()) {
+            match gpu.upload(&packed) {
                 Ok(mesh) => {
                     self.upload_bytes_this_frame += packed.color_bytes() + packed.face_record_bytes();
                     open.gpu_mesh = Some(mesh);
@@ -164,7 +105,7 @@ impl Editor {
         let document = Arc::clone(&open.document);
         let format = open.format;
         let gpu = self.gpu.clone();
-        let started = self.jobs.start("Repacking", move |job| {
+        let started = self.jobs.start(JobKind::Repack, "Repacking", move |job| {
             job.progress(0.1, "packing colours with MIP chains");
             let started = Instant::now();
             let packed = document.pack(format).map_err(|error| format!("repacking failed: {error}"))?;
@@ -172,8 +113,7 @@ impl Editor {
             job.progress(0.7, "uploading to the GPU");
             let gpu_mesh = match gpu {
                 Some(gpu) => Some(
-                    GpuMesh::upload(&gpu.ctx, &gpu.renderer, &packed, &MeshUploadOptions::default())
-                        .map_err(|error| format!("uploading the repacked buffers failed: {error}"))?,
+                    gpu.upload(&packed).map_err(|error| format!("uploading the repacked buffers failed: {error}"))?,
                 ),
                 None => None,
             };
@@ -189,35 +129,6 @@ impl Editor {
             Ok(()) => self.set_status(Severity::Info, "Repacking…"),
             Err(message) => self.set_status(Severity::Error, message),
         }
-    }
-
-    /// Applies a finished repack (if the document is still the one packed).
-    pub(crate) fn finish_repack(&mut self, repacked: Repacked, elapsed: Duration) {
-        let Some(open) = self.document.as_mut() else {
-            return;
-        };
-        if !Arc::ptr_eq(&open.document, &repacked.document) || self.mode == Mode::Paint {
-            log::info!("a repack finished for a document that changed since; ignored");
-            return;
-        }
-        if let Some(mesh) = repacked.gpu_mesh {
-            open.gpu_mesh = Some(mesh);
-        }
-        open.samples_with_mips = repacked.samples_with_mips;
-        open.packed_bytes = repacked.packed_bytes;
-        open.samples = open.document.store.sample_count();
-        open.last_repack = repacked.pack_time;
-        self.gpu_paint_layout = false;
-        self.scene_generation += 1;
-        self.set_status(
-            Severity::Info,
-            format!(
-                "Repacked: {} samples with MIP chains in {:.1} ms ({:.2} s with the upload)",
-                thousands(repacked.samples_with_mips),
-                repacked.pack_time.as_secs_f64() * 1000.0,
-                elapsed.as_secs_f64()
-            ),
-        );
     }
 
     /// Pixel coordinates in the 3D view of `pos` (points, window coordinates).
@@ -327,7 +238,7 @@ impl Editor {
         if let (Some(gpu), Some(mesh)) = (gpu.as_ref(), open.gpu_mesh.as_mut()) {
             if plan.grown {
                 let packed = session.layout.packed(&doc.store, &doc.positions, open.format);
-                match GpuMesh::upload(&gpu.ctx, &gpu.renderer, &packed, &MeshUploadOptions::default()) {
+                match gpu.upload(&packed) {
                     Ok(new_mesh) => {
                         *mesh = new_mesh;
                         bytes += packed.color_bytes() + packed.face_record_bytes();

@@ -4,9 +4,10 @@
 use crate::colors::layout::Resolution;
 use crate::render::{FilterMode, RenderSettings, Shading};
 
-use super::editor::{Action, Editor, Severity, thousands};
+use super::editor::Editor;
 use super::input::{self, POINTER_HELP, SHORTCUTS, shortcut_text};
-use super::loaded::human_bytes;
+use super::state::{Action, Severity};
+use super::text::{human_bytes, thousands};
 
 /// Width of the side panel, points.
 pub const SIDE_PANEL_WIDTH: f32 = 250.0;
@@ -48,7 +49,7 @@ impl Editor {
             button = button.shortcut_text(keys);
         }
         if ui.add_enabled(enabled, button).clicked() {
-            self.perform(action);
+            input::perform(self, action);
             ui.close();
         }
     }
@@ -102,30 +103,30 @@ impl Editor {
         let idle = !self.jobs.is_busy();
         ui.horizontal_wrapped(|ui| {
             if ui.add_enabled(idle, egui::Button::new("Open…")).on_hover_text("Ctrl+O").clicked() {
-                self.perform(Action::Open);
+                input::perform(self, Action::Open);
             }
             if ui.add_enabled(idle && has_document, egui::Button::new("Save")).on_hover_text("Ctrl+S").clicked() {
-                self.perform(Action::Save);
+                input::perform(self, Action::Save);
             }
             if ui
                 .add_enabled(idle && has_document, egui::Button::new("Save as…"))
                 .on_hover_text("Ctrl+Shift+S")
                 .clicked()
             {
-                self.perform(Action::SaveAs);
+                input::perform(self, Action::SaveAs);
             }
         });
         ui.horizontal_wrapped(|ui| {
             if ui.add_enabled(idle && has_document, egui::Button::new("Export glTF…")).on_hover_text("Ctrl+E").clicked()
             {
-                self.perform(Action::ExportGltf);
+                input::perform(self, Action::ExportGltf);
             }
             if ui
                 .add_enabled(idle && has_document, egui::Button::new("Export packed…"))
                 .on_hover_text("Ctrl+Shift+E")
                 .clicked()
             {
-                self.perform(Action::ExportPacked);
+                input::perform(self, Action::ExportPacked);
             }
         });
         ui.horizontal(|ui| {
@@ -188,7 +189,7 @@ impl Editor {
             .on_hover_text("H — log2 R: dark blue 0, blue, cyan, green, yellow, orange, magenta 12");
         ui.horizontal(|ui| {
             if ui.button("Frame all").on_hover_text("Home").clicked() {
-                self.perform(Action::FrameAll);
+                input::perform(self, Action::FrameAll);
             }
             ui.label(
                 egui::RichText::new(format!(
@@ -245,8 +246,8 @@ impl Editor {
         ui.horizontal(|ui| {
             let mode = egui::RichText::new(format!("{} mode", self.mode.name())).strong();
             let mode = match self.mode {
-                super::editor::Mode::Paint => mode.color(egui::Color32::from_rgb(255, 170, 60)),
-                super::editor::Mode::View => mode,
+                super::state::Mode::Paint => mode.color(egui::Color32::from_rgb(255, 170, 60)),
+                super::state::Mode::View => mode,
             };
             ui.label(mode).on_hover_text("Tab toggles paint mode");
             ui.separator();
@@ -336,10 +337,10 @@ impl Editor {
             }
         }
         let hint = match self.mode {
-            super::editor::Mode::View => {
+            super::state::Mode::View => {
                 "Middle drag: orbit · Shift: pan · Wheel: zoom · Home: frame all · Tab: paint · F1: help"
             }
-            super::editor::Mode::Paint => {
+            super::state::Mode::Paint => {
                 "PAINT · Left drag: paint · F / Shift+F: radius / strength · S: pick colour · Ctrl+Z: undo · Tab: leave"
             }
         };

@@ -27,7 +27,8 @@ use winit::window::{Window, WindowId};
 use crate::render::{DEPTH_FORMAT, DrawItem, GpuContext, OFFSCREEN_FORMAT, RenderTarget, Renderer};
 
 use super::editor::Editor;
-use super::loaded::{Gpu, Source};
+use crate::io::document::Source;
+use crate::render::Gpu;
 
 /// How the application starts.
 #[derive(Debug, Clone, Default)]
@@ -180,7 +181,7 @@ impl Shell {
         }
         let (gpu, gpu_error) = match Gpu::new(Arc::clone(&ctx)) {
             Ok(gpu) => (Some(Arc::new(gpu)), None),
-            Err(error) => (None, Some(super::editor::error_text(&error))),
+            Err(error) => (None, Some(format!("building the render pipelines: {error}"))),
         };
 
         let egui_ctx = egui::Context::default();
@@ -210,7 +211,7 @@ impl Shell {
         });
         if let Some(error) = gpu_error {
             // The panels still work (open, save, export); only the 3D view is off.
-            editor.set_status(super::editor::Severity::Error, format!("The 3D view is off: {error}"));
+            editor.set_status(super::state::Severity::Error, format!("The 3D view is off: {error}"));
         }
         Ok(Running {
             window,

@@ -14,16 +14,15 @@
 
 use std::time::Instant;
 
-use crate::camera::OrbitCamera;
+use crate::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera, default_camera};
 use crate::colors::format::ColorFormat;
 use crate::io::document::{Document, bounds};
 use crate::mesh::import::import_gltf;
 use crate::mesh::scene::Texture;
-use crate::mesh::weld::weld_scene;
 
 use crate::render::{
-    BaselineMesh, DrawItem, FilterMode, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderError,
-    RenderSettings, RenderTarget, Renderer, Shading, default_camera,
+    BaselineMesh, DrawItem, FilterMode, Gpu, OFFSCREEN_FORMAT, RenderError, RenderSettings, RenderTarget, Renderer,
+    Shading,
 };
 
 /// One measured path.
@@ -109,32 +108,18 @@ pub fn bench_render(
     height: u32,
     frames: usize,
 ) -> Result<RenderBench, BenchRenderError> {
-    let ctx = GpuContext::new_headless()?;
-    let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT)?;
+    let gpu = Gpu::new_headless()?;
+    let (ctx, renderer) = (&*gpu.ctx, &gpu.renderer);
     let packed = document.pack(ColorFormat::Rgba8Srgb)?;
-    let mesh = GpuMesh::upload(&ctx, &renderer, &packed, &MeshUploadOptions::default())?;
+    let mesh = gpu.upload(&packed)?;
 
     // Baseline: the file's own UVs and texture when it has them.
-    let scene = import_gltf(path).ok();
-    let textured = scene.as_ref().and_then(|scene| {
-        scene.materials.iter().find_map(|material| {
-            let texture = scene.textures.get(material.base_color_texture? as usize)?;
-            Some((weld_scene(scene), texture.clone(), material.base_color_factor))
-        })
-    });
+    let textured = match import_gltf(path) {
+        Ok(scene) => gpu.upload_baseline(&scene)?,
+        Err(_) => None,
+    };
     let (baseline_name, baseline) = match textured {
-        Some((welded, texture, factor)) => (
-            "gltf texture".to_owned(),
-            BaselineMesh::new(
-                &ctx,
-                &renderer,
-                &welded.positions_world,
-                &welded.triangles,
-                &welded.corner_uvs,
-                &texture,
-                factor,
-            )?,
-        ),
+        Some(mesh) => ("gltf texture".to_owned(), mesh),
         None => {
             let (min, size) = bounds(&document.positions);
             let corner_uvs: Vec<[[f32; 2]; 3]> = document
@@ -155,8 +140,8 @@ pub fn bench_render(
             (
                 format!("synthetic planar {side}x{side}"),
                 BaselineMesh::new(
-                    &ctx,
-                    &renderer,
+                    ctx,
+                    renderer,
                     &document.positions,
                     &document.store.topology().face_vertices,
                     &corner_uvs,
@@ -167,7 +152,7 @@ pub fn bench_render(
         }
     };
 
-    let camera: OrbitCamera = default_camera(&document.positions, 30.0, 20.0, None);
+    let camera: OrbitCamera = default_camera(mesh.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
     let color = ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("bench colour"),
         size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
@@ -178,7 +163,7 @@ pub fn bench_render(
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
         view_formats: &[],
     });
-    let depth = Renderer::create_depth_texture(&ctx, width, height);
+    let depth = Renderer::create_depth_texture(ctx, width, height);
     let color_view = color.create_view(&wgpu::TextureViewDescriptor::default());
     let depth_view = depth.create_view(&wgpu::TextureViewDescriptor::default());
     let target = RenderTarget { color: &color_view, depth: &depth_view, width, height };
@@ -197,7 +182,7 @@ pub fn bench_render(
         settings.shading = Shading::Unlit;
         let start = Instant::now();
         let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        renderer.draw(&ctx, &mut encoder, &target, item, &settings);
+        renderer.draw(ctx, &mut encoder, &target, item, &settings);
         ctx.queue.submit([encoder.finish()]);
         // A failed wait leaves the timing as measured so far; the report still compares.
         let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());

@@ -4,8 +4,13 @@
 //! mesh is welded, given a uniform resolution, and coloured: without a texture it gets
 //! a deterministic colour from position so the result is visibly non-uniform. A packed
 //! file is unpacked into the editable store.
+//!
+//! [`open_for_display`] is the one way to open a document for display (the editor, `render`,
+//! `bench render`, the examples): open the [`Source`], refuse a mesh without triangles, pack
+//! it in its [`Document::display_format`].
 
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use thiserror::Error;
 
@@ -45,6 +50,12 @@ pub enum DocumentError {
         /// The cause.
         source: TopologyError,
     },
+    /// The mesh has no triangles to show or paint.
+    #[error("{path}: the file holds no triangles to paint")]
+    NoTriangles {
+        /// The file.
+        path: PathBuf,
+    },
     /// Packing or unpacking failed.
     #[error("{path}: {source}")]
     Pack {
@@ -53,6 +64,71 @@ pub enum DocumentError {
         /// The cause.
         source: PackError,
     },
+}
+
+/// What to open: the built-in scene or a file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Source {
+    /// The Duck embedded in the binary ([`BUILT_IN_GLB`]).
+    BuiltIn,
+    /// A .glb / .gltf or packed file.
+    File(PathBuf),
+}
+
+/// The built-in scene (Khronos Duck, see assets/SOURCES.md), embedded in the binary.
+pub const BUILT_IN_GLB: &[u8] = include_bytes!("../../assets/models/Duck/Duck.glb");
+/// How the built-in scene is named in titles and messages.
+pub const BUILT_IN_NAME: &str = "Duck (built-in)";
+
+impl Source {
+    /// The name shown in messages: the path, or [`BUILT_IN_NAME`].
+    pub fn name(&self) -> String {
+        match self {
+            Source::BuiltIn => BUILT_IN_NAME.to_owned(),
+            Source::File(path) => path.display().to_string(),
+        }
+    }
+
+    /// The file name for titles (the whole name when it has no file name part).
+    pub fn title(&self) -> String {
+        match self {
+            Source::BuiltIn => BUILT_IN_NAME.to_owned(),
+            Source::File(path) => path.file_name().map_or_else(|| self.name(), |n| n.to_string_lossy().into_owned()),
+        }
+    }
+}
+
+/// A document opened for display: its packed buffers (face records and colours with MIP
+/// chains, in [`Document::display_format`]) beside the editable document.
+#[derive(Debug, Clone)]
+pub struct Displayed {
+    /// The document.
+    pub document: Document,
+    /// Its packed buffers.
+    pub packed: PackedMesh,
+    /// How long packing took.
+    pub pack_time: Duration,
+}
+
+/// Opens `source` for display: glTF at uniform `gltf_resolution` or a packed file, refuses a
+/// mesh without triangles, and packs it in its display format. `progress(fraction, stage)`
+/// is told each stage. Importer notes are in `document.warnings`.
+pub fn open_for_display(
+    source: &Source,
+    gltf_resolution: Resolution,
+    progress: &mut dyn FnMut(f32, &str),
+) -> Result<Displayed, DocumentError> {
+    progress(0.05, "reading and importing");
+    let document = Document::open_source(source, gltf_resolution)?;
+    let name = PathBuf::from(source.name());
+    if document.store.topology().face_count() == 0 {
+        return Err(DocumentError::NoTriangles { path: name });
+    }
+    progress(0.45, "packing colours with MIP chains");
+    let started = Instant::now();
+    let packed =
+        document.pack(document.display_format()).map_err(|source| DocumentError::Pack { path: name, source })?;
+    Ok(Displayed { document, packed, pack_time: started.elapsed() })
 }
 
 /// Where a document came from.
@@ -170,6 +246,26 @@ impl Document {
             return Self::from_packed(&packed).map_err(|source| DocumentError::Pack { path: path.to_owned(), source });
         }
         Self::from_scene(import_gltf(path)?, gltf_resolution, path)
+    }
+
+    /// Opens `source`: the built-in scene or a file, as [`Document::open`] does.
+    pub fn open_source(source: &Source, gltf_resolution: Resolution) -> Result<Self, DocumentError> {
+        match source {
+            Source::BuiltIn => {
+                let scene = crate::mesh::import::import_gltf_slice(BUILT_IN_GLB, None, "Duck.glb")?;
+                Self::from_scene(scene, gltf_resolution, Path::new(BUILT_IN_NAME))
+            }
+            Source::File(path) => Self::open(path, gltf_resolution),
+        }
+    }
+
+    /// The colour format the document is shown and saved in by default: a packed file's own
+    /// format, RGBA8 sRGB for glTF.
+    pub fn display_format(&self) -> ColorFormat {
+        match self.source {
+            SourceKind::Packed(format) => format,
+            SourceKind::Gltf => ColorFormat::default(),
+        }
     }
 
     /// A document from a glTF scene already in memory (e.g. a model embedded in the binary and

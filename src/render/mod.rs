@@ -30,18 +30,20 @@
 //!
 //! The renderer is target-agnostic: [`Renderer::draw`] records into any colour view of the
 //! format the renderer was built for; [`Renderer::render_image`] is the offscreen path
-//! (render, copy, read back into an [`image::RgbaImage`]).
+//! (render, copy, read back into an [`image::RgbaImage`]). [`Gpu`] bundles a device with the
+//! renderer and is the one upload path ([`Gpu::upload`]). The GPU layer never opens files:
+//! it draws what [`crate::io::document::open_for_display`] opened.
 
 mod baseline;
 mod context;
-mod headless;
+mod gpu;
 mod mesh_gpu;
 mod renderer;
 mod uniforms;
 
 pub use baseline::{BaselineMesh, BaselineVertex, mip_chain_linear};
 pub use context::{GpuContext, backends_from_env};
-pub use headless::{RenderFileError, RenderRequest, RenderedFile, default_camera, render_file};
+pub use gpu::Gpu;
 pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshUploadOptions, atlas_texture_format, default_atlas_width};
 pub use renderer::{DrawItem, FilterMode, Overlays, RenderSettings, RenderTarget, Renderer, Shading};
 pub use uniforms::FrameUniforms;

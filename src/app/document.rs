@@ -14,34 +14,12 @@ use anyhow::{Context, Result};
 use crate::camera::BoundingSphere;
 use crate::colors::format::ColorFormat;
 use crate::colors::layout::Resolution;
-use crate::io::document::{Document, SourceKind};
+use crate::io::document::{Displayed, Document, Source, SourceKind, open_for_display};
 use crate::paint::picking::{BvhPreset, MeshBvh};
-use crate::render::{GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, Renderer};
+use crate::render::{Gpu, GpuMesh};
 
-use super::editor::thousands;
 use super::jobs::JobContext;
-
-/// The built-in scene: the Duck, embedded in the binary so it opens from any directory.
-pub const DEFAULT_SCENE_GLB: &[u8] = include_bytes!("../../assets/models/Duck/Duck.glb");
-/// The name the built-in scene goes by in titles and messages.
-pub const DEFAULT_SCENE_NAME: &str = "Duck (built-in)";
-
-/// The GPU objects the editor shares with its worker threads.
-#[derive(Debug)]
-pub struct Gpu {
-    /// Device and queue.
-    pub ctx: Arc<GpuContext>,
-    /// Pipelines for the 3D view (offscreen target in [`OFFSCREEN_FORMAT`]).
-    pub renderer: Renderer,
-}
-
-impl Gpu {
-    /// Builds the renderer for `ctx`.
-    pub fn new(ctx: Arc<GpuContext>) -> Result<Self> {
-        let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT).context("building the render pipelines")?;
-        Ok(Gpu { ctx, renderer })
-    }
-}
+use super::text::{human_bytes, thousands};
 
 /// A document open in the editor.
 #[derive(Debug)]
@@ -81,62 +59,21 @@ impl OpenDocument {
     }
 }
 
-/// Where a document comes from.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Source {
-    /// The built-in Duck.
-    BuiltIn,
-    /// A glTF or packed file.
-    File(PathBuf),
-}
-
-impl Source {
-    /// Name for messages.
-    pub fn name(&self) -> String {
-        match self {
-            Source::BuiltIn => DEFAULT_SCENE_NAME.to_owned(),
-            Source::File(path) => path.display().to_string(),
-        }
-    }
-}
-
-/// Opens `source` (glTF at `resolution`, or packed), packs it, uploads it when `gpu` is
-/// given and builds the picking BVH. Refuses meshes without triangles.
+/// Opens `source` for display ([`open_for_display`]: glTF at `resolution`, or packed),
+/// uploads it when `gpu` is given and builds the picking BVH.
 pub fn load(source: &Source, resolution: Resolution, gpu: Option<&Gpu>, job: &JobContext) -> Result<OpenDocument> {
-    job.progress(0.05, "reading and importing");
-    let document = match source {
-        Source::BuiltIn => {
-            let scene = crate::mesh::import::import_gltf_slice(DEFAULT_SCENE_GLB, None, "Duck.glb")?;
-            Document::from_scene(scene, resolution, Path::new(DEFAULT_SCENE_NAME))?
-        }
-        Source::File(path) => Document::open(path, resolution)?,
-    };
+    let Displayed { document, packed, pack_time } =
+        open_for_display(source, resolution, &mut |fraction, stage| job.progress(fraction, stage))?;
     let name = source.name();
-    let faces = document.store.topology().face_count();
-    anyhow::ensure!(faces > 0, "{name}: the file holds no triangles to paint");
-    let format = match document.source {
-        SourceKind::Packed(format) => format,
-        SourceKind::Gltf => ColorFormat::default(),
-    };
-    job.progress(0.45, "packing colours with MIP chains");
-    let started = Instant::now();
-    let packed = document.pack(format).with_context(|| format!("packing {name}"))?;
-    let last_repack = started.elapsed();
     let gpu_mesh = match gpu {
         Some(gpu) => {
             job.progress(0.65, "uploading to the GPU");
-            let mesh = GpuMesh::upload(&gpu.ctx, &gpu.renderer, &packed, &MeshUploadOptions::default())
-                .with_context(|| format!("uploading {name} to the GPU"))?;
-            Some(mesh)
+            Some(gpu.upload(&packed).with_context(|| format!("uploading {name} to the GPU"))?)
         }
         None => None,
     };
     job.progress(0.8, "building the picking BVH");
     let bvh = MeshBvh::build(&document.positions, &document.store.topology().face_vertices, BvhPreset::FastBuild);
-    let title = match source {
-        Source::BuiltIn => DEFAULT_SCENE_NAME.to_owned(),
-        Source::File(path) => path.file_name().map_or_else(|| name.clone(), |n| n.to_string_lossy().into_owned()),
-    };
     job.progress(1.0, "done");
     let document_is_packed = matches!(document.source, SourceKind::Packed(_));
     Ok(OpenDocument {
@@ -144,6 +81,7 @@ pub fn load(source: &Source, resolution: Resolution, gpu: Option<&Gpu>, job: &Jo
         samples: document.store.sample_count(),
         samples_with_mips: packed.sample_count(),
         packed_bytes: packed.face_record_bytes() + packed.color_bytes(),
+        format: document.display_format(),
         document: Arc::new(document),
         gpu_mesh,
         bvh,
@@ -155,9 +93,8 @@ pub fn load(source: &Source, resolution: Resolution, gpu: Option<&Gpu>, job: &Jo
             Source::BuiltIn => None,
             Source::File(path) => Some(path.clone()),
         },
-        title,
-        format,
-        last_repack,
+        title: source.title(),
+        last_repack: pack_time,
     })
 }
 
@@ -213,16 +150,4 @@ pub fn write_gltf(document: &Document, path: &Path, job: &JobContext) -> Result<
             human_bytes(summary.bytes)
         ),
     })
-}
-
-/// `bytes` as B / KiB / MiB / GiB with one decimal.
-pub fn human_bytes(bytes: u64) -> String {
-    const UNITS: [&str; 4] = ["B", "KiB", "MiB", "GiB"];
-    let mut value = bytes as f64;
-    let mut unit = 0;
-    while value >= 1024.0 && unit + 1 < UNITS.len() {
-        value /= 1024.0;
-        unit += 1;
-    }
-    if unit == 0 { format!("{bytes} B") } else { format!("{value:.1} {}", UNITS[unit]) }
 }

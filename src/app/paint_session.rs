@@ -1,0 +1,72 @@
+//! The state of paint mode while it is on: the paint layout, the base snapshot, the brush
+//! engine and an interactive gesture; and the result of the repack job that ends it. The
+//! editor's paint-mode commands and panel are in [`super::paint`].
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use crate::colors::store::ColorStore;
+use crate::io::document::Document;
+use crate::packing::paint_layout::PaintLayout;
+use crate::paint::brush::{self, Painter};
+use crate::render::GpuMesh;
+
+/// Points of pointer travel for strength 0 → 1 in the Shift+F gesture.
+pub const STRENGTH_GESTURE_POINTS: f32 = 200.0;
+
+/// Which brush value an interactive gesture changes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GestureKind {
+    /// The radius (F).
+    Radius,
+    /// The strength (Shift+F).
+    Strength,
+}
+
+/// An interactive radius / strength gesture in progress: the value follows the pointer's
+/// distance from `center`; a click or Enter confirms, Esc or a right click cancels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Gesture {
+    /// What it changes.
+    pub kind: GestureKind,
+    /// The circle's centre, points.
+    pub center: egui::Pos2,
+    /// The settings before the gesture (restored on cancel).
+    pub before: brush::BrushSettings,
+}
+
+/// The state of paint mode while it is on.
+#[derive(Debug)]
+pub struct PaintSession {
+    /// Where every element's samples live in the GPU colour buffer.
+    pub layout: PaintLayout,
+    /// The colours when paint mode was entered (Erase to base).
+    pub base: ColorStore,
+    /// The brush engine.
+    pub painter: Painter,
+    /// A radius / strength gesture in progress.
+    pub gesture: Option<Gesture>,
+    /// The pointer's last position over the 3D view, points (fill connected, eyedropper).
+    pub last_pointer: Option<egui::Pos2>,
+    /// The primary button went down to confirm a gesture: no stroke until it is released.
+    pub swallow_primary: bool,
+    /// Bytes uploaded by the current (or last) stroke.
+    pub stroke_upload_bytes: u64,
+    /// Samples changed by the current (or last) stroke.
+    pub stroke_samples_changed: u64,
+}
+
+/// The result of a repack job (leaving paint mode).
+#[derive(Debug)]
+pub struct Repacked {
+    /// The document that was packed (applied only if it is still the open one).
+    pub document: Arc<Document>,
+    /// The compact buffers on the GPU (`None` without a GPU).
+    pub gpu_mesh: Option<GpuMesh>,
+    /// Samples with MIP chains.
+    pub samples_with_mips: u64,
+    /// Bytes of face records and colours.
+    pub packed_bytes: u64,
+    /// How long packing took.
+    pub pack_time: Duration,
+}

@@ -1,0 +1,183 @@
+//! The editor's small shared types: mode, status, view settings, the [`Action`]s every
+//! menu and shortcut maps to, the viewport and frame timing. They depend on nothing else
+//! in the app, so every other file may use them.
+
+use std::time::{Duration, Instant};
+
+use crate::render::{FilterMode, Overlays, Shading};
+
+/// What the editor is doing with the pointer in the 3D view. Paint mode (Tab) slots in
+/// here: its tools get the pointer in [`super::input::viewport_input`], edit the document's
+/// store and upload dirty samples to its GPU mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Mode {
+    /// Look at the mesh: navigation only.
+    #[default]
+    View,
+    /// Paint on the mesh: the left button paints with the brush ([`super::paint`]).
+    Paint,
+}
+
+impl Mode {
+    /// Name for the status line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::View => "View",
+            Mode::Paint => "Paint",
+        }
+    }
+}
+
+/// How bad a status message is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Severity {
+    /// Progress and results.
+    Info,
+    /// Something worked, with caveats.
+    Warning,
+    /// Something failed; nothing was changed.
+    Error,
+}
+
+/// The status line's message.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Status {
+    /// The message.
+    pub text: String,
+    /// Its severity.
+    pub severity: Severity,
+}
+
+/// Everything that decides how the 3D view looks, besides the camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewSettings {
+    /// Mesh-colors reconstruction filter.
+    pub filter: FilterMode,
+    /// Lit or unlit.
+    pub shading: Shading,
+    /// Wireframe and resolution heat map.
+    pub overlays: Overlays,
+    /// Redraw every frame (to measure fps) instead of only when something changes.
+    pub continuous_redraw: bool,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        ViewSettings {
+            filter: FilterMode::Trilinear,
+            shading: Shading::Lit,
+            overlays: Overlays::default(),
+            continuous_redraw: false,
+        }
+    }
+}
+
+/// Every command the UI offers: shortcuts and menus map to these
+/// ([`super::input::SHORTCUTS`]), and [`super::input::perform`] carries them out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Action {
+    /// Show the Open dialog.
+    Open,
+    /// Save the project (packed file); asks for a name the first time.
+    Save,
+    /// Save under a new name.
+    SaveAs,
+    /// Export a tessellated vertex-colour .glb.
+    ExportGltf,
+    /// Export the packed buffers in a chosen colour format.
+    ExportPacked,
+    /// Frame the whole mesh.
+    FrameAll,
+    /// Centre on the surface point under the cursor and move halfway towards it.
+    FrameUnderCursor,
+    /// Look from the front (+Z).
+    ViewFront,
+    /// Look from the back (−Z).
+    ViewBack,
+    /// Look from the right (+X).
+    ViewRight,
+    /// Look from the left (−X).
+    ViewLeft,
+    /// Look from above.
+    ViewTop,
+    /// Look from below.
+    ViewBottom,
+    /// Toggle the wireframe overlay.
+    ToggleWireframe,
+    /// Toggle the resolution heat map.
+    ToggleHeatmap,
+    /// Toggle lit / unlit shading.
+    ToggleShading,
+    /// Cycle the filter: nearest, linear, trilinear.
+    CycleFilter,
+    /// Show or hide the shortcut help window.
+    ToggleHelp,
+    /// Close the application.
+    Quit,
+    /// Enter or leave paint mode.
+    TogglePaintMode,
+    /// Undo the last stroke (paint mode).
+    Undo,
+    /// Redo the last undone stroke (paint mode).
+    Redo,
+    /// Pick the colour under the cursor into the brush (paint mode).
+    Eyedropper,
+    /// Set the brush radius by moving the mouse (paint mode).
+    RadiusGesture,
+    /// Set the brush strength by moving the mouse (paint mode).
+    StrengthGesture,
+}
+
+/// The 3D view's area this frame, as the last `Editor::ui` laid it out.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewportInfo {
+    /// The area in points.
+    pub rect: egui::Rect,
+    /// Physical pixels per point.
+    pub pixels_per_point: f32,
+}
+
+impl ViewportInfo {
+    /// The area's size in physical pixels (at least 1×1).
+    pub fn size_px(&self) -> [u32; 2] {
+        let w = (self.rect.width() * self.pixels_per_point).round().max(1.0) as u32;
+        let h = (self.rect.height() * self.pixels_per_point).round().max(1.0) as u32;
+        [w, h]
+    }
+
+    /// The area's top-left corner in physical pixels.
+    pub fn min_px(&self) -> [i32; 2] {
+        [
+            (self.rect.min.x * self.pixels_per_point).round() as i32,
+            (self.rect.min.y * self.pixels_per_point).round() as i32,
+        ]
+    }
+}
+
+/// Frame timing for the scene panel.
+#[derive(Debug, Clone, Default)]
+pub struct FrameStats {
+    /// Frames drawn in the current one-second window.
+    frames: u32,
+    window_start: Option<Instant>,
+    /// Frames per second over the last full second of redrawing.
+    pub fps: f32,
+    /// CPU time of the last frame (UI, 3D and egui recording, submit), milliseconds.
+    pub frame_ms: f32,
+}
+
+impl FrameStats {
+    /// Records one drawn frame that took `cpu_time`.
+    pub fn record(&mut self, cpu_time: Duration) {
+        let now = Instant::now();
+        self.frame_ms = cpu_time.as_secs_f32() * 1000.0;
+        let start = *self.window_start.get_or_insert(now);
+        self.frames += 1;
+        let elapsed = now.duration_since(start).as_secs_f32();
+        if elapsed >= 1.0 {
+            self.fps = self.frames as f32 / elapsed;
+            self.frames = 0;
+            self.window_start = Some(now);
+        }
+    }
+}
