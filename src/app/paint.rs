@@ -14,7 +14,8 @@ use crate::colors::layout::Resolution;
 use crate::colors::store::ColorStore;
 use crate::packing::paint_layout::PaintLayout;
 use crate::paint::brush::{
-    self, BlendMode, BrushRadius, Falloff, FillScope, PaintView, Painter, ResolutionOp, StrokeUpdate, Tool,
+    self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, ResolutionOp, StrokeUpdate,
+    Tool,
 };
 use crate::paint::undo::UndoHistory;
 
@@ -492,94 +493,15 @@ impl Editor {
         if ui.add_enabled(self.document.is_some(), egui::Button::new(button)).clicked() {
             self.toggle_paint_mode();
         }
-        let brush = &mut self.brush;
-        ui.horizontal(|ui| {
-            ui.label("Tool:");
-            ui.selectable_value(&mut brush.tool, Tool::Paint, "Colour");
-            ui.selectable_value(&mut brush.tool, Tool::Blur, "Blur");
-            let is_resolution = matches!(brush.tool, Tool::Resolution(_));
-            if ui.selectable_label(is_resolution, "Resolution").clicked() && !is_resolution {
-                brush.tool = Tool::Resolution(ResolutionOp::Raise);
-            }
-        });
-        if let Tool::Resolution(op) = &mut brush.tool {
-            ui.horizontal(|ui| {
-                ui.radio_value(op, ResolutionOp::Raise, "Raise");
-                ui.radio_value(op, ResolutionOp::Lower, "Lower");
-                let is_set = matches!(op, ResolutionOp::Set(_));
-                if ui.radio(is_set, "Set").clicked() && !is_set {
-                    *op = ResolutionOp::Set(Resolution::from_log2(3).unwrap_or(Resolution::ONE));
-                }
-            });
-            if let ResolutionOp::Set(r) = op {
-                ui.horizontal(|ui| resolution_combo_ui(ui, "To:", r));
-            }
-        }
-        ui.horizontal(|ui| {
-            ui.label("Colour:");
-            let mut color = to_egui(brush.color);
-            if egui::color_picker::color_edit_button_rgba(ui, &mut color, egui::color_picker::Alpha::OnlyBlend)
-                .changed()
-            {
-                brush.color = color.to_rgba_unmultiplied();
-            }
-            let [r, g, b, _] = brush.color.map(crate::colors::format::encode_srgb8);
-            ui.label(egui::RichText::new(format!("#{r:02x}{g:02x}{b:02x}")).monospace().weak());
-        });
-        ui.horizontal(|ui| {
-            let mut world = matches!(brush.radius, BrushRadius::World { .. });
-            ui.label("Radius in:");
-            let pixels_clicked = ui.radio_value(&mut world, false, "pixels").clicked();
-            let world_clicked = ui.radio_value(&mut world, true, "world").clicked();
-            if pixels_clicked && !matches!(brush.radius, BrushRadius::Pixels { .. }) {
-                brush.radius = BrushRadius::Pixels { radius_px: 30.0 };
-            }
-            if world_clicked && !matches!(brush.radius, BrushRadius::World { .. }) {
-                let scale = self.document.as_ref().map_or(1.0, |d| d.bounds.radius);
-                brush.radius = BrushRadius::World { radius_world: scale * 0.05 };
-            }
-        });
-        match &mut brush.radius {
-            BrushRadius::Pixels { radius_px } => {
-                ui.add(egui::Slider::new(radius_px, 1.0..=500.0).logarithmic(true).text("Radius (px)"))
-                    .on_hover_text("F: set interactively");
-            }
-            BrushRadius::World { radius_world } => {
-                let max = self.document.as_ref().map_or(10.0, |d| d.bounds.radius * 2.0).max(1e-3);
-                ui.add(egui::Slider::new(radius_world, max * 1e-4..=max).logarithmic(true).text("Radius (world)"))
-                    .on_hover_text("F: set interactively");
-            }
-        }
-        ui.add(egui::Slider::new(&mut brush.strength, 0.0..=1.0).text("Strength")).on_hover_text("Shift+F");
-        ui.add(egui::Slider::new(&mut brush.spacing_percent, 1.0..=200.0).text("Spacing (%)"));
-        ui.horizontal(|ui| {
-            let label = ui.label("Falloff:");
-            egui::ComboBox::from_id_salt("falloff")
-                .selected_text(brush.falloff.name())
-                .show_ui(ui, |ui| {
-                    for falloff in [Falloff::Smooth, Falloff::Linear, Falloff::Constant, Falloff::Sharp] {
-                        ui.selectable_value(&mut brush.falloff, falloff, falloff.name());
-                    }
-                })
-                .response
-                .labelled_by(label.id);
-        });
-        ui.horizontal(|ui| {
-            let label = ui.label("Blend:");
-            egui::ComboBox::from_id_salt("blend")
-                .selected_text(blend_name(brush.blend))
-                .show_ui(ui, |ui| {
-                    for blend in BlendMode::ALL {
-                        ui.selectable_value(&mut brush.blend, blend, blend_name(blend));
-                    }
-                })
-                .response
-                .labelled_by(label.id);
-        });
-        ui.checkbox(&mut brush.occlusion, "Occlusion").on_hover_text("Paint only what the eye sees");
-        ui.checkbox(&mut brush.backface_culling, "Backface culling");
-        ui.checkbox(&mut brush.mirror_x, "X mirror");
+        let bounds_radius = self.document.as_ref().map(|d| d.bounds.radius);
+        brush_settings_ui(ui, &mut self.brush, bounds_radius);
         ui.separator();
+        self.paint_commands_ui(ui, painting);
+    }
+
+    /// The panel's commands (eyedropper, fill, resolution for all, undo / redo) and the undo
+    /// memory.
+    fn paint_commands_ui(&mut self, ui: &mut egui::Ui, painting: bool) {
         ui.add_enabled_ui(painting, |ui| {
             ui.horizontal_wrapped(|ui| {
                 if ui.button("Eyedropper").on_hover_text("S over the mesh").clicked() {
@@ -636,6 +558,96 @@ impl Editor {
             );
         }
     }
+}
+
+/// The brush settings: tool, colour, radius (pixels or world units; `bounds_radius` of the
+/// mesh scales the world slider), strength, spacing, falloff, blend, occlusion, culling,
+/// mirror. The panel owns nothing else: it edits `brush` in place.
+fn brush_settings_ui(ui: &mut egui::Ui, brush: &mut BrushSettings, bounds_radius: Option<f64>) {
+    ui.horizontal(|ui| {
+        ui.label("Tool:");
+        ui.selectable_value(&mut brush.tool, Tool::Paint, "Colour");
+        ui.selectable_value(&mut brush.tool, Tool::Blur, "Blur");
+        let is_resolution = matches!(brush.tool, Tool::Resolution(_));
+        if ui.selectable_label(is_resolution, "Resolution").clicked() && !is_resolution {
+            brush.tool = Tool::Resolution(ResolutionOp::Raise);
+        }
+    });
+    if let Tool::Resolution(op) = &mut brush.tool {
+        ui.horizontal(|ui| {
+            ui.radio_value(op, ResolutionOp::Raise, "Raise");
+            ui.radio_value(op, ResolutionOp::Lower, "Lower");
+            let is_set = matches!(op, ResolutionOp::Set(_));
+            if ui.radio(is_set, "Set").clicked() && !is_set {
+                *op = ResolutionOp::Set(Resolution::from_log2(3).unwrap_or(Resolution::ONE));
+            }
+        });
+        if let ResolutionOp::Set(r) = op {
+            ui.horizontal(|ui| resolution_combo_ui(ui, "To:", r));
+        }
+    }
+    ui.horizontal(|ui| {
+        ui.label("Colour:");
+        let mut color = to_egui(brush.color);
+        if egui::color_picker::color_edit_button_rgba(ui, &mut color, egui::color_picker::Alpha::OnlyBlend).changed() {
+            brush.color = color.to_rgba_unmultiplied();
+        }
+        let [r, g, b, _] = brush.color.map(crate::colors::format::encode_srgb8);
+        ui.label(egui::RichText::new(format!("#{r:02x}{g:02x}{b:02x}")).monospace().weak());
+    });
+    ui.horizontal(|ui| {
+        let mut world = matches!(brush.radius, BrushRadius::World { .. });
+        ui.label("Radius in:");
+        let pixels_clicked = ui.radio_value(&mut world, false, "pixels").clicked();
+        let world_clicked = ui.radio_value(&mut world, true, "world").clicked();
+        if pixels_clicked && !matches!(brush.radius, BrushRadius::Pixels { .. }) {
+            brush.radius = BrushRadius::Pixels { radius_px: 30.0 };
+        }
+        if world_clicked && !matches!(brush.radius, BrushRadius::World { .. }) {
+            let scale = bounds_radius.unwrap_or(1.0);
+            brush.radius = BrushRadius::World { radius_world: scale * 0.05 };
+        }
+    });
+    match &mut brush.radius {
+        BrushRadius::Pixels { radius_px } => {
+            ui.add(egui::Slider::new(radius_px, 1.0..=500.0).logarithmic(true).text("Radius (px)"))
+                .on_hover_text("F: set interactively");
+        }
+        BrushRadius::World { radius_world } => {
+            let max = bounds_radius.map_or(10.0, |r| r * 2.0).max(1e-3);
+            ui.add(egui::Slider::new(radius_world, max * 1e-4..=max).logarithmic(true).text("Radius (world)"))
+                .on_hover_text("F: set interactively");
+        }
+    }
+    ui.add(egui::Slider::new(&mut brush.strength, 0.0..=1.0).text("Strength")).on_hover_text("Shift+F");
+    ui.add(egui::Slider::new(&mut brush.spacing_percent, 1.0..=200.0).text("Spacing (%)"));
+    ui.horizontal(|ui| {
+        let label = ui.label("Falloff:");
+        egui::ComboBox::from_id_salt("falloff")
+            .selected_text(brush.falloff.name())
+            .show_ui(ui, |ui| {
+                for falloff in [Falloff::Smooth, Falloff::Linear, Falloff::Constant, Falloff::Sharp] {
+                    ui.selectable_value(&mut brush.falloff, falloff, falloff.name());
+                }
+            })
+            .response
+            .labelled_by(label.id);
+    });
+    ui.horizontal(|ui| {
+        let label = ui.label("Blend:");
+        egui::ComboBox::from_id_salt("blend")
+            .selected_text(blend_name(brush.blend))
+            .show_ui(ui, |ui| {
+                for blend in BlendMode::ALL {
+                    ui.selectable_value(&mut brush.blend, blend, blend_name(blend));
+                }
+            })
+            .response
+            .labelled_by(label.id);
+    });
+    ui.checkbox(&mut brush.occlusion, "Occlusion").on_hover_text("Paint only what the eye sees");
+    ui.checkbox(&mut brush.backface_culling, "Backface culling");
+    ui.checkbox(&mut brush.mirror_x, "X mirror");
 }
 
 /// A labelled combo box of resolutions 1 … 64.

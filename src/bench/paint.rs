@@ -10,7 +10,7 @@ use std::time::Instant;
 use glam::DVec3;
 
 use crate::bench::pack::Timing;
-use crate::camera::OrbitCamera;
+use crate::camera::{BoundingSphere, DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera, default_camera};
 use crate::colors::format::ColorFormat;
 use crate::colors::store::ColorStore;
 use crate::io::document::Document;
@@ -54,44 +54,9 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
     let positions = &document.positions;
     let triangles = &document.store.topology().face_vertices;
     let [width, height] = options.viewport_px;
-    let camera = OrbitCamera::framing(crate::camera::BoundingSphere::of_points(positions), 30.0, 20.0);
-    // Pixels on the mesh, on a grid over the viewport (for picks).
+    let camera = default_camera(BoundingSphere::of_points(positions), DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
     let reference = MeshBvh::build(positions, triangles, BvhPreset::FastBuild);
-    let grid = 64u32;
-    let mut on_mesh = Vec::new();
-    for gy in 0..grid {
-        for gx in 0..grid {
-            let cursor = [(f64::from(gx) + 0.5) * f64::from(width) / f64::from(grid), {
-                (f64::from(gy) + 0.5) * f64::from(height) / f64::from(grid)
-            }];
-            let (origin, direction) = camera.ray_through_pixel(cursor[0], cursor[1], width, height);
-            if reference.cast(origin, direction, f64::INFINITY).is_some() {
-                on_mesh.push((origin, direction));
-            }
-        }
-    }
-    let mut presets = Vec::new();
-    for preset in BvhPreset::ALL {
-        let (build, bvh) = Timing::measure(1, || MeshBvh::build(positions, triangles, preset));
-        let (pick, hits) = Timing::measure(3, || {
-            let mut hits = 0u32;
-            for k in 0..options.picks {
-                if let Some((origin, direction)) = on_mesh.get(k % on_mesh.len().max(1)) {
-                    hits += u32::from(bvh.cast(*origin, *direction, f64::INFINITY).is_some());
-                }
-            }
-            hits
-        });
-        let picks = options.picks.max(1) as f64;
-        presets.push(serde_json::json!({
-            "preset": preset.name(),
-            "build_seconds": build.best_seconds,
-            "pick_seconds_best": pick.best_seconds / picks,
-            "pick_seconds_median": pick.median_seconds / picks,
-            "picks": options.picks,
-            "hits": hits,
-        }));
-    }
+    let presets = bvh_presets(positions, triangles, &camera, &reference, options);
 
     // Pick latency through the whole cursor path (pixel → ray → BVH), default preset.
     let bvh = reference;
@@ -143,42 +108,8 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
                 mirror_x: false,
                 ..BrushSettings::default()
             };
-            let mut history = UndoHistory::new(crate::paint::undo::DEFAULT_CAP_BYTES);
-            store.take_dirty();
-            let mut times = Vec::new();
-            let (mut covered, mut upload_bytes) = (0, 0);
-            let mut layout = PaintLayout::new(&store);
-            if !step_per_dab {
-                history.begin_step(&store, "bench")?;
-            }
-            for k in 0..options.dabs.max(1) {
-                let color = if k % 2 == 0 { [0.9, 0.2, 0.1, 1.0] } else { [0.1, 0.3, 0.9, 1.0] };
-                painter.set_settings(BrushSettings { color, ..settings });
-                if step_per_dab {
-                    history.begin_step(&store, "bench")?;
-                }
-                let started = Instant::now();
-                let stats = painter.dab_at(&view, &mut store, &mut history, center, radius)?;
-                times.push(started.elapsed().as_secs_f64());
-                if step_per_dab {
-                    history.end_step();
-                }
-                covered = stats.samples_covered;
-                upload_bytes = upload_like_the_editor(&mut layout, &mut store);
-            }
-            history.end_step();
-            times.sort_by(f64::total_cmp);
-            let (best, median) = (times[0], times[times.len() / 2]);
-            row[name] = serde_json::json!({
-                "samples_covered": covered,
-                "dab_seconds_best": best,
-                "dab_seconds_median": median,
-                "samples_per_second_best": covered as f64 / best,
-                "samples_per_second_median": covered as f64 / median,
-                "upload_bytes_rgba8": upload_bytes,
-                "dabs": times.len(),
-                "undo_bytes": history.bytes_used(),
-            });
+            row[name] =
+                measure_dabs(&view, &mut store, &mut painter, settings, (center, radius), options.dabs, step_per_dab)?;
         }
         brushes.push(row);
     }
@@ -198,6 +129,106 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
             "bytes": packed_bytes,
             "threads": crate::packing::packer::pack_threads(),
         },
+    }))
+}
+
+/// Build and pick time of every BVH preset, and its hits, on rays through a grid of pixels
+/// that hit the mesh (found with `reference`).
+fn bvh_presets(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    camera: &OrbitCamera,
+    reference: &MeshBvh,
+    options: &PaintBenchOptions,
+) -> Vec<serde_json::Value> {
+    // Pixels on the mesh, on a grid over the viewport (for picks).
+    let [width, height] = options.viewport_px;
+    let grid = 64u32;
+    let mut on_mesh = Vec::new();
+    for gy in 0..grid {
+        for gx in 0..grid {
+            let cursor = [(f64::from(gx) + 0.5) * f64::from(width) / f64::from(grid), {
+                (f64::from(gy) + 0.5) * f64::from(height) / f64::from(grid)
+            }];
+            let (origin, direction) = camera.ray_through_pixel(cursor[0], cursor[1], width, height);
+            if reference.cast(origin, direction, f64::INFINITY).is_some() {
+                on_mesh.push((origin, direction));
+            }
+        }
+    }
+    let mut presets = Vec::new();
+    for preset in BvhPreset::ALL {
+        let (build, bvh) = Timing::measure(1, || MeshBvh::build(positions, triangles, preset));
+        let (pick, hits) = Timing::measure(3, || {
+            let mut hits = 0u32;
+            for k in 0..options.picks {
+                if let Some((origin, direction)) = on_mesh.get(k % on_mesh.len().max(1)) {
+                    hits += u32::from(bvh.cast(*origin, *direction, f64::INFINITY).is_some());
+                }
+            }
+            hits
+        });
+        let picks = options.picks.max(1) as f64;
+        presets.push(serde_json::json!({
+            "preset": preset.name(),
+            "build_seconds": build.best_seconds,
+            "pick_seconds_best": pick.best_seconds / picks,
+            "pick_seconds_median": pick.median_seconds / picks,
+            "picks": options.picks,
+            "hits": hits,
+        }));
+    }
+
+    presets
+}
+
+/// Times `dabs` dabs of `settings` at `sphere` (centre, world radius) as the editor paints
+/// them (colours alternating, all in one undo step or one step per dab), with the bytes the
+/// last dab uploads.
+fn measure_dabs(
+    view: &PaintView,
+    store: &mut ColorStore,
+    painter: &mut Painter,
+    settings: BrushSettings,
+    (center, radius): (DVec3, f64),
+    dabs: usize,
+    step_per_dab: bool,
+) -> Result<serde_json::Value, BrushError> {
+    let mut history = UndoHistory::new(crate::paint::undo::DEFAULT_CAP_BYTES);
+    store.take_dirty();
+    let mut times = Vec::new();
+    let (mut covered, mut upload_bytes) = (0, 0);
+    let mut layout = PaintLayout::new(store);
+    if !step_per_dab {
+        history.begin_step(store, "bench")?;
+    }
+    for k in 0..dabs.max(1) {
+        let color = if k % 2 == 0 { [0.9, 0.2, 0.1, 1.0] } else { [0.1, 0.3, 0.9, 1.0] };
+        painter.set_settings(BrushSettings { color, ..settings });
+        if step_per_dab {
+            history.begin_step(store, "bench")?;
+        }
+        let started = Instant::now();
+        let stats = painter.dab_at(view, store, &mut history, center, radius)?;
+        times.push(started.elapsed().as_secs_f64());
+        if step_per_dab {
+            history.end_step();
+        }
+        covered = stats.samples_covered;
+        upload_bytes = upload_like_the_editor(&mut layout, store);
+    }
+    history.end_step();
+    times.sort_by(f64::total_cmp);
+    let (best, median) = (times[0], times[times.len() / 2]);
+    Ok(serde_json::json!({
+        "samples_covered": covered,
+        "dab_seconds_best": best,
+        "dab_seconds_median": median,
+        "samples_per_second_best": covered as f64 / best,
+        "samples_per_second_median": covered as f64 / median,
+        "upload_bytes_rgba8": upload_bytes,
+        "dabs": times.len(),
+        "undo_bytes": history.bytes_used(),
     }))
 }
 

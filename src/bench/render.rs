@@ -113,44 +113,7 @@ pub fn bench_render(
     let packed = document.pack(ColorFormat::Rgba8Srgb)?;
     let mesh = gpu.upload(&packed)?;
 
-    // Baseline: the file's own UVs and texture when it has them.
-    let textured = match import_gltf(path) {
-        Ok(scene) => gpu.upload_baseline(&scene)?,
-        Err(_) => None,
-    };
-    let (baseline_name, baseline) = match textured {
-        Some(mesh) => ("gltf texture".to_owned(), mesh),
-        None => {
-            let (min, size) = bounds(&document.positions);
-            let corner_uvs: Vec<[[f32; 2]; 3]> = document
-                .store
-                .topology()
-                .face_vertices
-                .iter()
-                .map(|face| {
-                    face.map(|v| {
-                        let p = document.positions[v as usize];
-                        let uv = |a: usize| if size[a] > 0.0 { (p[a] - min[a]) / size[a] } else { 0.0 };
-                        [uv(0), uv(1)]
-                    })
-                })
-                .collect();
-            let texels = (document.store.sample_count() as f64).sqrt().ceil().max(256.0) as u32;
-            let side = texels.next_power_of_two().min(ctx.limits().max_texture_dimension_2d);
-            (
-                format!("synthetic planar {side}x{side}"),
-                BaselineMesh::new(
-                    ctx,
-                    renderer,
-                    &document.positions,
-                    &document.store.topology().face_vertices,
-                    &corner_uvs,
-                    &synthetic_texture(side),
-                    [1.0; 4],
-                )?,
-            )
-        }
-    };
+    let (baseline_name, baseline) = baseline(&gpu, path, document)?;
 
     let camera: OrbitCamera = default_camera(mesh.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
     let color = ctx.device.create_texture(&wgpu::TextureDescriptor {
@@ -221,6 +184,55 @@ pub fn bench_render(
         triangles: mesh.face_count,
         baseline: baseline_name,
         modes,
+    })
+}
+
+/// The baseline of `document`: the file's own UVs and texture when it has them, else a
+/// planar projection onto a synthetic texture of as many texels as the document has
+/// samples. Returns its name for the report and the mesh.
+fn baseline(
+    gpu: &Gpu,
+    path: &std::path::Path,
+    document: &Document,
+) -> Result<(String, BaselineMesh), BenchRenderError> {
+    let (ctx, renderer) = (&*gpu.ctx, &gpu.renderer);
+    // Baseline: the file's own UVs and texture when it has them.
+    let textured = match import_gltf(path) {
+        Ok(scene) => gpu.upload_baseline(&scene)?,
+        Err(_) => None,
+    };
+    Ok(match textured {
+        Some(mesh) => ("gltf texture".to_owned(), mesh),
+        None => {
+            let (min, size) = bounds(&document.positions);
+            let corner_uvs: Vec<[[f32; 2]; 3]> = document
+                .store
+                .topology()
+                .face_vertices
+                .iter()
+                .map(|face| {
+                    face.map(|v| {
+                        let p = document.positions[v as usize];
+                        let uv = |a: usize| if size[a] > 0.0 { (p[a] - min[a]) / size[a] } else { 0.0 };
+                        [uv(0), uv(1)]
+                    })
+                })
+                .collect();
+            let texels = (document.store.sample_count() as f64).sqrt().ceil().max(256.0) as u32;
+            let side = texels.next_power_of_two().min(ctx.limits().max_texture_dimension_2d);
+            (
+                format!("synthetic planar {side}x{side}"),
+                BaselineMesh::new(
+                    ctx,
+                    renderer,
+                    &document.positions,
+                    &document.store.topology().face_vertices,
+                    &corner_uvs,
+                    &synthetic_texture(side),
+                    [1.0; 4],
+                )?,
+            )
+        }
     })
 }
 

@@ -129,22 +129,7 @@ impl BaselineMesh {
             )));
         }
         let limits = ctx.limits();
-        let max = limits.max_texture_dimension_2d;
-        if texture.width == 0 || texture.height == 0 || texture.width > max || texture.height > max {
-            return Err(RenderError::InvalidTexture(format!(
-                "{}×{} is outside 1..={max} per side",
-                texture.width, texture.height
-            )));
-        }
-        let expected = texture.width as usize * texture.height as usize * 4;
-        if texture.rgba8_srgb.len() != expected {
-            return Err(RenderError::InvalidTexture(format!(
-                "{}×{} needs {expected} bytes, got {}",
-                texture.width,
-                texture.height,
-                texture.rgba8_srgb.len()
-            )));
-        }
+        check_texture(texture, limits.max_texture_dimension_2d)?;
         let vertex_total = triangles.len() * 3;
         let vertex_count = u32::try_from(vertex_total)
             .map_err(|_| RenderError::InvalidMesh(format!("{} triangles", triangles.len())))?;
@@ -182,30 +167,7 @@ impl BaselineMesh {
             usage: wgpu::BufferUsages::VERTEX,
         });
 
-        let levels = mip_chain_linear(texture);
-        let gpu_texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("baseline base colour"),
-            size: wgpu::Extent3d { width: texture.width, height: texture.height, depth_or_array_layers: 1 },
-            mip_level_count: levels.len() as u32,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba8UnormSrgb,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        for (level, (w, h, data)) in levels.iter().enumerate() {
-            ctx.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &gpu_texture,
-                    mip_level: level as u32,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                data,
-                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(w * 4), rows_per_image: Some(*h) },
-                wgpu::Extent3d { width: *w, height: *h, depth_or_array_layers: 1 },
-            );
-        }
+        let gpu_texture = upload_texture(ctx, texture);
         let view = gpu_texture.create_view(&wgpu::TextureViewDescriptor::default());
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("baseline trilinear repeat"),
@@ -257,4 +219,54 @@ impl BaselineMesh {
         }
         self.vertices.size() + texels * 4
     }
+}
+
+/// Refuses a texture of zero size, beyond `max` texels per side, or whose data length
+/// disagrees with its size.
+fn check_texture(texture: &Texture, max: u32) -> Result<(), RenderError> {
+    if texture.width == 0 || texture.height == 0 || texture.width > max || texture.height > max {
+        return Err(RenderError::InvalidTexture(format!(
+            "{}×{} is outside 1..={max} per side",
+            texture.width, texture.height
+        )));
+    }
+    let expected = texture.width as usize * texture.height as usize * 4;
+    if texture.rgba8_srgb.len() != expected {
+        return Err(RenderError::InvalidTexture(format!(
+            "{}×{} needs {expected} bytes, got {}",
+            texture.width,
+            texture.height,
+            texture.rgba8_srgb.len()
+        )));
+    }
+    Ok(())
+}
+
+/// Uploads `texture` (RGBA8 sRGB) with its mipmaps, filtered in linear light.
+fn upload_texture(ctx: &GpuContext, texture: &Texture) -> wgpu::Texture {
+    let levels = mip_chain_linear(texture);
+    let gpu_texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("baseline base colour"),
+        size: wgpu::Extent3d { width: texture.width, height: texture.height, depth_or_array_layers: 1 },
+        mip_level_count: levels.len() as u32,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8UnormSrgb,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for (level, (w, h, data)) in levels.iter().enumerate() {
+        ctx.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &gpu_texture,
+                mip_level: level as u32,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            data,
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(w * 4), rows_per_image: Some(*h) },
+            wgpu::Extent3d { width: *w, height: *h, depth_or_array_layers: 1 },
+        );
+    }
+    gpu_texture
 }

@@ -212,31 +212,7 @@ impl GpuMesh {
         packed: &PackedMesh,
         options: &MeshUploadOptions,
     ) -> Result<Self, RenderError> {
-        let vertex_count = u32::try_from(packed.positions.len())
-            .map_err(|_| RenderError::InvalidMesh(format!("{} vertices", packed.positions.len())))?;
-        let face_count = u32::try_from(packed.indices.len())
-            .map_err(|_| RenderError::InvalidMesh(format!("{} faces", packed.indices.len())))?;
-        if packed.face_records.len() != packed.indices.len() {
-            return Err(RenderError::InvalidMesh(format!(
-                "{} face records for {} faces",
-                packed.face_records.len(),
-                packed.indices.len()
-            )));
-        }
-        if let Some((face, corners)) =
-            packed.indices.iter().enumerate().find(|(_, corners)| corners.iter().any(|&v| v >= vertex_count))
-        {
-            return Err(RenderError::InvalidMesh(format!(
-                "face {face} uses vertex {corners:?}, but there are only {vertex_count} vertices"
-            )));
-        }
-        let bytes_per_sample = packed.format.bytes_per_sample();
-        if !packed.colors.len().is_multiple_of(bytes_per_sample) {
-            return Err(RenderError::InvalidMesh(format!(
-                "colour buffer of {} bytes is not a whole number of {bytes_per_sample}-byte samples",
-                packed.colors.len()
-            )));
-        }
+        let (vertex_count, face_count) = check_packed(packed)?;
 
         let limits = ctx.limits();
         let width = options.atlas_width.unwrap_or_else(|| default_atlas_width(&limits));
@@ -365,4 +341,35 @@ impl GpuMesh {
             + data_texture_bytes(&self.face_records)
             + atlas
     }
+}
+
+/// Vertex and face counts of `packed`, or why it cannot be drawn: counts beyond `u32`, face
+/// records and faces disagreeing, a corner out of range, a partial colour sample.
+fn check_packed(packed: &PackedMesh) -> Result<(u32, u32), RenderError> {
+    let vertex_count = u32::try_from(packed.positions.len())
+        .map_err(|_| RenderError::InvalidMesh(format!("{} vertices", packed.positions.len())))?;
+    let face_count = u32::try_from(packed.indices.len())
+        .map_err(|_| RenderError::InvalidMesh(format!("{} faces", packed.indices.len())))?;
+    if packed.face_records.len() != packed.indices.len() {
+        return Err(RenderError::InvalidMesh(format!(
+            "{} face records for {} faces",
+            packed.face_records.len(),
+            packed.indices.len()
+        )));
+    }
+    if let Some((face, corners)) =
+        packed.indices.iter().enumerate().find(|(_, corners)| corners.iter().any(|&v| v >= vertex_count))
+    {
+        return Err(RenderError::InvalidMesh(format!(
+            "face {face} uses vertex {corners:?}, but there are only {vertex_count} vertices"
+        )));
+    }
+    let bytes_per_sample = packed.format.bytes_per_sample();
+    if !packed.colors.len().is_multiple_of(bytes_per_sample) {
+        return Err(RenderError::InvalidMesh(format!(
+            "colour buffer of {} bytes is not a whole number of {bytes_per_sample}-byte samples",
+            packed.colors.len()
+        )));
+    }
+    Ok((vertex_count, face_count))
 }
