@@ -17,12 +17,13 @@
 //! | [`packing`] | [`packing::linear`] (16-byte face records, colour buffer with MIP chains), [`packing::packer`] (store ⇄ linear, eq. 2.5/2.6), [`packing::paint_layout`] (paint-mode blocks with slack, dirty ranges), [`packing::sampler`] (the CPU reference sampler, the truth the GPU is tested against), [`packing::file`] (the packed file format) |
 //! | [`paint`] | [`paint::picking`] (obvhs BVH, watertight rays), [`paint::brush`] (colour / blur / resolution brushes, tools, replay), [`paint::undo`] (per stroke, memory cap) |
 //! | [`io`] | [`io::document`] (open glTF or packed files into a store; pack for export), [`io::export_gltf`], [`io::bake`] (texture → mesh colors), [`io::autosave`] |
+//! | [`atomic_write`] | the one way files are written: temporary file, `sync_all`, rename, directory sync |
 //! | [`camera`] | the orbit camera: matrices, framing, pixel rays (shared by render, picking, replay) |
 //! | [`render`] | **GPU**: wgpu context, packed buffers on the GPU, sampling pipelines, readback |
 //! | [`bench`](mod@bench) | **GPU**: the measurements behind `meshpaint bench` (time and size, as JSON) |
 //! | [`app`] | **GPU + UI**: the desktop editor (winit, egui, wgpu): window, panels, input, background jobs |
 //!
-//! `mesh`, `colors`, `packing`, `paint`, `io` and `camera` are the core: they never import
+//! `mesh`, `colors`, `packing`, `paint`, `io`, `camera` and `atomic_write` are the core: they never import
 //! `wgpu`, `egui` or `winit` (`tests/architecture.rs` checks it).
 //!
 //! ## Data flow
@@ -41,6 +42,7 @@
 //! The binary (`src/main.rs`) and the editor ([`app`]) are the only places where everything meets.
 
 pub mod app;
+pub mod atomic_write;
 pub mod bench;
 pub mod camera;
 pub mod colors;

@@ -39,7 +39,6 @@
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use gltf::json;
@@ -513,51 +512,11 @@ pub fn write_tessellated_glb(
     Ok(ExportSummary { vertices, triangles, bytes: bytes.len() as u64 })
 }
 
-/// Writes `bytes` to `path` through a synced temporary file in the same directory.
+/// Writes `bytes` to `path` atomically ([`crate::atomic_write`]).
 fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
-    let io_error = |path: &Path, action: &'static str| {
-        let path = path.to_path_buf();
-        move |source: std::io::Error| ExportError::Io { path, action, source }
-    };
-    let Some(file_name) = path.file_name() else {
-        return Err(io_error(path, "write a file at a path without a file name")(
-            std::io::ErrorKind::InvalidInput.into(),
-        ));
-    };
-    let dir = match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let mut temp_name = std::ffi::OsString::from(".");
-    temp_name.push(file_name);
-    temp_name.push(format!(".{}-{}.tmp", std::process::id(), temp_counter()));
-    let temp = dir.join(temp_name);
-    let written = (|| {
-        let mut file = std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&temp)
-            .map_err(io_error(&temp, "create the temporary file"))?;
-        file.write_all(bytes).map_err(io_error(&temp, "write the temporary file"))?;
-        file.sync_all().map_err(io_error(&temp, "flush the temporary file to disk"))?;
-        drop(file);
-        std::fs::rename(&temp, path).map_err(io_error(path, "rename the temporary file onto"))
-    })();
-    if let Err(error) = written {
-        // Best effort: the temporary file may not exist (any more).
-        let _ = std::fs::remove_file(&temp);
-        return Err(error);
-    }
-    // Make the rename itself durable where directories can be synced (best effort).
-    if let Ok(dir_handle) = std::fs::File::open(dir) {
-        let _ = dir_handle.sync_all();
-    }
-    Ok(())
-}
-
-/// A process-wide counter making temporary names unique across threads.
-fn temp_counter() -> u64 {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    COUNTER.fetch_add(1, Ordering::Relaxed)
+    crate::atomic_write::write_atomically(path, bytes).map_err(|error| ExportError::Io {
+        path: error.path,
+        action: error.action,
+        source: error.source,
+    })
 }

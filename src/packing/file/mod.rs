@@ -38,7 +38,6 @@
 //! Deeper layout consistency (e.g. two faces agreeing on a shared edge's chain base) is
 //! the unpacker's job ([`crate::packing::packer`]), not this module's.
 
-use std::io::Write;
 use std::path::Path;
 
 use crate::colors::format::ColorFormat;
@@ -562,56 +561,11 @@ pub fn from_bytes(bytes: &[u8]) -> Result<PackedMesh, PackedFileError> {
 pub fn write_file(path: &Path, mesh: &PackedMesh) -> Result<(), PackedFileError> {
     let bytes = to_bytes(mesh)
         .map_err(|source| PackedFileError::File { path: path.to_path_buf(), source: Box::new(source) })?;
-    let Some(file_name) = path.file_name() else {
-        return Err(PackedFileError::Io {
-            path: path.to_path_buf(),
-            action: "write a file at a path without a file name",
-            source: std::io::ErrorKind::InvalidInput.into(),
-        });
-    };
-    let dir = match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let mut temp_name = std::ffi::OsString::from(".");
-    temp_name.push(file_name);
-    temp_name.push(format!(".{}-{}.tmp", std::process::id(), temp_counter()));
-    let temp = dir.join(temp_name);
-
-    if let Err(error) = write_temp_and_rename(&temp, path, &bytes) {
-        // Best effort: the temporary file may not exist (any more).
-        let _ = std::fs::remove_file(&temp);
-        return Err(error);
-    }
-    // Make the rename itself durable where directories can be synced (best effort).
-    if let Ok(dir_handle) = std::fs::File::open(dir) {
-        let _ = dir_handle.sync_all();
-    }
-    Ok(())
-}
-
-/// Writes `bytes` to the new file `temp`, syncs it and renames it to `path`.
-fn write_temp_and_rename(temp: &Path, path: &Path, bytes: &[u8]) -> Result<(), PackedFileError> {
-    let io_error = |path: &Path, action: &'static str| {
-        let path = path.to_path_buf();
-        move |source: std::io::Error| PackedFileError::Io { path, action, source }
-    };
-    let mut file = std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(temp)
-        .map_err(io_error(temp, "create the temporary file"))?;
-    file.write_all(bytes).map_err(io_error(temp, "write the temporary file"))?;
-    file.sync_all().map_err(io_error(temp, "flush the temporary file to disk"))?;
-    drop(file);
-    std::fs::rename(temp, path).map_err(io_error(path, "rename the temporary file onto"))
-}
-
-/// A process-wide counter making temporary names unique across threads.
-fn temp_counter() -> u64 {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    COUNTER.fetch_add(1, Ordering::Relaxed)
+    crate::atomic_write::write_atomically(path, &bytes).map_err(|error| PackedFileError::Io {
+        path: error.path,
+        action: error.action,
+        source: error.source,
+    })
 }
 
 /// Reads and decodes the packed file at `path`. Errors name the path.
