@@ -25,51 +25,14 @@
 // `index` is texel (index % W, index / W). Rgba8 sRGB samples are decoded to linear by
 // the hardware on textureLoad; 16F and 32F samples are linear already.
 
-// Keep in sync with `FrameUniforms` in src/render/uniforms.rs (160 bytes).
-struct FrameUniforms {
-    // clip ← (world − render origin)
-    clip_from_world: mat4x4<f32>,
-    // xyz: unit vector towards the light (world space); w: ambient term in [0, 1].
-    light: vec4<f32>,
-    // Wireframe colour, linear RGBA.
-    wire_color: vec4<f32>,
-    // Multiplies the base colour (the baseline's glTF baseColorFactor; 1 for mesh colors).
-    tint: vec4<f32>,
-    // 0 = nearest, 1 = linear. The mesh-colors pipeline is chosen by it: the shader reads
-    // the override FILTER_KIND, which the renderer sets to the same value.
-    filter_kind: u32,
-    // 0 = fixed level `level`, 1 = automatic level from screen-space derivatives (chosen
-    // by pipeline, as filter_kind: the shader reads the override LEVEL_MODE).
-    level_mode: u32,
-    // Fixed MIP level (clamped per face to log2 R_f).
-    level: u32,
-    // FLAG_* bits.
-    flags: u32,
-    // Atlas width W in texels.
-    atlas_width: u32,
-    // Samples in the colour buffer (>= 1; every index is clamped below it).
-    sample_count: u32,
-    // Colours per vertex (1 + log2 max R).
-    vertex_levels: u32,
-    // Wireframe line width in pixels.
-    wire_width: f32,
-    // Number of faces (face records).
-    face_count: u32,
-    // Number of vertices (positions).
-    vertex_count: u32,
-    _pad0: u32,
-    _pad1: u32,
-}
+// `FrameUniforms` (the uniform block `u`), the `FLAG_*` bits and `wireframe_overlay` are in
+// shaders/frame.wgsl, which the renderer prepends to this file.
 
 // Pipeline constants, set by the renderer from `FilterMode::uniform_fields` (keep in sync
 // with `MESH_PIPELINE_KEYS` in src/render/renderer.rs): 0 = nearest, 1 = linear.
 override FILTER_KIND: u32 = 1u;
 // 0 = fixed level `u.level`, 1 = automatic level (trilinear).
 override LEVEL_MODE: u32 = 1u;
-
-const FLAG_LIT: u32 = 1u;
-const FLAG_WIREFRAME: u32 = 2u;
-const FLAG_HEATMAP: u32 = 4u;
 
 const LOG2_SHIFT: u32 = 28u;
 const BASE_MASK: u32 = 0x0fffffffu;
@@ -441,10 +404,7 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
         rgb = rgb * (ambient + (1.0 - ambient) * diffuse);
     }
     if (u.flags & FLAG_WIREFRAME) != 0u {
-        let pixels = in.bary / max(bary_width, vec3<f32>(1e-12));
-        let edge = min(pixels.x, min(pixels.y, pixels.z));
-        let coverage = clamp(0.5 * u.wire_width + 0.5 - edge, 0.0, 1.0);
-        rgb = mix(rgb, u.wire_color.rgb, coverage * u.wire_color.a);
+        rgb = wireframe_overlay(rgb, in.bary, bary_width, u.wire_color, u.wire_width);
     }
     return vec4<f32>(rgb, alpha);
 }

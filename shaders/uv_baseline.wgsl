@@ -7,30 +7,8 @@
 // Vertices come from a vertex buffer, three per face (faces keep their own UVs across
 // seams), positions relative to the render origin.
 
-// Keep in sync with `FrameUniforms` in src/render/uniforms.rs and shaders/mesh_colors.wgsl
-// (160 bytes). The baseline reads clip_from_world, light, wire_color, tint (the glTF
-// baseColorFactor), flags and wire_width.
-struct FrameUniforms {
-    clip_from_world: mat4x4<f32>,
-    light: vec4<f32>,
-    wire_color: vec4<f32>,
-    tint: vec4<f32>,
-    filter_kind: u32,
-    level_mode: u32,
-    level: u32,
-    flags: u32,
-    atlas_width: u32,
-    sample_count: u32,
-    vertex_levels: u32,
-    wire_width: f32,
-    face_count: u32,
-    vertex_count: u32,
-    _pad0: u32,
-    _pad1: u32,
-}
-
-const FLAG_LIT: u32 = 1u;
-const FLAG_WIREFRAME: u32 = 2u;
+// `FrameUniforms` (the uniform block `u`), the `FLAG_*` bits and `wireframe_overlay` are in
+// shaders/frame.wgsl, which the renderer prepends to this file.
 
 @group(0) @binding(0) var<uniform> u: FrameUniforms;
 @group(0) @binding(1) var base_color: texture_2d<f32>;
@@ -77,10 +55,7 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
         rgb = rgb * (ambient + (1.0 - ambient) * diffuse);
     }
     if (u.flags & FLAG_WIREFRAME) != 0u {
-        let pixels = in.bary / max(bary_width, vec3<f32>(1e-12));
-        let edge = min(pixels.x, min(pixels.y, pixels.z));
-        let coverage = clamp(0.5 * u.wire_width + 0.5 - edge, 0.0, 1.0);
-        rgb = mix(rgb, u.wire_color.rgb, coverage * u.wire_color.a);
+        rgb = wireframe_overlay(rgb, in.bary, bary_width, u.wire_color, u.wire_width);
     }
     return vec4<f32>(rgb, alpha);
 }

@@ -12,11 +12,10 @@ use meshpaint::app::{Action, Editor, Mode, Severity};
 use meshpaint::io::document::Source;
 use meshpaint::render::{FilterMode, Shading};
 
-const JOB_TIMEOUT: Duration = Duration::from_secs(60);
+mod common;
+use common::crate_path;
 
-fn crate_path(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
-}
+const JOB_TIMEOUT: Duration = Duration::from_secs(60);
 
 fn new_editor() -> Editor {
     Editor::new(None, Arc::new(|| {}))

@@ -1,13 +1,15 @@
 //! The real window under Xvfb: start `meshpaint Duck.glb`, drive it with xdotool (orbit,
 //! toggle the wireframe, export a .glb, open a broken file, quit) and check screenshots:
 //! the 3D view must match an offscreen render of the same camera within a tolerance, so a
-//! blank or misplaced view fails. Screenshots go to screenshots/app_*.png.
+//! blank or misplaced view fails. Screenshots go to target/test-output/app_*.png; with
+//! `MESHPAINT_UPDATE_SCREENSHOTS=1` they are also copied over the committed
+//! screenshots/app_*.png (`MESHPAINT_UPDATE_SCREENSHOTS=1 cargo test --test app_window`).
 //!
 //! Needs Xvfb, xdotool and ImageMagick (`bash .ci/run` installs them) and a Vulkan or GL
 //! adapter (lavapipe without a GPU). Missing tools fail the test; they never skip it.
 
 use std::io::Read;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -15,11 +17,11 @@ use std::time::{Duration, Instant};
 use image::RgbImage;
 use meshpaint::app::editor::Editor;
 use meshpaint::io::document::Source;
-use meshpaint::render::{DrawItem, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, Renderer};
+use meshpaint::render::{DrawItem, GpuMesh, MeshUploadOptions};
 
-fn crate_path(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
-}
+mod common;
+use common::gpu::Gpu;
+use common::{crate_path, output_dir, update_screenshot};
 
 /// Child processes killed when the test ends, however it ends.
 struct Processes {
@@ -194,8 +196,7 @@ fn reference_view(file: &Path, size: (u32, u32)) -> RgbImage {
     editor.frame_all();
     let open = editor.document.as_ref().expect("the reference document did not open");
     let packed = open.document.pack(open.format).unwrap();
-    let ctx = GpuContext::new_headless().expect("no GPU adapter (install mesa-vulkan-drivers)");
-    let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT).unwrap();
+    let Gpu { ctx, renderer } = Gpu::create();
     let mesh = GpuMesh::upload(&ctx, &renderer, &packed, &MeshUploadOptions::default()).unwrap();
     let image =
         renderer.render_image(&ctx, DrawItem::MeshColors(&mesh), &editor.render_settings(), size.0, size.1).unwrap();
@@ -266,8 +267,9 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     assert!(rect.2 > 400 && rect.3 > 300, "3D view too small: {rect:?}\n{log}");
 
     // 1. The default view: not blank, and the same image as an offscreen render.
-    let shots = crate_path("screenshots");
-    std::fs::create_dir_all(&shots).unwrap();
+    // Screenshots go to target/test-output (never over the committed screenshots/, unless
+    // MESHPAINT_UPDATE_SCREENSHOTS=1 asks for it once the checks on them passed).
+    let shots = output_dir();
     let first = screenshot(&display, &shots.join("app_duck.png"));
     let view = crop(&first, rect);
     check_view_not_blank(&view, "default view");
@@ -278,6 +280,7 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
         "the 3D view differs from the offscreen render: mean {mean:.2}, {:.1}% off",
         off * 100.0
     );
+    update_screenshot(&shots.join("app_duck.png"), "app_duck.png");
 
     // 2. Orbit with the middle button, toggle the wireframe with W.
     let (cx, cy) = (rect.0 + rect.2 / 2, rect.1 + rect.3 / 2);
@@ -300,6 +303,7 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     assert!(moved > 3.0, "orbiting did not change the view (mean difference {moved:.2})");
     let (before, after) = (dark_share(&view), dark_share(&orbited));
     assert!(after > before + 0.05, "no wireframe: dark share {before:.3} → {after:.3}");
+    update_screenshot(&shots.join("app_duck_orbit_wireframe.png"), "app_duck_orbit_wireframe.png");
 
     // 3. Export glTF through the dialog (Ctrl+E, type the path, Enter).
     let exported = dir.join("exported duck.glb");
@@ -467,7 +471,8 @@ fn paint_mode_stroke_lands_under_the_cursor_and_is_saved() {
     xdotool(&display, &["mouseup", "1"]);
     wait_for_log(&log_path, "paint stroke", from, Duration::from_secs(30), app!());
     pause(1.5);
-    let shot = screenshot(&display, &crate_path("screenshots/app_paint.png"));
+    let shot_path = output_dir().join("app_paint.png");
+    let shot = screenshot(&display, &shot_path);
     let view = crop(&shot, rect);
     let red = view
         .enumerate_pixels()
@@ -480,6 +485,7 @@ fn paint_mode_stroke_lands_under_the_cursor_and_is_saved() {
         })
         .count();
     assert!(red > 2000, "no red stroke in the paint-mode screenshot ({red} red pixels near the stroke)");
+    update_screenshot(&shot_path, "app_paint.png");
 
     // Tab leaves (repack), Ctrl+S saves through the dialog.
     let from = read_log(&log_path).len();

@@ -5,7 +5,7 @@
 //! the last generation the helper reported written.
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -16,42 +16,10 @@ use meshpaint::io::autosave::{self, Autosaver};
 use meshpaint::io::document::Document;
 use meshpaint::packing::file as packed_file;
 
+mod common;
+use common::{Rng, TempDir, model};
+
 const BIN: &str = env!("CARGO_BIN_EXE_meshpaint");
-
-fn model(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models").join(relative)
-}
-
-/// A directory under the temp dir, unique per process and test, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(test: &str) -> Self {
-        let path = std::env::temp_dir().join(format!("meshpaint-autosave-{}-{test}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&path);
-        std::fs::create_dir_all(&path).unwrap();
-        TempDir(path)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
 
 fn all_samples(store: &ColorStore) -> Vec<(SampleRef, [u32; 4])> {
     let mut out = Vec::new();

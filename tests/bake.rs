@@ -5,8 +5,6 @@
 // Colour channels are indexed 0..4 in parallel arrays; an index reads clearest.
 #![allow(clippy::needless_range_loop)]
 
-use std::path::Path;
-
 use meshpaint::colors::format::{Rgba, decode_rgba8_srgb, linear_to_srgb};
 use meshpaint::colors::layout::Resolution;
 use meshpaint::colors::store::{ColorStore, SampleRef};
@@ -16,12 +14,11 @@ use meshpaint::mesh::scene::{Material, Scene, Texture};
 use meshpaint::mesh::topology::Topology;
 use meshpaint::mesh::weld::{WeldedMesh, weld_scene};
 
+mod common;
+use common::model;
+
 fn r(value: u64) -> Resolution {
     Resolution::new(value).unwrap()
-}
-
-fn asset(relative: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models").join(relative)
 }
 
 /// A texture from a function of the texel centre's UV returning sRGB-encoded bytes.
@@ -365,7 +362,7 @@ fn baked_mean(store: &ColorStore) -> [f64; 3] {
 }
 
 fn bake_asset(relative: &str, resolution: u64) -> (WeldedMesh, Scene, ColorStore) {
-    let scene = meshpaint::mesh::import::import_gltf(&asset(relative)).unwrap();
+    let scene = meshpaint::mesh::import::import_gltf(&model(relative)).unwrap();
     let mesh = weld_scene(&scene);
     let store = baked(&mesh, &scene, resolution);
     (mesh, scene, store)
@@ -402,7 +399,7 @@ fn textured_models_bake_to_their_textures_average() {
 /// `Document::open` bakes textured files and keeps position colours for plain ones.
 #[test]
 fn document_open_bakes_textured_models() {
-    let document = Document::open(&asset("Duck/Duck.glb"), r(4)).unwrap();
+    let document = Document::open(&model("Duck/Duck.glb"), r(4)).unwrap();
     let (_, _, store) = bake_asset("Duck/Duck.glb", 4);
     let mut same = true;
     store.for_each_site(|site| same &= document.store.get(site.sample) == store.get(site.sample));
@@ -410,7 +407,7 @@ fn document_open_bakes_textured_models() {
     assert!(document.store.clone().take_dirty().is_empty(), "opening leaves nothing dirty");
 
     // Cubes: factor-only materials, one colour per face.
-    let path = asset("Cubes/Cubes.glb");
+    let path = model("Cubes/Cubes.glb");
     let document = Document::open(&path, r(2)).unwrap();
     let scene = meshpaint::mesh::import::import_gltf(&path).unwrap();
     let mesh = weld_scene(&scene);
@@ -421,7 +418,7 @@ fn document_open_bakes_textured_models() {
     });
 
     // Suzanne has no material: the position colour field stays.
-    let path = asset("Suzanne/monkey.glb");
+    let path = model("Suzanne/monkey.glb");
     let document = Document::open(&path, r(2)).unwrap();
     let (min, size) = meshpaint::io::document::bounds(&document.positions);
     for v in 0..document.positions.len() as u32 {

@@ -22,7 +22,8 @@ use meshpaint::paint::brush::{
 use meshpaint::paint::picking::{BvhPreset, MeshBvh};
 use meshpaint::paint::undo::UndoHistory;
 
-type Mesh = (Vec<[f32; 3]>, Vec<[u32; 3]>);
+mod common;
+use common::{Mesh, Rng, TempDir, icosphere, join, model};
 
 const WIDTH: u32 = 1024;
 const HEIGHT: u32 = 768;
@@ -31,22 +32,6 @@ const GREEN: Rgba = [0.1, 0.9, 0.2, 1.0];
 
 fn r(value: u64) -> Resolution {
     Resolution::new(value).unwrap()
-}
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn color(&mut self) -> Rgba {
-        [self.unit(), self.unit(), self.unit(), 1.0]
-    }
 }
 
 // ---------------------------------------------------------------- meshes
@@ -70,77 +55,6 @@ fn grid(n: u32, z: f32, [x0, x1]: [f32; 2], [y0, y1]: [f32; 2]) -> Mesh {
         }
     }
     (positions, triangles)
-}
-
-/// Two meshes in one (indices of the second shifted).
-fn join((mut positions, mut triangles): Mesh, (p2, t2): Mesh) -> Mesh {
-    let offset = positions.len() as u32;
-    positions.extend(p2);
-    triangles.extend(t2.into_iter().map(|t| t.map(|v| v + offset)));
-    (positions, triangles)
-}
-
-/// Icosahedron subdivided `levels` times, vertices on the unit sphere, outward winding.
-/// Symmetric under x → −x (vertices and faces), bit for bit.
-fn icosphere(levels: u32) -> Mesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut vertices: Vec<DVec3> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|p| DVec3::from_array(*p).normalize())
-    .collect();
-    let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut midpoints = HashMap::new();
-        let mut midpoint = |a: u32, b: u32, vertices: &mut Vec<DVec3>| {
-            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                vertices.push(((vertices[a as usize] + vertices[b as usize]) * 0.5).normalize());
-                vertices.len() as u32 - 1
-            })
-        };
-        let mut next = Vec::with_capacity(triangles.len() * 4);
-        for [a, b, c] in triangles {
-            let ab = midpoint(a, b, &mut vertices);
-            let bc = midpoint(b, c, &mut vertices);
-            let ca = midpoint(c, a, &mut vertices);
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        triangles = next;
-    }
-    (vertices.iter().map(|v| v.as_vec3().to_array()).collect(), triangles)
 }
 
 // ---------------------------------------------------------------- helpers
@@ -367,7 +281,7 @@ fn strength_falloff_and_blend_follow_the_closed_forms() {
 fn erase_to_base_restores_the_snapshot_even_after_a_resolution_change() {
     let mut scene = Scene::new(icosphere(2), 4, GREY, 0.0, 0.0);
     let mut rng = Rng(7);
-    scene.store.fill_with(|_| rng.color());
+    scene.store.fill_with(|_| rng.opaque_color());
     let base = scene.store.clone();
     let mut store = scene.store.clone();
     let mut history = UndoHistory::default();
@@ -639,7 +553,7 @@ fn a_stroke_is_one_undo_step_and_misses_place_no_dabs() {
 fn blur_moves_samples_towards_their_neighbour_mean() {
     let mut scene = Scene::new(grid(4, 0.0, [-1.0, 1.0], [-1.0, 1.0]), 16, GREY, 0.0, 0.0);
     let mut rng = Rng(3);
-    scene.store.fill_with(|_| rng.color());
+    scene.store.fill_with(|_| rng.opaque_color());
     let before = scene.store.clone();
     let mut store = scene.store.clone();
     let mut painter = Painter::new(&scene.positions);
@@ -831,7 +745,7 @@ fn the_eyedropper_reads_the_linear_colour_under_the_cursor() {
 fn repacking_after_painting_matches_packing_the_same_colours_directly() {
     let mut scene = Scene::new(icosphere(2), 8, GREY, 30.0, 20.0);
     let mut rng = Rng(11);
-    scene.store.fill_with(|_| rng.color());
+    scene.store.fill_with(|_| rng.opaque_color());
     scene.stroke(
         BrushSettings {
             falloff: Falloff::Smooth,
@@ -894,9 +808,8 @@ fn strokes_and_colours_parse() {
 /// library: its output equals a replay done here with `camera::default_camera`.
 #[test]
 fn the_paint_command_replays_strokes_like_the_library() {
-    let dir = std::env::temp_dir().join(format!("meshpaint-brush-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let input = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Duck/Duck.glb");
+    let dir = TempDir::new("paint-cli");
+    let input = model("Duck/Duck.glb");
     let output = dir.join("painted.mpk");
     let stroke = "300,300 700,400 500,600";
     let status = std::process::Command::new(env!("CARGO_BIN_EXE_meshpaint"))
@@ -964,12 +877,11 @@ fn the_paint_command_replays_strokes_like_the_library() {
         assert!(stderr.contains("error"), "{bad:?}: {stderr}");
         assert!(!dir.join("never.mpk").exists());
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn bench_paint_reports_every_measurement() {
-    let input = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Duck/Duck.glb");
+    let input = model("Duck/Duck.glb");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_meshpaint"))
         .args(["bench", "paint", input.to_str().unwrap(), "--resolution", "4", "--dabs", "2", "--json"])
         .output()

@@ -9,37 +9,11 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
+mod common;
+use common::{TempFile, crate_path, model};
+
 const BIN: &str = env!("CARGO_BIN_EXE_meshpaint");
 const FORMATS: [(&str, u64); 3] = [("rgba8", 4), ("rgba16f", 8), ("rgba32f", 16)];
-
-fn crate_path(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
-}
-
-fn model(relative: &str) -> PathBuf {
-    crate_path("assets/models").join(relative)
-}
-
-/// A file under the temp dir, unique per process and test, removed on drop.
-struct TempFile(PathBuf);
-
-impl TempFile {
-    fn new(test: &str, name: &str) -> Self {
-        let path = std::env::temp_dir().join(format!("meshpaint-cli-{}-{test}-{name}", std::process::id()));
-        let _ = std::fs::remove_file(&path);
-        TempFile(path)
-    }
-
-    fn path(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
-    }
-}
 
 fn meshpaint<I, S>(args: I) -> Output
 where

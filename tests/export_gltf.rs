@@ -8,7 +8,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use std::collections::{BTreeSet, HashMap};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 use std::sync::Mutex;
 
@@ -23,63 +23,11 @@ use meshpaint::mesh::topology::Topology;
 use meshpaint::packing::sampler::{Filter, sample};
 use serde_json::{Value, json};
 
+mod common;
+use common::{SplitMix64, TempDir, crate_path, model};
+
 fn r(value: u64) -> Resolution {
     Resolution::new(value).unwrap()
-}
-
-fn crate_path(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
-}
-
-fn model(relative: &str) -> PathBuf {
-    crate_path("assets/models").join(relative)
-}
-
-/// A directory under the temp dir, unique per process and test, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(test: &str) -> Self {
-        let path = std::env::temp_dir().join(format!("meshpaint-export-{}-{test}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&path);
-        std::fs::create_dir_all(&path).unwrap();
-        TempDir(path)
-    }
-
-    fn join(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-/// SplitMix64: a small deterministic generator (no rand dependency).
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: u64) -> u64 {
-        self.next_u64() % n
-    }
-
-    fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    fn color(&mut self) -> [f32; 4] {
-        [self.unit(), self.unit(), self.unit(), self.unit()]
-    }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -126,7 +74,7 @@ fn mixed_grid(seed: u64) -> Painted {
     let topology = Topology::build(positions.len() as u32, &triangles).unwrap();
     let resolutions = (0..triangles.len()).map(|f| r(MIXED[(f + f / (2 * N as usize)) % 4])).collect();
     let mut store = ColorStore::with_resolutions(topology, resolutions, [1.0; 4]).unwrap();
-    let mut rng = Rng(seed);
+    let mut rng = SplitMix64(seed);
     store.fill_with(|_| rng.color());
     Painted { name: "mixed grid".into(), positions, store }
 }
@@ -137,7 +85,7 @@ fn mixed_box(seed: u64) -> Painted {
     for face in 0..painted.store.topology().face_count() {
         painted.store.set_face_resolution(face, r(MIXED[face as usize % 4])).unwrap();
     }
-    let mut rng = Rng(seed);
+    let mut rng = SplitMix64(seed);
     painted.store.fill_with(|_| rng.color());
     painted.name = "mixed box".into();
     painted
@@ -378,7 +326,7 @@ fn round_trip_with_mixed_resolutions() {
 #[test]
 fn resolution_one_exports_the_vertex_colours() {
     let mut case = open_model("BoxTextured/BoxTextured.glb", 1);
-    let mut rng = Rng(5);
+    let mut rng = SplitMix64(5);
     case.store.fill_with(|_| rng.color());
     let mesh = check_round_trip(&case);
     let topology = case.store.topology();
@@ -470,7 +418,7 @@ fn check_linear_filter(case: &Painted, points: usize, seed: u64) {
     for res in store.face_resolutions() {
         starts.push(starts.last().unwrap() + (res.get() * res.get()) as usize);
     }
-    let mut rng = Rng(seed);
+    let mut rng = SplitMix64(seed);
     let mut checked = 0;
     let mut cache: HashMap<u32, Vec<LatticeTriangle>> = HashMap::new();
     while checked < points {
@@ -906,11 +854,7 @@ fn bad_color_0_accessors_are_refused() {
 fn exported_glb_reopens_in_meshpaint_with_the_sample_colours_at_its_vertices() {
     use meshpaint::colors::layout::Resolution;
     use meshpaint::io::document::Document;
-    let source = Document::open(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Duck/Duck.glb"),
-        Resolution::new(4).unwrap(),
-    )
-    .unwrap();
+    let source = Document::open(&model("Duck/Duck.glb"), Resolution::new(4).unwrap()).unwrap();
     let tessellation = meshpaint::io::export_gltf::tessellate(&source.positions, &source.store).unwrap();
     let path = std::env::temp_dir().join(format!("meshpaint-reopen-{}.glb", std::process::id()));
     meshpaint::io::export_gltf::write_tessellated_glb(&path, &source.positions, &source.store).unwrap();

@@ -16,9 +16,11 @@ use meshpaint::camera::{BoundingSphere, OrbitCamera};
 use meshpaint::colors::format::ColorFormat;
 use meshpaint::packing::linear::{FaceRecord, PackedMesh, pack_word};
 use meshpaint::packing::sampler::packed_sample_index;
-use meshpaint::render::{
-    DrawItem, FilterMode, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderSettings, Renderer, Shading,
-};
+use meshpaint::render::{DrawItem, FilterMode, GpuMesh, MeshUploadOptions, RenderSettings, Shading};
+
+mod common;
+use common::Rng;
+use common::gpu::Gpu;
 
 const SIZE: u32 = 256;
 const GRID: u32 = 8;
@@ -29,16 +31,6 @@ const SAMPLES: u64 = 20_000_000;
 const FILLER: [u8; 4] = [255, 0, 255, 255];
 /// Largest allowed per-channel difference in 8-bit steps (sRGB decode and encode round trip).
 const MAX_STEPS: u8 = 2;
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-}
 
 /// The grid's faces (the ones that show).
 fn visible_faces() -> std::ops::Range<u32> {
@@ -112,18 +104,6 @@ fn close(a: [u8; 4], b: [u8; 4]) -> bool {
     a.iter().zip(b).all(|(&x, y)| x.abs_diff(y) <= MAX_STEPS)
 }
 
-struct Gpu {
-    ctx: GpuContext,
-    renderer: Renderer,
-}
-
-fn gpu() -> Gpu {
-    let ctx = GpuContext::new_headless()
-        .unwrap_or_else(|error| panic!("GPU tests need an adapter (lavapipe: mesa-vulkan-drivers): {error}"));
-    let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT).unwrap();
-    Gpu { ctx, renderer }
-}
-
 fn camera(packed: &PackedMesh) -> OrbitCamera {
     OrbitCamera::framing(BoundingSphere::of_points(&packed.positions[PADDING as usize..]), 0.0, 0.0)
 }
@@ -164,7 +144,7 @@ fn check(gpu: &Gpu, packed: &PackedMesh, mesh: &GpuMesh, filter: FilterMode, exp
 
 #[test]
 fn large_indices_and_odd_atlas_widths_address_exactly() {
-    let gpu = gpu();
+    let gpu = Gpu::create();
     let packed = grid_mesh();
     let mut failures = Vec::new();
     // 1221 columns need 16380 rows (nearly the 16384 limit); 4093 is prime; 16384 is the default.
@@ -192,7 +172,7 @@ fn large_indices_and_odd_atlas_widths_address_exactly() {
 /// records were swapped show each other's interior colours.
 #[test]
 fn rewritten_face_records_take_effect() {
-    let gpu = gpu();
+    let gpu = Gpu::create();
     let packed = grid_mesh();
     let mesh = GpuMesh::upload(&gpu.ctx, &gpu.renderer, &packed, &MeshUploadOptions::default()).unwrap();
     let (first, end) = (4090u32, 4110u32);

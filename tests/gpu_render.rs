@@ -12,7 +12,6 @@
 #![allow(clippy::needless_range_loop)]
 
 use std::path::PathBuf;
-use std::sync::OnceLock;
 
 use glam::DVec3;
 use image::RgbaImage;
@@ -24,9 +23,11 @@ use meshpaint::mesh::topology::Topology;
 use meshpaint::packing::linear::PackedMesh;
 use meshpaint::packing::packer::pack;
 use meshpaint::packing::sampler::{Filter, sample};
-use meshpaint::render::{
-    DrawItem, FilterMode, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderSettings, Renderer, Shading,
-};
+use meshpaint::render::{DrawItem, FilterMode, GpuMesh, MeshUploadOptions, RenderSettings, Shading};
+
+mod common;
+use common::gpu::{shared as gpu, textured_baseline};
+use common::{Rng, model, output_dir};
 
 const SIZE: u32 = 256;
 /// Largest allowed per-channel difference in 8-bit steps.
@@ -35,38 +36,6 @@ const MAX_STEPS: u32 = 2;
 const EDGE_MARGIN: f64 = 1e-4;
 /// Nearest filtering: pixels within this many lattice units of a cell boundary are skipped.
 const CELL_MARGIN: f32 = 1e-3;
-
-struct Gpu {
-    ctx: GpuContext,
-    renderer: Renderer,
-}
-
-fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Result<Gpu, String>> = OnceLock::new();
-    let gpu = GPU.get_or_init(|| {
-        let ctx = GpuContext::new_headless().map_err(|error| error.to_string())?;
-        eprintln!("adapter: {}", ctx.describe());
-        let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT).map_err(|error| error.to_string())?;
-        Ok(Gpu { ctx, renderer })
-    });
-    match gpu {
-        Ok(gpu) => gpu,
-        Err(error) => panic!("GPU tests need an adapter (lavapipe: apt-get install mesa-vulkan-drivers): {error}"),
-    }
-}
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
 
 fn r(value: u64) -> Resolution {
     Resolution::new(value).unwrap()
@@ -208,12 +177,6 @@ impl Comparison {
     fn mean(&self) -> f64 {
         if self.compared == 0 { 0.0 } else { self.sum_steps / (self.compared as f64 * 4.0) }
     }
-}
-
-fn output_dir() -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/test-output");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn render(scene_mesh: &GpuMesh, camera: OrbitCamera, filter: FilterMode) -> RgbaImage {
@@ -622,10 +585,6 @@ fn r4096_face_fills_the_screen() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-fn model(relative: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/models").join(relative)
-}
-
 /// Mean per-channel difference (8-bit steps) over pixels covered in both images, and the
 /// number of pixels covered in exactly one.
 fn image_difference(a: &RgbaImage, b: &RgbaImage, background: [u8; 4]) -> (f64, u64, u64) {
@@ -648,26 +607,12 @@ fn image_difference(a: &RgbaImage, b: &RgbaImage, background: [u8; 4]) -> (f64, 
 #[test]
 fn mesh_colors_and_the_uv_baseline_look_alike() {
     use meshpaint::camera::{BoundingSphere, default_camera};
-    use meshpaint::render::BaselineMesh;
     let gpu = gpu();
     let path = model("Duck/Duck.glb");
     let document = meshpaint::io::document::Document::open(&path, r(16)).unwrap();
     let packed = document.pack(ColorFormat::Rgba8Srgb).unwrap();
     let mesh = upload(&packed, None);
-    let scene = meshpaint::mesh::import::import_gltf(&path).unwrap();
-    let welded = meshpaint::mesh::weld::weld_scene(&scene);
-    let (material, texture) =
-        scene.materials.iter().find_map(|m| Some((m, scene.textures.get(m.base_color_texture? as usize)?))).unwrap();
-    let baseline = BaselineMesh::new(
-        &gpu.ctx,
-        &gpu.renderer,
-        &welded.positions_world,
-        &welded.triangles,
-        &welded.corner_uvs,
-        texture,
-        material.base_color_factor,
-    )
-    .unwrap();
+    let baseline = textured_baseline(gpu, &path);
     let mut settings =
         RenderSettings::new(default_camera(BoundingSphere::of_points(&document.positions), 30.0, 20.0, None));
     settings.background = [0.0; 4];

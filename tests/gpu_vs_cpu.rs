@@ -9,21 +9,16 @@ use meshpaint::camera::{BoundingSphere, OrbitCamera};
 use meshpaint::colors::format::{ColorFormat, encode_srgb8};
 use meshpaint::colors::layout::{self, Resolution};
 use meshpaint::io::document::Document;
-use meshpaint::mesh::import::import_gltf;
-use meshpaint::mesh::weld::weld_scene;
 use meshpaint::packing::linear::PackedMesh;
 use meshpaint::packing::sampler::{Filter, sample};
 use meshpaint::paint::picking::{BvhPreset, MeshBvh};
-use meshpaint::render::{
-    BaselineMesh, DrawItem, FilterMode, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderSettings,
-    Renderer, Shading,
-};
+use meshpaint::render::{DrawItem, FilterMode, GpuMesh, MeshUploadOptions, RenderSettings, Shading};
+
+mod common;
+use common::gpu::{Gpu, textured_baseline};
+use common::model;
 
 const SIZE: u32 = 256;
-
-fn asset(path: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
-}
 
 struct Comparison {
     compared: usize,
@@ -35,8 +30,7 @@ struct Comparison {
 
 /// Renders `packed` unlit with `filter` and compares sampled pixels with the CPU truth.
 fn compare(packed: &PackedMesh, camera: OrbitCamera, filter: FilterMode) -> Comparison {
-    let ctx = GpuContext::new_headless().expect("a GPU adapter (lavapipe) is required");
-    let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT).unwrap();
+    let Gpu { ctx, renderer } = Gpu::create();
     let mesh = GpuMesh::upload(&ctx, &renderer, packed, &MeshUploadOptions::default()).unwrap();
     let mut settings = RenderSettings::new(camera);
     settings.filter = filter;
@@ -97,7 +91,7 @@ fn compare(packed: &PackedMesh, camera: OrbitCamera, filter: FilterMode) -> Comp
 }
 
 fn duck_document(resolution: u64) -> Document {
-    Document::open(&asset("assets/models/Duck/Duck.glb"), Resolution::new(resolution).unwrap()).unwrap()
+    Document::open(&model("Duck/Duck.glb"), Resolution::new(resolution).unwrap()).unwrap()
 }
 
 fn assert_close(name: &str, comparison: &Comparison, tolerance_steps: u8) {
@@ -131,7 +125,7 @@ fn duck_textured_r16_every_filter_matches_the_cpu_reference() {
 #[test]
 fn mixed_resolutions_across_shared_edges_on_a_real_mesh() {
     // Suzanne (open eyes: boundary edges) with R from 1 to 64 by face id, and Duck at R = 1.
-    let mut document = Document::open(&asset("assets/models/Suzanne/monkey.glb"), Resolution::new(8).unwrap()).unwrap();
+    let mut document = Document::open(&model("Suzanne/monkey.glb"), Resolution::new(8).unwrap()).unwrap();
     for face in 0..document.store.topology().face_count() {
         let r = Resolution::from_log2(face % 7).unwrap();
         document.store.set_face_resolution(face, r).unwrap();
@@ -165,34 +159,21 @@ fn psnr(a: &image::RgbaImage, b: &image::RgbaImage, background: [u8; 3]) -> (f64
 
 #[test]
 fn duck_r16_linear_is_visually_equivalent_to_the_uv_texture() {
-    let path = asset("assets/models/Duck/Duck.glb");
+    let path = model("Duck/Duck.glb");
     let document = duck_document(16);
-    let ctx = GpuContext::new_headless().expect("a GPU adapter (lavapipe) is required");
-    let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT).unwrap();
+    let gpu = Gpu::create();
+    let Gpu { ctx, renderer } = &gpu;
     let packed = document.pack(ColorFormat::Rgba8Srgb).unwrap();
-    let mesh = GpuMesh::upload(&ctx, &renderer, &packed, &MeshUploadOptions::default()).unwrap();
-    let scene = import_gltf(&path).unwrap();
-    let welded = weld_scene(&scene);
-    let material = scene.materials.iter().find(|m| m.base_color_texture.is_some()).unwrap();
-    let texture = &scene.textures[material.base_color_texture.unwrap() as usize];
-    let baseline = BaselineMesh::new(
-        &ctx,
-        &renderer,
-        &welded.positions_world,
-        &welded.triangles,
-        &welded.corner_uvs,
-        texture,
-        material.base_color_factor,
-    )
-    .unwrap();
+    let mesh = GpuMesh::upload(ctx, renderer, &packed, &MeshUploadOptions::default()).unwrap();
+    let baseline = textured_baseline(&gpu, &path);
     let mut worst = f64::INFINITY;
     for (yaw, pitch) in [(30.0, 20.0), (-60.0, 5.0), (160.0, 35.0)] {
         let camera = OrbitCamera::framing(BoundingSphere::of_points(&document.positions), yaw, pitch);
         let mut settings = RenderSettings::new(camera);
         settings.filter = FilterMode::Linear;
         settings.shading = Shading::Unlit;
-        let ours = renderer.render_image(&ctx, DrawItem::MeshColors(&mesh), &settings, 512, 512).unwrap();
-        let theirs = renderer.render_image(&ctx, DrawItem::Baseline(&baseline), &settings, 512, 512).unwrap();
+        let ours = renderer.render_image(ctx, DrawItem::MeshColors(&mesh), &settings, 512, 512).unwrap();
+        let theirs = renderer.render_image(ctx, DrawItem::Baseline(&baseline), &settings, 512, 512).unwrap();
         let background: [u8; 3] = settings.background.map(encode_srgb8)[..3].try_into().unwrap();
         let (db, pixels) = psnr(&ours, &theirs, background);
         println!("Duck R=16 linear vs UV texture, yaw {yaw} pitch {pitch}: PSNR {db:.2} dB over {pixels} pixels");

@@ -3,46 +3,14 @@
 //! midpoints, exactly along shared edges), brute-force sphere queries, identical answers
 //! for every preset, and the extremes (far from the origin, tiny, slivers, high valence).
 
-use std::path::Path;
-
 use glam::DVec3;
 use meshpaint::camera::{BoundingSphere, OrbitCamera};
 use meshpaint::paint::picking::{BvhKind, BvhPreset, MeshBvh, RayHit};
 
-type Mesh = (Vec<[f32; 3]>, Vec<[u32; 3]>);
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    /// Uniform in [0, 1).
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Uniform on the unit sphere.
-    fn direction(&mut self) -> DVec3 {
-        loop {
-            let v = DVec3::new(self.unit() * 2.0 - 1.0, self.unit() * 2.0 - 1.0, self.unit() * 2.0 - 1.0);
-            let len = v.length();
-            if len > 1e-3 && len <= 1.0 {
-                return v / len;
-            }
-        }
-    }
-}
+mod common;
+use common::{Mesh, Rng, icosphere, model, octahedron_mesh};
 
 // ---------------------------------------------------------------- meshes
-
-fn octahedron() -> Mesh {
-    let positions =
-        vec![[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
-    let triangles = vec![[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
-    (positions, triangles)
-}
 
 fn cube() -> Mesh {
     let positions = (0..8)
@@ -57,68 +25,6 @@ fn cube() -> Mesh {
     let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     let triangles = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
     (positions, triangles)
-}
-
-/// Icosahedron subdivided `levels` times, vertices on the unit sphere.
-fn icosphere(levels: u32) -> Mesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut vertices: Vec<DVec3> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|p| DVec3::from_array(*p).normalize())
-    .collect();
-    let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut midpoints = std::collections::HashMap::new();
-        let mut midpoint = |a: u32, b: u32, vertices: &mut Vec<DVec3>| {
-            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                vertices.push(((vertices[a as usize] + vertices[b as usize]) * 0.5).normalize());
-                vertices.len() as u32 - 1
-            })
-        };
-        let mut next = Vec::with_capacity(triangles.len() * 4);
-        for [a, b, c] in triangles {
-            let ab = midpoint(a, b, &mut vertices);
-            let bc = midpoint(b, c, &mut vertices);
-            let ca = midpoint(c, a, &mut vertices);
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        triangles = next;
-    }
-    (vertices.iter().map(|v| v.as_vec3().to_array()).collect(), triangles)
 }
 
 /// Double cone: a ring of `n` vertices at z = 0 and apexes at z = ±1 of valence `n`.
@@ -162,7 +68,7 @@ fn sliver_prism(length: f32, width: f32) -> Mesh {
 }
 
 fn duck() -> Mesh {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Duck/Duck.glb");
+    let path = model("Duck/Duck.glb");
     let scene = meshpaint::mesh::import::import_gltf(&path).unwrap();
     let welded = meshpaint::mesh::weld::weld_scene(&scene);
     (welded.positions_world, welded.triangles)
@@ -334,7 +240,7 @@ const VIEWS: [(f64, f64); 4] = [(0.0, 0.0), (35.0, 20.0), (140.0, -30.0), (250.0
 #[test]
 fn pixel_rays_match_brute_force_on_closed_meshes() {
     let meshes: Vec<(&str, Mesh, u32, usize)> = vec![
-        ("octahedron", octahedron(), 200, 4),
+        ("octahedron", octahedron_mesh(), 200, 4),
         ("cube", cube(), 200, 4),
         ("icosphere", icosphere(3), 200, 4),
         ("bicone", bicone(256), 200, 4),
@@ -362,8 +268,8 @@ fn random_rays_match_brute_force_barycentrics() {
         let (center, radius) = mesh_center_and_radius(&mesh);
         let mut compared = 0;
         for k in 0..3000 {
-            let origin = center + rng.direction() * radius * (1.5 + 3.0 * rng.unit());
-            let target = center + rng.direction() * radius * 0.7 * rng.unit();
+            let origin = center + rng.direction() * radius * (1.5 + 3.0 * rng.unit_f64());
+            let target = center + rng.direction() * radius * 0.7 * rng.unit_f64();
             if check_against_brute_force(&mesh, &bvh, origin, target - origin, &format!("{name} ray {k}")) {
                 compared += 1;
             }
@@ -377,7 +283,7 @@ fn random_rays_match_brute_force_barycentrics() {
 #[test]
 fn rays_aimed_at_the_centre_of_closed_meshes_never_miss() {
     let meshes: Vec<(&str, Mesh)> = vec![
-        ("octahedron", octahedron()),
+        ("octahedron", octahedron_mesh()),
         ("cube", cube()),
         ("icosphere", icosphere(3)),
         ("bicone 1000", bicone(1000)),
@@ -385,14 +291,14 @@ fn rays_aimed_at_the_centre_of_closed_meshes_never_miss() {
         ("icosphere at 1e6", transformed(&icosphere(2), 1e6, 1.0)),
         ("icosphere scaled 1e-4", transformed(&icosphere(2), 0.0, 1e-4)),
         ("icosphere at 1e3 scaled 1e-2", transformed(&icosphere(2), 1e3, 1e-2)),
-        ("octahedron at -1e6 scaled 1e4", transformed(&octahedron(), -1e6, 1e4)),
+        ("octahedron at -1e6 scaled 1e4", transformed(&octahedron_mesh(), -1e6, 1e4)),
     ];
     let mut rng = Rng(42);
     for (name, mesh) in meshes {
         let bvh = build(&mesh);
         let (center, radius) = mesh_center_and_radius(&mesh);
         for k in 0..20_000 {
-            let distance = radius * if k % 10 == 0 { 1e3 } else { 1.2 + 4.0 * rng.unit() };
+            let distance = radius * if k % 10 == 0 { 1e3 } else { 1.2 + 4.0 * rng.unit_f64() };
             let origin = center + rng.direction() * distance;
             let direction = (center - origin).normalize();
             let Some(hit) = bvh.cast(origin, direction, f64::INFINITY) else {
@@ -409,7 +315,7 @@ fn rays_aimed_at_the_centre_of_closed_meshes_never_miss() {
 #[test]
 fn rays_aimed_at_vertices_and_edge_midpoints_hit() {
     let meshes: Vec<(&str, Mesh)> = vec![
-        ("octahedron", octahedron()),
+        ("octahedron", octahedron_mesh()),
         ("cube", cube()),
         ("icosphere", icosphere(2)),
         ("bicone", bicone(64)),
@@ -473,7 +379,7 @@ fn rays_aimed_at_vertices_and_edge_midpoints_hit() {
 /// Every ray over the shape's footprint hits, at exactly the known depth.
 #[test]
 fn rays_exactly_along_shared_edges_and_vertices_hit() {
-    let octa = octahedron();
+    let octa = octahedron_mesh();
     let cube = cube();
     let (octa_bvh, cube_bvh) = (build(&octa), build(&cube));
     let mut tested = 0;
@@ -525,7 +431,7 @@ fn high_valence_apex_and_slivers() {
     // Rays through the ring vertices and spokes from many angles.
     let mut rng = Rng(99);
     for k in 0..2000u32 {
-        let target = vertex(&mesh, k) * 0.999 + DVec3::new(0.0, 0.0, 1e-3 * (rng.unit() - 0.5));
+        let target = vertex(&mesh, k) * 0.999 + DVec3::new(0.0, 0.0, 1e-3 * (rng.unit_f64() - 0.5));
         let origin = target + rng.direction() * 4.0;
         check_against_brute_force(&mesh, &bvh, origin, target - origin, "bicone 2000");
         assert!(bvh.cast(origin, target - origin, f64::INFINITY).is_some(), "spoke ray {k}");
@@ -577,8 +483,8 @@ fn faces_in_sphere_equals_brute_force() {
         let (center, radius) = mesh_center_and_radius(&mesh);
         let mut nonempty = 0;
         for k in 0..300 {
-            let sphere_center = center + rng.direction() * radius * 1.2 * rng.unit();
-            let r = radius * [0.0, 1e-3, 0.02, 0.1, 0.5, 2.0][k % 6] * (0.5 + rng.unit());
+            let sphere_center = center + rng.direction() * radius * 1.2 * rng.unit_f64();
+            let r = radius * [0.0, 1e-3, 0.02, 0.1, 0.5, 2.0][k % 6] * (0.5 + rng.unit_f64());
             let found = bvh.faces_in_sphere(sphere_center, r);
             assert!(found.windows(2).all(|w| w[0] < w[1]), "{name}: not sorted and unique");
             let tolerance = 1e-9 * radius;
@@ -608,8 +514,9 @@ fn every_preset_gives_identical_answers() {
         let rays = pixel_grid_rays(&mesh, &VIEWS[..2], 80);
         let (center, radius) = mesh_center_and_radius(&mesh);
         let mut rng = Rng(5);
-        let spheres: Vec<(DVec3, f64)> =
-            (0..200).map(|_| (center + rng.direction() * radius * rng.unit(), radius * 0.2 * rng.unit())).collect();
+        let spheres: Vec<(DVec3, f64)> = (0..200)
+            .map(|_| (center + rng.direction() * radius * rng.unit_f64(), radius * 0.2 * rng.unit_f64()))
+            .collect();
         let answers = |preset: BvhPreset| {
             let bvh = MeshBvh::build(&mesh.0, &mesh.1, preset);
             let hits: Vec<Option<RayHit>> = rays.iter().map(|&(o, d)| bvh.cast(o, d, f64::INFINITY)).collect();
@@ -690,7 +597,7 @@ fn edge_cases_of_the_query_api() {
 #[test]
 #[ignore = "a measurement, not a test: run with --release --ignored --nocapture"]
 fn bench_bvh_kinds() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/Bunny144k/bunny.glb");
+    let path = model("Bunny144k/bunny.glb");
     let scene = meshpaint::mesh::import::import_gltf(&path).unwrap();
     let welded = meshpaint::mesh::weld::weld_scene(&scene);
     let mesh = (welded.positions_world, welded.triangles);

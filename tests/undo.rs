@@ -13,27 +13,14 @@ use meshpaint::paint::brush::{ResolutionOp, Tool};
 use meshpaint::paint::picking::{BvhPreset, MeshBvh};
 use meshpaint::paint::undo::{SAMPLE_RECORD_BYTES, UndoError, UndoHistory};
 
+mod common;
+use common::Rng;
+
 const WIDTH: u32 = 800;
 const HEIGHT: u32 = 600;
 
 fn r(value: u64) -> Resolution {
     Resolution::new(value).unwrap()
-}
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn color(&mut self) -> Rgba {
-        [self.unit(), self.unit(), self.unit(), self.unit()]
-    }
 }
 
 /// A closed mesh: a UV sphere with `rings × segments` quads split in two.

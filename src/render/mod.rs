@@ -45,7 +45,10 @@ pub use baseline::{BaselineMesh, BaselineVertex, mip_chain_linear};
 pub use context::{GpuContext, backends_from_env};
 pub use gpu::Gpu;
 pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshUploadOptions, atlas_texture_format, default_atlas_width};
-pub use renderer::{DrawItem, FilterMode, Overlays, RenderSettings, RenderTarget, Renderer, Shading};
+pub use renderer::{
+    DrawItem, FRAME_WGSL, FilterMode, MESH_COLORS_WGSL, Overlays, RenderSettings, RenderTarget, Renderer, Shading,
+    UV_BASELINE_WGSL,
+};
 pub use uniforms::FrameUniforms;
 
 use thiserror::Error;

@@ -8,8 +8,17 @@ use super::{BaselineMesh, BaselineVertex, DEPTH_FORMAT, GpuContext, GpuMesh, Ren
 use crate::camera::OrbitCamera;
 use crate::colors::format::Rgba;
 
-const MESH_COLORS_WGSL: &str = include_str!("../../shaders/mesh_colors.wgsl");
-const UV_BASELINE_WGSL: &str = include_str!("../../shaders/uv_baseline.wgsl");
+/// shaders/frame.wgsl: the uniform block ([`FrameUniforms`]), its `FLAG_*` bits and helpers
+/// both pipelines share. Not a shader by itself: it is prepended to each shader below.
+pub const FRAME_WGSL: &str = include_str!("../../shaders/frame.wgsl");
+/// The mesh-colors shader exactly as the pipelines compile it: shaders/frame.wgsl followed
+/// by shaders/mesh_colors.wgsl (tests/shaders.rs validates this very string).
+pub const MESH_COLORS_WGSL: &str =
+    concat!(include_str!("../../shaders/frame.wgsl"), "\n", include_str!("../../shaders/mesh_colors.wgsl"));
+/// The UV-baseline shader exactly as its pipeline compiles it: shaders/frame.wgsl followed
+/// by shaders/uv_baseline.wgsl (tests/shaders.rs validates this very string).
+pub const UV_BASELINE_WGSL: &str =
+    concat!(include_str!("../../shaders/frame.wgsl"), "\n", include_str!("../../shaders/uv_baseline.wgsl"));
 
 /// How mesh colors are reconstructed and which MIP level is read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -382,7 +391,8 @@ impl Renderer {
             wire_width: settings.wire_width,
             face_count: 0,
             vertex_count: 0,
-            _pad: [0; 2],
+            _pad0: 0,
+            _pad1: 0,
         };
         match item {
             DrawItem::MeshColors(mesh) => {

@@ -4,8 +4,9 @@ use bytemuck::{Pod, Zeroable};
 
 /// Per-draw uniforms of both pipelines.
 ///
-/// Keep in sync with `struct FrameUniforms` in shaders/mesh_colors.wgsl and
-/// shaders/uv_baseline.wgsl (same fields, same order, 160 bytes).
+/// Keep in sync with `struct FrameUniforms` in shaders/frame.wgsl, which both shaders
+/// include (same field names, same order, 160 bytes; tests/shaders.rs compares every
+/// member's offset with [`std::mem::offset_of!`]).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct FrameUniforms {
@@ -37,8 +38,11 @@ pub struct FrameUniforms {
     pub face_count: u32,
     /// Number of vertices.
     pub vertex_count: u32,
-    /// Padding to a multiple of 16 bytes.
-    pub _pad: [u32; 2],
+    /// Padding to a multiple of 16 bytes (`_pad0`, `_pad1` as in the WGSL struct: uniform
+    /// arrays need a 16-byte stride there).
+    pub _pad0: u32,
+    /// See [`FrameUniforms::_pad0`].
+    pub _pad1: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 160);
@@ -52,7 +56,8 @@ impl FrameUniforms {
     pub const LEVEL_FIXED: u32 = 0;
     /// Choose the level per pixel from screen-space derivatives, blend two levels.
     pub const LEVEL_AUTO: u32 = 1;
-    /// Lambert + ambient shading with the face normal.
+    /// Lambert + ambient shading with the face normal. The `FLAG_*` bits: keep in sync with
+    /// the `FLAG_*` constants in shaders/frame.wgsl (tests/shaders.rs compares them).
     pub const FLAG_LIT: u32 = 1;
     /// Wireframe overlay.
     pub const FLAG_WIREFRAME: u32 = 2;

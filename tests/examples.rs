@@ -1,0 +1,64 @@
+//! The examples in examples/ run and do what they say. Each example's work is a function
+//! (its `main` only reads the command line), included here as a module and called directly:
+//! integration tests have no `cargo run --example`.
+
+mod common;
+use common::{TempDir, model};
+
+#[path = "../examples/paint_stroke.rs"]
+#[allow(dead_code)] // the example's `main`
+mod paint_stroke;
+
+#[path = "../examples/render_offscreen.rs"]
+#[allow(dead_code)] // the example's `main`
+mod render_offscreen;
+
+use meshpaint::colors::layout::Resolution;
+use meshpaint::colors::store::ColorStore;
+use meshpaint::io::document::{Document, SourceKind};
+
+/// Every sample's colour, in `for_each_site` order.
+fn colors(store: &ColorStore) -> Vec<[f32; 4]> {
+    let mut out = Vec::new();
+    store.for_each_site(|site| out.push(store.get(site.sample).unwrap()));
+    out
+}
+
+#[test]
+fn paint_stroke_writes_a_packed_file_with_painted_samples() {
+    let dir = TempDir::new("paint-stroke");
+    let input = model("Duck/Duck.glb");
+    let output = dir.join("painted.mpk");
+    let changed = paint_stroke::paint_stroke(&input, &output).unwrap();
+    assert!(changed > 100, "the stroke changed only {changed} samples");
+
+    let r8 = Resolution::new(8).unwrap();
+    let painted = Document::open(&output, r8).expect("the example's output does not reopen");
+    let SourceKind::Packed(format) = painted.source else { panic!("not a packed file: {:?}", painted.source) };
+    // The unpainted Duck, quantised exactly as the example's save was.
+    let original = Document::open(&input, r8).unwrap();
+    let original = Document::from_packed(&original.pack(format).unwrap()).unwrap();
+    let (before, after) = (colors(&original.store), colors(&painted.store));
+    assert_eq!(before.len(), after.len(), "the sample count changed");
+    let differ = before.iter().zip(&after).filter(|(a, b)| a != b).count() as u64;
+    assert!(differ > 100 && differ <= changed, "{differ} samples differ after reopening, {changed} changed");
+    // Every changed sample moved towards the brush colour (mix blend).
+    let distance = |c: &[f32; 4]| c.iter().zip(paint_stroke::COLOR).map(|(a, b)| (a - b) * (a - b)).sum::<f32>();
+    for (old, new) in before.iter().zip(&after).filter(|(a, b)| a != b) {
+        assert!(distance(new) <= distance(old) + 1e-4, "{old:?} → {new:?} is not towards {:?}", paint_stroke::COLOR);
+    }
+}
+
+#[test]
+fn render_offscreen_writes_a_png_of_the_mesh() {
+    let dir = TempDir::new("render-offscreen");
+    let output = dir.join("duck.png");
+    let adapter = render_offscreen::render_offscreen(&model("Duck/Duck.glb"), &output, 320, 240).unwrap();
+    eprintln!("adapter: {adapter}");
+    assert!(std::fs::metadata(&output).unwrap().len() > 0, "empty PNG");
+    let image = image::open(&output).expect("not a readable PNG").to_rgba8();
+    assert_eq!(image.dimensions(), (320, 240));
+    let background = *image.get_pixel(0, 0);
+    let covered = image.pixels().filter(|p| **p != background).count();
+    assert!(covered > 320 * 240 / 20, "only {covered} pixels differ from the background");
+}
