@@ -22,8 +22,16 @@
 //!
 //! Whether a sample was already recorded in the open step is a bit in a per-element bitset:
 //! one bitset over all vertices, and one per touched edge or face interior, found through a
-//! dense element → slot table. The brush asks for an element's [`SampleLog`] once per element
-//! and records each write with a bit test and a push.
+//! dense element → slot table. A tool asks the [`StoreWriter`] for an element's
+//! [`ElementWriter`] once per element, which records each write with a bit test and a push.
+//!
+//! # One write path
+//!
+//! Every tool changes the store through a [`StoreWriter`] (`&mut ColorStore` and
+//! `&mut UndoHistory` borrowed together for a dab, a fill, …): [`StoreWriter::set`], the
+//! per-element fast path [`StoreWriter::element`] and [`StoreWriter::set_face_resolution`]
+//! record the old state in the open step, then write through the store's setters, which mark
+//! the element dirty for the GPU upload. Undo, dirty tracking and GPU sync cannot diverge.
 //!
 //! # Memory
 //!
@@ -290,36 +298,50 @@ impl SeenSamples {
     }
 }
 
-/// Which element a [`SampleLog`] records for.
+/// One element's samples, as [`StoreWriter::element`] writes them: the vertex colours
+/// (index = vertex id), or the samples of one edge or face interior (index = storage offset).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum LogElement {
+pub enum Element {
+    /// Every vertex colour.
     Vertices,
+    /// The samples of an edge.
     Edge(u32),
+    /// The interior samples of a face.
     Interior(u32),
-    /// No step is open: nothing is recorded.
-    Off,
 }
 
-/// Records first writes to the samples of one element (or to vertices) in the open step.
-/// Obtained from [`UndoHistory::vertex_log`], [`UndoHistory::edge_log`] or
-/// [`UndoHistory::interior_log`]; recording is a bit test and, the first time, a push.
+impl Element {
+    /// The sample at `index` of this element.
+    #[inline(always)]
+    pub fn sample(self, index: u32) -> SampleRef {
+        match self {
+            Element::Vertices => SampleRef::Vertex(index),
+            Element::Edge(edge) => SampleRef::Edge { edge, offset: index },
+            Element::Interior(face) => SampleRef::Interior { face, offset: index },
+        }
+    }
+}
+
+/// Records first writes to the samples of one element (or to vertices) in the open step;
+/// recording is a bit test and, the first time, a push. Only [`ElementWriter`] records.
 #[derive(Debug)]
-pub struct SampleLog<'a> {
-    element: LogElement,
+struct SampleLog<'a> {
+    element: Element,
     bits: &'a mut [u64],
+    /// `None`: no step is open, nothing is recorded.
     list: Option<&'a mut Vec<(SampleRef, Rgba)>>,
 }
 
 impl SampleLog<'_> {
     /// A log that records nothing (no step is open).
-    fn off() -> Self {
-        SampleLog { element: LogElement::Off, bits: &mut [], list: None }
+    fn off(element: Element) -> Self {
+        SampleLog { element, bits: &mut [], list: None }
     }
 
-    /// Records that sample `index` of the element (the vertex id for vertex logs, the
-    /// storage offset otherwise) had colour `old` before its first write in the step.
-    #[inline]
-    pub fn record(&mut self, index: u32, old: Rgba) {
+    /// Records that sample `index` of the element had colour `old` before its first write
+    /// in the step.
+    #[inline(always)]
+    fn record(&mut self, index: u32, old: Rgba) {
         let Some(list) = self.list.as_deref_mut() else {
             return;
         };
@@ -331,21 +353,9 @@ impl SampleLog<'_> {
             return;
         }
         *bits |= bit;
-        let sample = match self.element {
-            LogElement::Vertices => SampleRef::Vertex(index),
-            LogElement::Edge(edge) => SampleRef::Edge { edge, offset: index },
-            LogElement::Interior(face) => SampleRef::Interior { face, offset: index },
-            LogElement::Off => return,
-        };
-        list.push((sample, old));
-    }
-
-    /// Whether writes are being recorded (a step is open).
-    pub fn is_recording(&self) -> bool {
-        self.list.is_some()
+        list.push((self.element.sample(index), old));
     }
 }
-
 /// The open step's current block of sample writes (started after the last resolution
 /// change), or `None` without an open step.
 fn current_samples(open: &mut Option<Step>) -> Option<&mut Vec<(SampleRef, Rgba)>> {
@@ -526,97 +536,65 @@ impl UndoHistory {
         }
     }
 
-    /// The log for vertex colours (index = vertex id).
-    pub fn vertex_log(&mut self) -> SampleLog<'_> {
-        match current_samples(&mut self.open) {
-            Some(list) => {
-                SampleLog { element: LogElement::Vertices, bits: &mut self.seen.vertex_bits, list: Some(list) }
+    /// The log of `element`, which currently has `sample_count` samples (ignored for
+    /// vertices).
+    fn element_log(&mut self, element: Element, sample_count: usize) -> SampleLog<'_> {
+        let (is_edge, id) = match element {
+            Element::Vertices => {
+                return match current_samples(&mut self.open) {
+                    Some(list) => SampleLog { element, bits: &mut self.seen.vertex_bits, list: Some(list) },
+                    None => SampleLog::off(element),
+                };
             }
-            None => SampleLog::off(),
-        }
-    }
-
-    /// The log for the samples of `edge`, which currently has `sample_count` samples.
-    pub fn edge_log(&mut self, edge: u32, sample_count: usize) -> SampleLog<'_> {
-        self.element_log(true, edge, sample_count)
-    }
-
-    /// The log for the interior samples of `face`, which currently has `sample_count` samples.
-    pub fn interior_log(&mut self, face: u32, sample_count: usize) -> SampleLog<'_> {
-        self.element_log(false, face, sample_count)
-    }
-
-    fn element_log(&mut self, is_edge: bool, id: u32, sample_count: usize) -> SampleLog<'_> {
+            Element::Edge(edge) => (true, edge),
+            Element::Interior(face) => (false, face),
+        };
         let table_len = if is_edge { self.seen.edge_slot.len() } else { self.seen.face_slot.len() };
         if self.open.is_none() || id as usize >= table_len {
-            return SampleLog::off();
+            return SampleLog::off(element);
         }
         let slot = self.seen.slot(is_edge, id, sample_count);
-        let element = if is_edge { LogElement::Edge(id) } else { LogElement::Interior(id) };
         match current_samples(&mut self.open) {
             Some(list) => SampleLog { element, bits: &mut self.seen.slots[slot], list: Some(list) },
-            None => SampleLog::off(),
+            None => SampleLog::off(element),
         }
     }
 
-    /// Records one sample's colour before its first write in the open step (no-op without
-    /// an open step). Convenient for occasional writes; the brush uses the element logs.
-    pub fn record_sample(&mut self, store: &ColorStore, sample: SampleRef, old: Rgba) {
-        match sample {
-            SampleRef::Vertex(v) => self.vertex_log().record(v, old),
-            SampleRef::Edge { edge, offset } => {
-                let count = store.edge_samples(edge).len();
-                self.edge_log(edge, count).record(offset, old);
-            }
-            SampleRef::Interior { face, offset } => {
-                let count = store.interior_samples(face).len();
-                self.interior_log(face, count).record(offset, old);
-            }
+    /// Records the state of `face` and its edges before a resolution change in the open step
+    /// (no-op without one).
+    fn record_resolution_change(&mut self, store: &ColorStore, face: u32) -> Result<(), UndoError> {
+        if self.open.is_none() {
+            return Ok(());
         }
+        let state = FaceState::capture(store, face)?;
+        // Offsets recorded from now on refer to the new sizes.
+        self.seen.forget(false, face);
+        for (edge, _, _) in &state.edges {
+            self.seen.forget(true, *edge);
+        }
+        if let Some(step) = self.open.as_mut() {
+            step.changes.push(Change::Resolution(Box::new(state)));
+        }
+        Ok(())
     }
 
-    /// Writes `color` to `sample`, recording the old colour in the open step. Returns
-    /// whether the sample exists.
+    /// Writes `color` to `sample` through a [`StoreWriter`] (recording the old colour in the
+    /// open step). Returns whether the sample exists.
     pub fn set_sample(&mut self, store: &mut ColorStore, sample: SampleRef, color: Rgba) -> bool {
-        let Some(old) = store.get(sample) else {
-            return false;
-        };
-        if old.map(f32::to_bits) != color.map(f32::to_bits) {
-            self.record_sample(store, sample, old);
-            store.set(sample, color);
-        }
-        true
+        let exists = store.get(sample).is_some();
+        StoreWriter::new(store, self).set(sample, color);
+        exists
     }
 
-    /// Changes the resolution of `face` (resampling as the store defines), recording the
-    /// face's old resolution and the old samples of the face and its three edges in the open
-    /// step. Returns whether the resolution changed. Without an open step, nothing is
-    /// recorded.
+    /// Changes the resolution of `face` through a [`StoreWriter`] (see
+    /// [`StoreWriter::set_face_resolution`]). Returns whether the resolution changed.
     pub fn set_face_resolution(
         &mut self,
         store: &mut ColorStore,
         face: u32,
         resolution: Resolution,
     ) -> Result<bool, UndoError> {
-        let Some(current) = store.face_resolution(face) else {
-            return Err(StoreError::NoSuchFace { face, face_count: store.topology().face_count() }.into());
-        };
-        if current == resolution {
-            return Ok(false);
-        }
-        if self.open.is_some() {
-            let state = FaceState::capture(store, face)?;
-            // Offsets recorded from now on refer to the new sizes.
-            self.seen.forget(false, face);
-            for (edge, _, _) in &state.edges {
-                self.seen.forget(true, *edge);
-            }
-            if let Some(step) = self.open.as_mut() {
-                step.changes.push(Change::Resolution(Box::new(state)));
-            }
-        }
-        store.set_face_resolution(face, resolution)?;
-        Ok(true)
+        StoreWriter::new(store, self).set_face_resolution(face, resolution)
     }
 
     /// Undoes the newest step. Returns `false` when there is nothing to undo.
@@ -662,5 +640,105 @@ impl UndoHistory {
                 Err(error)
             }
         }
+    }
+}
+
+/// Whether two colours differ in any bit (one 128-bit comparison).
+#[inline(always)]
+fn differs(a: Rgba, b: Rgba) -> bool {
+    bytemuck::cast::<Rgba, u128>(a) != bytemuck::cast::<Rgba, u128>(b)
+}
+
+/// The one way tools change a store: every write records the old value in the history's
+/// open step (when one is open) and goes through the store's own setters, which mark the
+/// element dirty for the GPU upload. Borrow one for the duration of a dab, a fill, …
+#[derive(Debug)]
+pub struct StoreWriter<'a> {
+    store: &'a mut ColorStore,
+    history: &'a mut UndoHistory,
+}
+
+impl<'a> StoreWriter<'a> {
+    /// A writer of `store` recording into `history`.
+    pub fn new(store: &'a mut ColorStore, history: &'a mut UndoHistory) -> Self {
+        StoreWriter { store, history }
+    }
+
+    /// The store, to read.
+    #[inline(always)]
+    pub fn store(&self) -> &ColorStore {
+        self.store
+    }
+
+    /// Writes `color` to `sample`, recording the old colour first. Returns whether the
+    /// colour changed (`false` when it is bit-identical or the sample does not exist).
+    pub fn set(&mut self, sample: SampleRef, color: Rgba) -> bool {
+        let (element, index) = match sample {
+            SampleRef::Vertex(v) => (Element::Vertices, v),
+            SampleRef::Edge { edge, offset } => (Element::Edge(edge), offset),
+            SampleRef::Interior { face, offset } => (Element::Interior(face), offset),
+        };
+        let mut out = self.element(element);
+        out.get(index).is_some_and(|old| out.write(index, old, color))
+    }
+
+    /// The writer of one element's samples: the fast path for many writes to one element
+    /// (one slot look-up, then a bit test per write).
+    #[inline]
+    pub fn element(&mut self, element: Element) -> ElementWriter<'_> {
+        let count = match element {
+            Element::Vertices => 0,
+            Element::Edge(edge) => self.store.edge_samples(edge).len(),
+            Element::Interior(face) => self.store.interior_samples(face).len(),
+        };
+        ElementWriter { store: self.store, log: self.history.element_log(element, count) }
+    }
+
+    /// Changes the resolution of `face` (resampling as [`ColorStore::set_face_resolution`]
+    /// defines), recording the face's old resolution and the old samples of the face and its
+    /// three edges in the open step. Returns whether the resolution changed.
+    pub fn set_face_resolution(&mut self, face: u32, resolution: Resolution) -> Result<bool, UndoError> {
+        let Some(current) = self.store.face_resolution(face) else {
+            return Err(StoreError::NoSuchFace { face, face_count: self.store.topology().face_count() }.into());
+        };
+        if current == resolution {
+            return Ok(false);
+        }
+        self.history.record_resolution_change(self.store, face)?;
+        self.store.set_face_resolution(face, resolution)?;
+        Ok(true)
+    }
+}
+
+/// Writes the samples of one [`Element`], from [`StoreWriter::element`].
+#[derive(Debug)]
+pub struct ElementWriter<'w> {
+    store: &'w mut ColorStore,
+    log: SampleLog<'w>,
+}
+
+impl ElementWriter<'_> {
+    /// The store, to read.
+    #[inline(always)]
+    pub fn store(&self) -> &ColorStore {
+        self.store
+    }
+
+    /// The colour of sample `index` of the element.
+    #[inline(always)]
+    pub fn get(&self, index: u32) -> Option<Rgba> {
+        self.store.get(self.log.element.sample(index))
+    }
+
+    /// Writes `new` to sample `index`, whose colour is `old` (as [`ElementWriter::get`] returned
+    /// it), recording `old` on the first write in the step. Returns whether the colour changed
+    /// (nothing is written or recorded when `new` is bit-identical to `old`).
+    #[inline(always)]
+    pub fn write(&mut self, index: u32, old: Rgba, new: Rgba) -> bool {
+        if !differs(new, old) {
+            return false;
+        }
+        self.log.record(index, old);
+        self.store.set(self.log.element.sample(index), new)
     }
 }

@@ -1,0 +1,181 @@
+//! Where a dab reaches and how strongly: the [`Coverage`] of a lattice row, the brush
+//! spheres of one dab ([`Footprint`]), [`Everywhere`] (fill) and the occlusion test.
+
+use glam::DVec3;
+
+use crate::paint::picking::MeshBvh;
+
+use super::settings::Falloff;
+
+/// Occlusion tolerance: a hit counts as hiding a sample only if it is nearer than
+/// `distance · (1 − OCCLUSION_TOLERANCE)` (the sample's own face is hit at the distance).
+pub const OCCLUSION_TOLERANCE: f64 = 1e-6;
+
+/// Where the brush reaches and how strongly: the weight of a point and, for a lattice row
+/// `a + b·k`, the range of `k` that can have a positive weight.
+pub(super) trait Coverage {
+    /// The inclusive range of `k` in `lo..=hi` where `a + b·k` may be covered (a superset:
+    /// [`Coverage::weight`] decides).
+    fn row_range(&self, a: DVec3, b: DVec3, lo: u32, hi: u32, mask: u8) -> Option<(u32, u32)>;
+    /// Weight at `p` for the spheres in `mask`.
+    fn weight(&self, p: DVec3, mask: u8) -> f32;
+    /// Whether every point of the segment or triangle with these corners is inside a sphere
+    /// in `mask` (its rows then need no [`Coverage::row_range`]).
+    fn covers(&self, corners: &[DVec3], mask: u8) -> bool;
+}
+
+/// The brush spheres of one dab (one, or two with mirror).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Footprint<'a> {
+    pub(super) centers: [DVec3; 2],
+    pub(super) eyes: [DVec3; 2],
+    count: usize,
+    radius_sq: f64,
+    inv_radius: f64,
+    strength: f32,
+    falloff: Falloff,
+    occlusion: Option<&'a MeshBvh>,
+}
+
+impl<'a> Footprint<'a> {
+    /// The footprint of spheres at `centers[..count]` seen from `eyes[..count]`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn new(
+        centers: [DVec3; 2],
+        eyes: [DVec3; 2],
+        count: usize,
+        radius: f64,
+        strength: f32,
+        falloff: Falloff,
+        occlusion: Option<&'a MeshBvh>,
+    ) -> Self {
+        Footprint {
+            centers,
+            eyes,
+            count: count.clamp(1, 2),
+            radius_sq: radius * radius,
+            inv_radius: 1.0 / radius,
+            strength,
+            falloff,
+            occlusion,
+        }
+    }
+
+    /// The weight for one sphere and no occlusion: the common case, kept small to inline.
+    #[inline(always)]
+    fn weight_single(&self, p: DVec3) -> f32 {
+        let d2 = (p - self.centers[0]).length_squared();
+        if d2.is_nan() || d2 > self.radius_sq {
+            return 0.0;
+        }
+        self.strength * self.falloff.weight_of_squared((d2 * self.inv_radius * self.inv_radius) as f32)
+    }
+
+    /// [`Coverage::weight`] with mirror or occlusion.
+    #[inline(never)]
+    fn weight_general(&self, p: DVec3, mask: u8) -> f32 {
+        let mut best = 0.0f32;
+        for k in 0..self.count {
+            if mask & (1 << k) == 0 {
+                continue;
+            }
+            let d2 = (p - self.centers[k]).length_squared();
+            if d2.is_nan() || d2 > self.radius_sq {
+                continue;
+            }
+            let w = self.strength * self.falloff.weight_of_squared((d2 * self.inv_radius * self.inv_radius) as f32);
+            if w <= best {
+                continue;
+            }
+            if let Some(bvh) = self.occlusion
+                && !visible(bvh, self.eyes[k], p)
+            {
+                continue;
+            }
+            best = w;
+        }
+        best
+    }
+}
+
+impl Coverage for Footprint<'_> {
+    #[inline]
+    fn row_range(&self, a: DVec3, b: DVec3, lo: u32, hi: u32, mask: u8) -> Option<(u32, u32)> {
+        if lo > hi {
+            return None;
+        }
+        let bb = b.length_squared();
+        let mut range: Option<(f64, f64)> = None;
+        for k in 0..self.count {
+            if mask & (1 << k) == 0 {
+                continue;
+            }
+            let d = a - self.centers[k];
+            let db = d.dot(b);
+            let excess = d.length_squared() - self.radius_sq;
+            let (k0, k1) = if bb > 0.0 {
+                let disc = db * db - bb * excess;
+                if disc.is_nan() || disc < 0.0 {
+                    continue;
+                }
+                let root = disc.sqrt();
+                ((-db - root) / bb, (-db + root) / bb)
+            } else if excess <= 0.0 {
+                (f64::from(lo), f64::from(hi))
+            } else {
+                continue;
+            };
+            range = Some(range.map_or((k0, k1), |(r0, r1)| (r0.min(k0), r1.max(k1))));
+        }
+        let (k0, k1) = range?;
+        let start = k0.floor().max(f64::from(lo));
+        let end = k1.ceil().min(f64::from(hi));
+        if start.is_nan() || end.is_nan() || start > end {
+            return None;
+        }
+        Some((start as u32, end as u32))
+    }
+
+    #[inline(always)]
+    fn weight(&self, p: DVec3, mask: u8) -> f32 {
+        if self.count == 1 && self.occlusion.is_none() {
+            return if mask & 1 != 0 { self.weight_single(p) } else { 0.0 };
+        }
+        self.weight_general(p, mask)
+    }
+
+    #[inline]
+    fn covers(&self, corners: &[DVec3], mask: u8) -> bool {
+        (0..self.count).any(|k| {
+            mask & (1 << k) != 0 && corners.iter().all(|&c| (c - self.centers[k]).length_squared() <= self.radius_sq)
+        })
+    }
+}
+
+/// Everything, with one weight (fill).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Everywhere(pub(super) f32);
+
+impl Coverage for Everywhere {
+    fn row_range(&self, _: DVec3, _: DVec3, lo: u32, hi: u32, _: u8) -> Option<(u32, u32)> {
+        (lo <= hi).then_some((lo, hi))
+    }
+
+    fn weight(&self, _: DVec3, _: u8) -> f32 {
+        self.0
+    }
+
+    fn covers(&self, _: &[DVec3], _: u8) -> bool {
+        true
+    }
+}
+
+/// Whether nothing lies on the segment from `eye` to `point` (except near `point` itself).
+pub fn visible(bvh: &MeshBvh, eye: DVec3, point: DVec3) -> bool {
+    let to = point - eye;
+    let distance = to.length();
+    if distance.is_nan() || distance <= 0.0 {
+        return true;
+    }
+    bvh.cast(eye, to / distance, distance * (1.0 - OCCLUSION_TOLERANCE)).is_none()
+}

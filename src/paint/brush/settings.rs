@@ -1,0 +1,252 @@
+//! Brush settings: the tool, falloff, blend mode, radius and resolution operation of a
+//! stroke, and their validation.
+
+use crate::colors::format::Rgba;
+use crate::colors::layout::Resolution;
+
+use super::error::BrushError;
+
+/// How the brush weight falls off from the centre (`x = d / radius` in `[0, 1]`, `s = 1 − x`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Falloff {
+    /// `s²(3 − 2s)`: smoothstep, flat at the centre and at the rim.
+    #[default]
+    Smooth,
+    /// `s`.
+    Linear,
+    /// `1` everywhere inside.
+    Constant,
+    /// `s²`: a pointed centre.
+    Sharp,
+}
+
+impl Falloff {
+    /// Every falloff.
+    pub const ALL: [Falloff; 4] = [Falloff::Smooth, Falloff::Linear, Falloff::Constant, Falloff::Sharp];
+
+    /// The weight at `distance_fraction = d / radius`: in `[0, 1]`, and 0 outside the brush
+    /// (`> 1`, or NaN).
+    #[inline]
+    pub fn weight(self, distance_fraction: f32) -> f32 {
+        if distance_fraction.is_nan() || distance_fraction > 1.0 {
+            return 0.0;
+        }
+        let s = 1.0 - distance_fraction.max(0.0);
+        match self {
+            Falloff::Smooth => s * s * (3.0 - 2.0 * s),
+            Falloff::Linear => s,
+            Falloff::Constant => 1.0,
+            Falloff::Sharp => s * s,
+        }
+    }
+
+    /// [`Falloff::weight`] of `sqrt(distance_fraction_sq)` (the square root taken in `f32`,
+    /// and not at all for [`Falloff::Constant`]).
+    #[inline]
+    pub fn weight_of_squared(self, distance_fraction_sq: f32) -> f32 {
+        if distance_fraction_sq.is_nan() || distance_fraction_sq > 1.0 {
+            return 0.0;
+        }
+        if self == Falloff::Constant {
+            return 1.0;
+        }
+        self.weight(distance_fraction_sq.max(0.0).sqrt())
+    }
+
+    /// The command-line name (`smooth`, `linear`, `constant`, `sharp`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Falloff::Smooth => "smooth",
+            Falloff::Linear => "linear",
+            Falloff::Constant => "constant",
+            Falloff::Sharp => "sharp",
+        }
+    }
+
+    /// Parses a name given by [`Falloff::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|f| f.name() == name)
+    }
+}
+
+/// How a painted colour combines with the sample's colour (linear light).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum BlendMode {
+    /// Towards the brush colour (alpha included).
+    #[default]
+    Mix,
+    /// Adds the brush colour to RGB (alpha kept).
+    Add,
+    /// Multiplies RGB by the brush colour (alpha kept).
+    Multiply,
+    /// Towards the base snapshot (the colours when painting started).
+    EraseToBase,
+}
+
+impl BlendMode {
+    /// Every mode.
+    pub const ALL: [BlendMode; 4] = [BlendMode::Mix, BlendMode::Add, BlendMode::Multiply, BlendMode::EraseToBase];
+
+    /// The command-line name (`mix`, `add`, `multiply`, `erase`).
+    pub fn name(self) -> &'static str {
+        match self {
+            BlendMode::Mix => "mix",
+            BlendMode::Add => "add",
+            BlendMode::Multiply => "multiply",
+            BlendMode::EraseToBase => "erase",
+        }
+    }
+
+    /// Parses a name given by [`BlendMode::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// `old · (1 − w) + target · w` with this mode's target; `base` is the base colour of
+    /// the sample (used by [`BlendMode::EraseToBase`] only).
+    #[inline]
+    pub fn blend(self, old: Rgba, color: Rgba, base: Rgba, weight: f32) -> Rgba {
+        let target = match self {
+            BlendMode::Mix => color,
+            BlendMode::Add => [old[0] + color[0], old[1] + color[1], old[2] + color[2], old[3]],
+            BlendMode::Multiply => [old[0] * color[0], old[1] * color[1], old[2] * color[2], old[3]],
+            BlendMode::EraseToBase => base,
+        };
+        let keep = 1.0 - weight;
+        [
+            old[0] * keep + target[0] * weight,
+            old[1] * keep + target[1] * weight,
+            old[2] * keep + target[2] * weight,
+            old[3] * keep + target[3] * weight,
+        ]
+    }
+}
+
+/// The brush size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BrushRadius {
+    /// A radius on screen, converted to world units at each dab's hit depth.
+    Pixels {
+        /// Radius, pixels.
+        radius_px: f64,
+    },
+    /// A radius in world units.
+    World {
+        /// Radius, world units.
+        radius_world: f64,
+    },
+}
+
+impl Default for BrushRadius {
+    fn default() -> Self {
+        BrushRadius::Pixels { radius_px: 30.0 }
+    }
+}
+
+/// What the resolution brush does to each face it touches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ResolutionOp {
+    /// Doubles `R` (up to the maximum).
+    Raise,
+    /// Halves `R` (down to 1).
+    Lower,
+    /// Sets `R`.
+    Set(Resolution),
+}
+
+impl ResolutionOp {
+    /// The new resolution of a face at `current`, or `None` when it stays.
+    pub fn apply(self, current: Resolution) -> Option<Resolution> {
+        let next = match self {
+            ResolutionOp::Raise => current.doubled()?,
+            ResolutionOp::Lower => current.halved()?,
+            ResolutionOp::Set(r) => r,
+        };
+        (next != current).then_some(next)
+    }
+}
+
+/// The active tool of a stroke.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Tool {
+    /// Paint colour with a blend mode.
+    #[default]
+    Paint,
+    /// Blur: samples move towards the mean of their lattice neighbours.
+    Blur,
+    /// Change face resolutions.
+    Resolution(ResolutionOp),
+}
+
+/// Brush settings. A stroke uses the settings it began with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BrushSettings {
+    /// The tool.
+    pub tool: Tool,
+    /// Paint colour, linear light, straight alpha.
+    pub color: Rgba,
+    /// Blend mode of the paint tool.
+    pub blend: BlendMode,
+    /// Brush radius.
+    pub radius: BrushRadius,
+    /// Weight at the centre, `0..=1`.
+    pub strength: f32,
+    /// Falloff curve.
+    pub falloff: Falloff,
+    /// Distance between dabs along a stroke, percent of the radius (`> 0`).
+    pub spacing_percent: f64,
+    /// Paint only samples visible from the eye.
+    pub occlusion: bool,
+    /// Paint only samples on faces facing the eye.
+    pub backface_culling: bool,
+    /// Also paint mirrored across the plane `x =` centre of the mesh bounds.
+    pub mirror_x: bool,
+}
+
+impl Default for BrushSettings {
+    fn default() -> Self {
+        BrushSettings {
+            tool: Tool::Paint,
+            color: [1.0, 0.0, 0.0, 1.0],
+            blend: BlendMode::Mix,
+            radius: BrushRadius::default(),
+            strength: 1.0,
+            falloff: Falloff::Smooth,
+            spacing_percent: 10.0,
+            occlusion: true,
+            backface_culling: true,
+            mirror_x: false,
+        }
+    }
+}
+
+impl BrushSettings {
+    /// Checks every value is in range.
+    pub fn validate(&self) -> Result<(), BrushError> {
+        let bad = |message: String| Err(BrushError::InvalidSetting(message));
+        if !(0.0..=1.0).contains(&self.strength) {
+            return bad(format!("strength {} is not in 0..=1", self.strength));
+        }
+        if !(self.spacing_percent.is_finite() && self.spacing_percent > 0.0) {
+            return bad(format!("spacing {} % is not a positive number", self.spacing_percent));
+        }
+        match self.radius {
+            BrushRadius::Pixels { radius_px } if !(radius_px.is_finite() && radius_px > 0.0) => {
+                bad(format!("radius {radius_px} px is not a positive number"))
+            }
+            BrushRadius::World { radius_world } if !(radius_world.is_finite() && radius_world > 0.0) => {
+                bad(format!("radius {radius_world} is not a positive number"))
+            }
+            _ if !self.color.iter().all(|c| c.is_finite()) => bad("the colour is not finite".into()),
+            _ => Ok(()),
+        }
+    }
+
+    pub(super) fn label(&self) -> &'static str {
+        match self.tool {
+            Tool::Paint => "paint stroke",
+            Tool::Blur => "blur stroke",
+            Tool::Resolution(_) => "resolution stroke",
+        }
+    }
+}
