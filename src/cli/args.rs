@@ -113,6 +113,10 @@ impl OutputArgs {
     }
 }
 
+/// The log target of the command line's warnings: the binary's root, as when they were
+/// logged from `main.rs` (keeps the `[WARN  meshpaint]` prefix and `RUST_LOG` filters).
+pub(super) const LOG_TARGET: &str = "meshpaint";
+
 /// `--format` values.
 pub(super) fn parse_format(name: &str) -> Result<ColorFormat, String> {
     ColorFormat::from_name(name).ok_or_else(|| format!("unknown format '{name}' (rgba8, rgba16f, rgba32f)"))
@@ -132,7 +136,7 @@ pub(super) fn open(path: &Path, resolution: ResolutionArg) -> Result<Document> {
     let resolution = resolution.get()?;
     let document = Document::open(path, resolution)?;
     for warning in &document.warnings {
-        log::warn!("{}: {warning}", path.display());
+        log::warn!(target: LOG_TARGET, "{}: {warning}", path.display());
     }
     Ok(document)
 }

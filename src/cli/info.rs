@@ -9,7 +9,7 @@ use meshpaint::colors::stats::MeshStats;
 use meshpaint::io::document::SourceKind;
 use meshpaint::packing::file as packed_file;
 
-use super::args::{ResolutionArg, open};
+use super::args::{LOG_TARGET, ResolutionArg, open};
 
 /// Arguments of `meshpaint info`.
 #[derive(Debug, clap::Args)]
@@ -63,7 +63,7 @@ fn gltf_info(path: &Path, resolution: ResolutionArg, json: bool) -> Result<()> {
     let resolution = resolution.get()?;
     let scene = meshpaint::mesh::import::import_gltf(path)?;
     for warning in &scene.warnings {
-        log::warn!("{}: {warning}", path.display());
+        log::warn!(target: LOG_TARGET, "{}: {warning}", path.display());
     }
     let mesh = meshpaint::mesh::weld::weld_scene(&scene);
     let topology = meshpaint::mesh::topology::Topology::build(mesh.positions_world.len() as u32, &mesh.triangles)

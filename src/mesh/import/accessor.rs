@@ -249,7 +249,7 @@ impl Importer<'_, '_> {
                 .and_then(|v| v.checked_add(element_size as u64))
                 .and_then(|v| v.checked_add(offset))
         };
-        if !needed.is_some_and(|n| n <= bytes.len() as u64) {
+        if needed.is_none_or(|n| n > bytes.len() as u64) {
             return invalid(format!(
                 "{what}: {count} elements at offset {offset} with stride {stride} lie outside bufferView {view_index} ({} bytes): data out of bounds",
                 bytes.len()
