@@ -1,0 +1,104 @@
+//! `meshpaint bench pack | render | paint`: measurements printed as JSON.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Subcommand;
+
+use meshpaint::colors::format::ColorFormat;
+
+use super::args::{ResolutionArg, ResolutionArg16, open, parse_format};
+
+#[derive(Debug, Subcommand)]
+pub(super) enum BenchCommand {
+    /// Repack (store → face records + colour buffer with MIP chains) vs memcpy of the same bytes.
+    Pack {
+        /// A .glb / .gltf file or a packed file.
+        file: PathBuf,
+        #[command(flatten)]
+        resolution: ResolutionArg16,
+        /// Colour formats to measure (default: all three).
+        #[arg(long, value_parser = parse_format)]
+        format: Vec<ColorFormat>,
+        /// Repetitions per measurement (the best and the median are reported).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+    },
+    /// Frame time of the UV baseline and each mesh-colors filter mode (interleaved), GPU memory.
+    Render {
+        /// A .glb / .gltf file or a packed file.
+        file: PathBuf,
+        #[command(flatten)]
+        resolution: ResolutionArg,
+        /// Image width.
+        #[arg(long, default_value_t = 1280)]
+        width: u32,
+        /// Image height.
+        #[arg(long, default_value_t = 720)]
+        height: u32,
+        /// Frames per mode.
+        #[arg(long, default_value_t = 20)]
+        frames: usize,
+    },
+    /// Picking and painting: BVH presets, pick latency, dab time and samples/s for brushes
+    /// covering ~1k / 10k / 100k samples, upload bytes per dab, repack time.
+    Paint {
+        /// A .glb / .gltf file or a packed file (default: the Bunny).
+        #[arg(default_value = "assets/models/Bunny144k/bunny.glb")]
+        file: PathBuf,
+        #[command(flatten)]
+        resolution: ResolutionArg,
+        /// Timed dabs per brush size.
+        #[arg(long, default_value_t = 30)]
+        dabs: usize,
+        /// Print compact JSON (default: indented JSON).
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+pub(super) fn run(what: BenchCommand) -> Result<()> {
+    match what {
+        BenchCommand::Pack { file, resolution, format, runs } => {
+            let document = open(&file, resolution.into())?;
+            let formats = if format.is_empty() { ColorFormat::ALL.to_vec() } else { format };
+            let mut results = Vec::new();
+            for format in formats {
+                let result = meshpaint::bench::pack::bench_pack(&document, format, runs)?;
+                results.push(result.to_json());
+            }
+            let report = serde_json::json!({
+                "bench": "pack",
+                "file": file.display().to_string(),
+                "triangles": document.store.topology().face_count(),
+                "resolution": resolution.resolution,
+                "threads": 1,
+                "results": results,
+            });
+            println!("{report}");
+            Ok(())
+        }
+        BenchCommand::Paint { file, resolution, dabs, json } => {
+            let document = open(&file, resolution)?;
+            let options = meshpaint::bench::PaintBenchOptions { dabs, ..Default::default() };
+            let mut report = meshpaint::bench::bench_paint(&document, &options)?;
+            report["file"] = file.display().to_string().into();
+            report["resolution"] = resolution.resolution.into();
+            if json {
+                println!("{report}");
+            } else {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            }
+            Ok(())
+        }
+        BenchCommand::Render { file, resolution, width, height, frames } => {
+            let document = open(&file, resolution)?;
+            let result = meshpaint::bench::bench_render(&file, &document, width, height, frames)?;
+            let mut report = result.to_json();
+            report["file"] = file.display().to_string().into();
+            report["resolution"] = resolution.resolution.into();
+            println!("{report}");
+            Ok(())
+        }
+    }
+}

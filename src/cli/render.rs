@@ -1,0 +1,129 @@
+//! `meshpaint render`: a headless GPU render written as a PNG.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+
+use meshpaint::camera::default_camera;
+use meshpaint::io::document::{Source, open_for_display};
+use meshpaint::render::{DrawItem, FilterMode, Gpu, Overlays, RenderSettings, Shading};
+
+use super::args::{CameraArgs, LOG_TARGET, ResolutionArg};
+
+/// Arguments of `meshpaint render`.
+#[derive(Debug, clap::Args)]
+pub(super) struct RenderArgs {
+    /// A .glb / .gltf file or a packed file.
+    file: PathBuf,
+    /// Output PNG.
+    #[arg(long, short = 'o')]
+    output: PathBuf,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 1024)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 768)]
+    height: u32,
+    /// Filter: nearest, linear, mip (linear at --level) or trilinear (automatic level).
+    #[arg(long, value_enum, default_value_t = RenderFilter::Trilinear)]
+    filter: RenderFilter,
+    /// MIP level for --filter mip (also selects a level for nearest or linear).
+    #[arg(long)]
+    level: Option<u32>,
+    #[command(flatten)]
+    resolution: ResolutionArg,
+    /// Shading: unlit (the exact colour) or lit (Lambert + ambient).
+    #[arg(long, value_enum, default_value_t = RenderShading::Lit)]
+    shading: RenderShading,
+    #[command(flatten)]
+    camera: CameraArgs,
+    /// Overlay triangle edges.
+    #[arg(long)]
+    wireframe: bool,
+    /// Show per-face resolution as a heat map instead of the colours.
+    #[arg(long)]
+    heatmap: bool,
+    /// Draw the glTF UVs and base-colour texture (the baseline) instead of mesh colors.
+    #[arg(long)]
+    baseline_uv: bool,
+}
+
+/// `--filter` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum RenderFilter {
+    Nearest,
+    Linear,
+    Mip,
+    Trilinear,
+}
+
+/// `--shading` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum RenderShading {
+    Unlit,
+    Lit,
+}
+
+/// The filter mode `--filter` and `--level` select.
+fn filter_mode(filter: RenderFilter, level: Option<u32>) -> Result<FilterMode> {
+    Ok(match (filter, level) {
+        (RenderFilter::Nearest, None) => FilterMode::Nearest,
+        (RenderFilter::Nearest, Some(level)) => FilterMode::NearestMipLevel(level),
+        (RenderFilter::Linear, None) => FilterMode::Linear,
+        (RenderFilter::Linear | RenderFilter::Mip, Some(level)) => FilterMode::MipLevel(level),
+        (RenderFilter::Mip, None) => anyhow::bail!("--filter mip needs --level N"),
+        (RenderFilter::Trilinear, None) => FilterMode::Trilinear,
+        (RenderFilter::Trilinear, Some(_)) => anyhow::bail!("--level does not apply to --filter trilinear"),
+    })
+}
+
+pub(super) fn run(args: RenderArgs) -> Result<()> {
+    let filter = filter_mode(args.filter, args.level)?;
+    args.camera.check()?;
+    let CameraArgs { yaw, pitch, distance } = args.camera;
+    let settings = |bounds| {
+        let mut settings = RenderSettings::new(default_camera(bounds, yaw, pitch, distance));
+        settings.filter = filter;
+        settings.shading = match args.shading {
+            RenderShading::Unlit => Shading::Unlit,
+            RenderShading::Lit => Shading::Lit,
+        };
+        settings.overlays = Overlays { wireframe: args.wireframe, heatmap: args.heatmap };
+        settings
+    };
+    let started = std::time::Instant::now();
+    let gpu = Gpu::new_headless()?;
+    let (image, triangles, samples) = if args.baseline_uv {
+        let scene = meshpaint::mesh::import::import_gltf(&args.file)?;
+        let mesh = gpu.upload_baseline(&scene)?.with_context(|| {
+            format!(
+                "{}: --baseline-uv needs a glTF file with a base-colour texture, and no material has one",
+                args.file.display()
+            )
+        })?;
+        let image = gpu.render_image(DrawItem::Baseline(&mesh), &settings(mesh.bounds), args.width, args.height)?;
+        (image, mesh.vertex_count / 3, 0)
+    } else {
+        let source = Source::File(args.file.clone());
+        let displayed = open_for_display(&source, args.resolution.get()?, &mut |_, _| {})?;
+        for warning in &displayed.document.warnings {
+            log::warn!(target: LOG_TARGET, "{}: {warning}", args.file.display());
+        }
+        let mesh = gpu.upload(&displayed.packed)?;
+        let image = gpu.render_image(DrawItem::MeshColors(&mesh), &settings(mesh.bounds), args.width, args.height)?;
+        (image, mesh.face_count, mesh.atlas.samples)
+    };
+    image.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
+    eprintln!(
+        "{} → {}: {}×{}, {} triangles, {} samples, {} ({:.2} s)",
+        args.file.display(),
+        args.output.display(),
+        args.width,
+        args.height,
+        triangles,
+        samples,
+        gpu.describe(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
