@@ -31,9 +31,19 @@ pub enum Filter {
 pub trait MeshColorSource {
     /// Resolution of `face` (level 0), or `None` for a face that does not exist.
     fn face_resolution(&self, face: u32) -> Option<Resolution>;
-    /// The colour at lattice point `(i, j)` of `face` at `level` (whose resolution is
-    /// `R_f >> level`); `None` when the point, face or level is not available.
+    /// The colour at lattice point `(i, j)` of `face` at the requested level `level`: the
+    /// face's lattice is that of its own level `min(level, log2 R_f)` (resolution
+    /// `R_f >> min(level, log2 R_f)`), its corners are the vertex colours at
+    /// `min(level, last vertex level)` (see the module docs: every shared element is read
+    /// at a level that does not depend on the face reading it); `None` when the point,
+    /// face or level is not available.
     fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba>;
+    /// Resolution `R_e` (level 0) of face edge `k` of `face`.
+    fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution>;
+    /// The edge's own sample at position `p` (`1..r_e`, counted from the face edge's start
+    /// corner) of face edge `k` at the edge's level `min(level, log2 R_e)`, whose
+    /// resolution is `r_e = R_e >> min(level, log2 R_e)`.
+    fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba>;
 }
 
 impl MeshColorSource for ColorStore {
@@ -42,10 +52,27 @@ impl MeshColorSource for ColorStore {
     }
 
     fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
-        if level != 0 {
+        // The store holds level 0 only: a face whose own level is 0 (level 0, or R_f = 1)
+        // reads it, vertices included.
+        if level.min(ColorStore::face_resolution(self, face)?.log2()) != 0 {
             return None;
         }
         self.face_sample(face, i, j)
+    }
+
+    fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution> {
+        let edge = *self.topology().face_edges.get(face as usize)?.get(usize::from(k))?;
+        ColorStore::edge_resolution(self, edge)
+    }
+
+    fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba> {
+        let edge = *self.topology().face_edges.get(face as usize)?.get(usize::from(k))?;
+        let r_edge = ColorStore::edge_resolution(self, edge)?;
+        if level.min(r_edge.log2()) != 0 || p == 0 || p >= r_edge.get() {
+            return None;
+        }
+        let reversed = self.topology().is_reversed(face, usize::from(k));
+        self.edge_samples(edge).get(layout::edge_storage_offset(r_edge, p, reversed) as usize).copied()
     }
 }
 
@@ -71,6 +98,14 @@ impl MeshColorSource for StoreMips {
     fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
         self.chains.lattice_color(face, level, i, j)
     }
+
+    fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution> {
+        self.chains.edge_resolution(face, k)
+    }
+
+    fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba> {
+        self.chains.edge_color(face, k, level, p)
+    }
 }
 
 impl MeshColorSource for PackedMesh {
@@ -81,21 +116,31 @@ impl MeshColorSource for PackedMesh {
     fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
         self.color(packed_sample_index(self, face, level, i, j)?)
     }
+
+    fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution> {
+        Some(self.face_records.get(face as usize)?.edge(usize::from(k))?.1)
+    }
+
+    fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba> {
+        self.color(packed_edge_index(self, face, k, level, p)?)
+    }
 }
 
-/// Index in the colour buffer of lattice point `(i, j)` of `face` at `level` — the
-/// addressing the shaders implement (keep in sync with shaders/mesh_colors.wgsl).
-pub fn packed_sample_index(packed: &PackedMesh, face: u32, level: u32, i: u32, j: u32) -> Option<u64> {
+/// Index in the colour buffer of lattice point `(i, j)` of `face` at the requested level
+/// `requested` — the addressing the shaders implement (keep in sync with
+/// shaders/mesh_colors.wgsl). The lattice is the face's own level
+/// `min(requested, log2 R_f)`; corners are vertex level `min(requested, vertex_levels − 1)`.
+pub fn packed_sample_index(packed: &PackedMesh, face: u32, requested: u32, i: u32, j: u32) -> Option<u64> {
     let record = packed.face_records.get(face as usize)?;
     let corners = packed.indices.get(face as usize)?;
     let r_face = record.resolution()?;
-    let level = level.min(r_face.log2());
+    let level = requested.min(r_face.log2());
     let r = r_face.at_level(level).ok()?;
     Some(match layout::classify_sample(r, i, j, [false; 3])? {
         SampleLocation::Vertex { corner } => {
             let vertex = u64::from(corners[usize::from(corner)]);
             let last = packed.vertex_levels.checked_sub(1)?;
-            vertex * u64::from(packed.vertex_levels) + u64::from(level.min(last))
+            vertex * u64::from(packed.vertex_levels) + u64::from(requested.min(last))
         }
         SampleLocation::Edge { face_edge, offset } => {
             let k = usize::from(face_edge);
@@ -114,8 +159,30 @@ pub fn packed_sample_index(packed: &PackedMesh, face: u32, level: u32, i: u32, j
     })
 }
 
+/// Index in the colour buffer of the edge's own sample at position `p` (`1..r_e`, from
+/// the face edge's start corner) of face edge `k` of `face`, at the edge's level
+/// `min(requested, log2 R_e)` (`r_e = R_e >> min(requested, log2 R_e)`).
+pub fn packed_edge_index(packed: &PackedMesh, face: u32, k: u8, requested: u32, p: u32) -> Option<u64> {
+    let record = packed.face_records.get(face as usize)?;
+    let corners = packed.indices.get(face as usize)?;
+    let k = usize::from(k);
+    let (base, r_edge) = record.edge(k)?;
+    let level = requested.min(r_edge.log2());
+    let r_level = r_edge.at_level(level).ok()?;
+    if p == 0 || p >= r_level.get() {
+        return None;
+    }
+    let reversed = corners[k] > corners[(k + 1) % 3];
+    let in_level = layout::edge_storage_offset(r_level, p, reversed);
+    Some(u64::from(base) + u64::from(layout::edge_level_offset(r_edge, level).ok()?) + u64::from(in_level))
+}
+
 /// Samples `face` at `barycentric` with `filter` at MIP `level`. Returns `None` when the
 /// source cannot provide the samples (unknown face, or a level the source lacks).
+///
+/// `level` is the requested level `L`: the face's lattice is read at `min(L, log2 R_f)`,
+/// its vertices at `min(L, last vertex level)` and its edges at `min(L, log2 R_e)`; linear
+/// filtering applies the seam rule of the module docs on sub-triangles with a fine side.
 pub fn sample<S: MeshColorSource + ?Sized>(
     source: &S,
     face: u32,
@@ -124,22 +191,105 @@ pub fn sample<S: MeshColorSource + ?Sized>(
     level: u32,
 ) -> Option<Rgba> {
     let r_face = source.face_resolution(face)?;
-    let level = level.min(r_face.log2());
-    let r = r_face.at_level(level).ok()?;
+    let r = r_face.at_level(level.min(r_face.log2())).ok()?;
     match filter {
         Filter::Nearest => {
             let (i, j) = layout::nearest_sample(r, barycentric);
             source.lattice_color(face, level, i, j)
         }
-        Filter::Linear => {
-            let mut out = [0.0f32; 4];
-            for s in layout::linear_samples(r, barycentric) {
-                let color = source.lattice_color(face, level, s.i, s.j)?;
-                for c in 0..4 {
-                    out[c] += s.weight * color[c];
-                }
-            }
-            Some(out)
-        }
+        Filter::Linear => sample_linear(source, face, barycentric, level, r),
     }
+}
+
+/// Trilinear filtering at a continuous level of detail `lod` (as the shader's automatic
+/// level): the blend `c0 + (c1 − c0)·t` of linear levels `⌊lod⌋` and `⌊lod⌋ + 1`,
+/// `t = lod − ⌊lod⌋` (level `⌊lod⌋` alone when `t = 0`). `lod` is clamped below at 0 (NaN
+/// reads as 0); levels past an element's last read its last level.
+pub fn sample_trilinear<S: MeshColorSource + ?Sized>(
+    source: &S,
+    face: u32,
+    barycentric: [f32; 3],
+    lod: f32,
+) -> Option<Rgba> {
+    let lod = if lod.is_nan() { 0.0 } else { lod.clamp(0.0, crate::colors::layout::MAX_LOG2_RESOLUTION as f32) };
+    let l0 = lod.floor() as u32;
+    let t = lod - l0 as f32;
+    let c0 = sample(source, face, barycentric, Filter::Linear, l0)?;
+    if t <= 0.0 {
+        return Some(c0);
+    }
+    let c1 = sample(source, face, barycentric, Filter::Linear, l0 + 1)?;
+    Some(std::array::from_fn(|c| c0[c] + (c1[c] - c0[c]) * t))
+}
+
+/// Linear filtering at requested level `level` on the face's lattice of resolution `r`
+/// (its own level), with the seam rule on sub-triangles that have a side on a fine edge.
+fn sample_linear<S: MeshColorSource + ?Sized>(
+    source: &S,
+    face: u32,
+    barycentric: [f32; 3],
+    level: u32,
+    r: Resolution,
+) -> Option<Rgba> {
+    let samples = layout::linear_samples(r, barycentric);
+    let res = r.get();
+    // A "lower" sub-triangle (i, j), (i+1, j), (i, j+1) is the only kind with a side on the
+    // face's boundary; `linear_samples` lists it in that order (an "upper" one starts at
+    // (i+1, j+1), so its first two samples differ in j).
+    let (i, j) = (samples[0].i, samples[0].j);
+    let lower = samples[0].j == samples[1].j;
+    // Ratio r_e / r of each face edge at this level (1: no finer samples on it).
+    let mut ratio = [1u32; 3];
+    for k in 0..3u8 {
+        let r_edge = source.edge_resolution(face, k)?;
+        let r_edge_level = r_edge.get() >> level.min(r_edge.log2());
+        ratio[usize::from(k)] = (r_edge_level / res).max(1);
+    }
+    let on_side = [lower && j == 0, lower && i + j + 1 == res, lower && i == 0];
+    let fine = |k: usize| on_side[k] && ratio[k] > 1;
+    let mut colors = [[0.0f32; 4]; 3];
+    for (slot, s) in colors.iter_mut().zip(&samples) {
+        *slot = source.lattice_color(face, level, s.i, s.j)?;
+    }
+    if !(fine(0) || fine(1) || fine(2)) {
+        // No fine side: eq. 2.4, bit-identical to the formula without the seam rule.
+        let mut out = [0.0f32; 4];
+        for (s, color) in samples.iter().zip(&colors) {
+            for c in 0..4 {
+                out[c] += s.weight * color[c];
+            }
+        }
+        return Some(out);
+    }
+    // The fan from the centroid G: the sector of the side opposite the smallest weight.
+    let [a, b, c] = [samples[0].weight, samples[1].weight, samples[2].weight];
+    let [ca, cb, cc] = colors;
+    // (k, γ, numerator of t, start P, end Q, lattice position of P along face edge k)
+    let (k, gamma, num, from, to, q) = if c <= a && c <= b {
+        (0usize, 3.0 * c, b - c, ca, cb, i)
+    } else if a <= b {
+        (1usize, 3.0 * a, c - a, cb, cc, j)
+    } else {
+        (2usize, 3.0 * b, a - b, cc, ca, res.wrapping_sub(j + 1))
+    };
+    let den = 1.0 - gamma;
+    let t = if den > 0.0 { (num / den).clamp(0.0, 1.0) } else { 0.0 };
+    let (e0, e1, f) = if fine(k) {
+        // The edge's own samples between P and Q: m of them per sub-triangle side.
+        let m = ratio[k];
+        let x = t * m as f32;
+        let n = x.floor().clamp(0.0, (m - 1) as f32) as u32;
+        let f = x - n as f32;
+        let p0 = q * m + n;
+        let e0 = if n == 0 { from } else { source.edge_color(face, k as u8, level, p0)? };
+        let e1 = if n + 1 == m { to } else { source.edge_color(face, k as u8, level, p0 + 1)? };
+        (e0, e1, f)
+    } else {
+        (from, to, t)
+    };
+    Some(std::array::from_fn(|ch| {
+        let centroid = (ca[ch] + cb[ch] + cc[ch]) / 3.0;
+        let edge = (1.0 - f) * e0[ch] + f * e1[ch];
+        gamma * centroid + (1.0 - gamma) * edge
+    }))
 }
