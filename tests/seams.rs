@@ -381,3 +381,40 @@ fn uniform_resolution_is_bit_identical_to_the_old_formula() {
     }
     println!("{compared} lookups bit-identical");
 }
+
+/// Alternative (A), edges stored at the coarser face's resolution: what it would lose. For
+/// random colours on an edge of resolution `R_e` next to a face of `R_c`, the fine signal
+/// along the edge minus its `R_c` subsampling, as RMS over the edge (closed form per
+/// segment: ∫ of a squared linear function), and the edge samples it would not store.
+#[test]
+fn alternative_min_resolution_edges_lose_the_fine_detail() {
+    let mut rng = Rng(2024);
+    for (fine, coarse) in [(8u32, 2u32), (16, 1), (64, 4), (64, 32)] {
+        let mut squared = 0.0f64;
+        let trials = 200;
+        for _ in 0..trials {
+            let samples: Vec<f64> = (0..=fine).map(|_| f64::from(rng.unit())).collect();
+            let stride = fine / coarse;
+            for p in 0..fine {
+                // Difference at both ends of segment p; the integral of (d0 + (d1 − d0)s)²
+                // over s ∈ [0, 1] is (d0² + d0·d1 + d1²)/3.
+                let coarse_at = |q: u32| {
+                    let (k, f) = (q / stride, f64::from(q % stride) / f64::from(stride));
+                    let (a, b) = (samples[(k * stride) as usize], samples[((k + 1) * stride).min(fine) as usize]);
+                    a + (b - a) * f
+                };
+                let d0 = samples[p as usize] - coarse_at(p);
+                let d1 =
+                    samples[p as usize + 1] - if p + 1 == fine { samples[fine as usize] } else { coarse_at(p + 1) };
+                squared += (d0 * d0 + d0 * d1 + d1 * d1) / 3.0 / f64::from(fine);
+            }
+        }
+        let rms = (squared / f64::from(trials)).sqrt();
+        println!(
+            "min-R edge {fine}→{coarse}: RMS detail lost {rms:.3} (colour units, random samples), \
+             {} level-0 edge samples saved per edge",
+            fine - coarse
+        );
+        assert!(rms > 0.05, "random detail cannot be represented at the coarser resolution");
+    }
+}

@@ -193,8 +193,7 @@ fn side_on_edge(res: u32, i: u32, j: u32, side: usize) -> bool {
 /// Segments of each side of the lower sub-triangle at `(i, j)`: `R_e / R_f` on a fine
 /// side, else 1; `None` when the sub-triangle has no fine side (not fanned).
 fn fan_segments(ratios: &[u32; 3], res: u32, i: u32, j: u32) -> Option<[u32; 3]> {
-    let segments: [u32; 3] =
-        std::array::from_fn(|side| if side_on_edge(res, i, j, side) { ratios[side] } else { 1 });
+    let segments: [u32; 3] = std::array::from_fn(|side| if side_on_edge(res, i, j, side) { ratios[side] } else { 1 });
     segments.iter().any(|&m| m > 1).then_some(segments)
 }
 
@@ -370,7 +369,11 @@ pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessella
                         };
                         let edge = face_edges[side];
                         let Some(r_edge) = store.edge_resolution(edge) else {
-                            return Err(ExportError::MissingSample { face, i: corners_ij[side].0, j: corners_ij[side].1 });
+                            return Err(ExportError::MissingSample {
+                                face,
+                                i: corners_ij[side].0,
+                                j: corners_ij[side].1,
+                            });
                         };
                         let reversed = topology.is_reversed(face, side);
                         let mut previous = start;

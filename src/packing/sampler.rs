@@ -1,15 +1,93 @@
 //! The CPU reference sampler: the truth the WGSL shaders are tested against.
 //!
 //! `sample(source, face, barycentric, filter, level)` evaluates mesh colors on one face:
-//! nearest (the highest-weight sample, thesis 2.2.3) or linear (three samples, eq. 2.4)
-//! at MIP level `level` (clamped to the face's last level, where only vertex colours
-//! remain), through [`MeshColorSource`], implemented by
+//! nearest (the highest-weight sample, thesis 2.2.3) or linear (three samples, eq. 2.4,
+//! with the seam rule below) at requested MIP level `level`; [`sample_trilinear`] blends
+//! two levels. Sources ([`MeshColorSource`]):
 //! - [`ColorStore`]: level 0, read straight from the editable maps;
 //! - [`StoreMips`]: every level of a store, its MIP chains evaluated in full `f32`
 //!   (the packer's filters with RGBA32F, whose quantisation is the identity);
 //! - [`PackedMesh`]: every level of packed buffers in any colour format.
 //!
 //! The arithmetic is `f32` in the order the shaders use.
+//!
+//! # Seams between faces of different resolution
+//!
+//! An edge stores samples at `R_e = max R_f` of its faces. Eq. 2.4 on a coarser face only
+//! interpolates every `R_e / R_f`-th of them, so before this rule the two faces showed
+//! different colours along the same edge (random colours, two triangles, largest jump
+//! 0.52–0.96 at level 0 and 0.13–0.77 at coarser levels over all pairs in 1..=64; the
+//! issue measured 0.69 for 8|2, 0.80 for 16|1, 0.91 for 64|4). The rule:
+//!
+//! 1. **Levels per element.** At requested level `L` a face's own lattice is read at
+//!    `min(L, log2 R_f)` (resolution `r`), every vertex at `min(L, vertex_levels − 1)` and
+//!    edge `k` at `min(L, log2 R_e)` (resolution `r_e`). None of these depends on the face
+//!    reading the element, so at any `L` both faces read the same stored values.
+//!    (Before, vertices were read at the face's clamped level: a face past its last level
+//!    and its finer neighbour read the shared vertex at different levels.) When the
+//!    lattice has edge points (`r >= 2`) all three levels equal `L`, and the edge is read
+//!    with stride `r_e / r = R_e / R_f` exactly as before.
+//! 2. **Fine sides.** A face edge is a *fine side* at `L` when `r_e > r`. Only a "lower"
+//!    sub-triangle `A = (i, j), B = (i+1, j), C = (i, j+1)` can have a side on the face
+//!    boundary (AB on edge 0 when `j = 0`, BC on edge 1 when `i + j + 1 = r`, CA on edge 2
+//!    when `i = 0`). Sub-triangles without a side on a fine side: eq. 2.4 unchanged.
+//! 3. **Centroid fan.** Otherwise, with eq. 2.4's weights `(a, b, c)` of `A, B, C`, the
+//!    sub-triangle is fanned from its centroid `G` (colour `(C_A + C_B + C_C)/3`); the
+//!    point lies in the sector of the side opposite its smallest weight. For `c` smallest
+//!    (sector `G A B`): `γ = 3c`, `t = (b − c)/(1 − 3c)` and
+//!    `colour = γ·C_G + (1 − γ)·E_AB(t)`, where `E_AB` is the 1D linear interpolation of
+//!    the edge's own `m = r_e / r` segments between `A` and `B` if AB is on a fine side,
+//!    else `lerp(C_A, C_B, t)`; the sectors `G B C` (`a` smallest, `γ = 3a`,
+//!    `t = (c − a)/(1 − 3a)`) and `G C A` (`b` smallest, `γ = 3b`, `t = (a − b)/(1 − 3b)`)
+//!    likewise. Ties go to AB, then BC.
+//!
+//! Derivation. In sector `G A B` a point is `P = γG + αA + βB` with `γ + α + β = 1`,
+//! `α, β >= 0`; since `G = (A + B + C)/3`, its weights in the sub-triangle are
+//! `a = α + γ/3`, `b = β + γ/3`, `c = γ/3`, hence `γ = 3c`, `β = b − c`, `α = a − c`, the
+//! sector condition is `c <= a, b`, and the parameter along AB is `β/(α + β) = (b−c)/(1−3c)`.
+//! The colour is linear on each fan triangle `(G, x_n, x_{n+1})` (`x_n` the edge samples
+//! on AB), so the rule is exactly piecewise linear on that triangulation. On AB itself
+//! (`c = 0`, `γ = 0`) it is `E_AB`, i.e. the linear interpolation of consecutive edge
+//! samples — what the finer face (`r = r_e` there) shows along its own sub-triangle
+//! sides. On a side that is not fine it is `lerp`, what the neighbouring sub-triangle
+//! shows, so the face stays continuous inside. At every level both faces therefore show
+//! `E` along every shared edge (proved by measurement in tests/seams.rs: zero difference
+//! between faces, ≤ 6e-8 from the exact edge interpolation, every pair in 1..=64, pairs
+//! with 4096, boundary and non-manifold edges, every level). On uniform-resolution
+//! meshes no side is ever fine and `vertex_levels − 1 = log2 R`, so results are
+//! bit-identical to eq. 2.4 as before (tested against a copy of the old function).
+//!
+//! **Trilinear** is the blend of two fixed levels, so it is continuous whenever both
+//! faces use the same `lod` ([`sample_trilinear`]; tested). The shader picks `lod` per
+//! face from screen-space derivatives, `log2(footprint · R_f)`: two faces of different
+//! `R` seeing the same footprint pick levels `log2(R_1 / R_2)` apart (and faces of any
+//! `R` with different screen-space shapes differ too, as before this rule), so GPU
+//! trilinear can still show a level-of-detail step across an edge — a limitation of
+//! per-face derivative LOD, like a texture's across a UV seam; making it per-edge
+//! consistent needs a LOD that is continuous over the mesh (e.g. interpolated per
+//! vertex), not done here. Its level is clamped to the mesh's last level
+//! (`vertex_levels − 1`, = `log2 R_f` on uniform meshes) so coarse faces keep following
+//! their vertices' chains as far as their finer neighbours do.
+//!
+//! **Nearest** stays discontinuous by nature: a face shows the value of its own nearest
+//! lattice sample, so along a mixed edge the coarser face shows cells `R_e / R_f` times
+//! longer than the finer face's, each holding the edge (or vertex) sample at its centre
+//! — the two sides agree at the coarse face's lattice points and differ in between.
+//!
+//! **Alternatives measured** (random colours, the worst case for detail):
+//! - *(A) edges at the coarser face's `R`*: zero sampling cost and fewer bytes
+//!   (`R_max − R_min` level-0 samples per mixed edge, ≈ 2× with the chain), but the fine
+//!   face loses its detail along the edge: RMS 0.27 (8→2), 0.32 (16→1), 0.32 (64→4), 0.20
+//!   (64→32) colour units (test `alternative_min_resolution_edges_lose_the_fine_detail`);
+//!   a stroke ending on an `R` boundary would be blurred along the boundary.
+//! - *(B) additive correction* `L + (1 − c)·δ(t)`: similar cost for one fine side, but
+//!   corner sub-triangles meet two fine sides and an `R = 1` face three, where the
+//!   corrections overlap; and it is not piecewise linear on a triangulation, so the
+//!   tessellated export could not reproduce it exactly.
+//! - *The fan (chosen)*: no extra bytes (face records stay 16 B: the shader derives the
+//!   fine sides from the `log2 R_e` it already decodes), detail kept exactly, one or two
+//!   extra loads only in fanned sub-triangles; frame time in the README / final report
+//!   (`meshpaint bench render`).
 
 use crate::colors::format::ColorFormat;
 use crate::colors::format::Rgba;
