@@ -418,3 +418,57 @@ fn alternative_min_resolution_edges_lose_the_fine_detail() {
         assert!(rms > 0.05, "random detail cannot be represented at the coarser resolution");
     }
 }
+
+/// MIP chains at mixed resolutions (eq. 2.6 on edges with every incident face): edge
+/// level `l` = `(C + ½ Σ N)/(1 + n/2)` over the two neighbours along the edge and two per
+/// incident face — interior samples of a face at the edge's resolution, and for a coarser
+/// face what it shows there at level `l − 1` (the linear filter with the seam rule).
+#[test]
+fn edge_mip_levels_take_coarser_faces_as_they_are_shown() {
+    let mut checked = 0;
+    for store in [two_triangles(8, 2, 5), two_triangles(1, 16, 6), fins([2, 32, 8, 1], 7), fins([16, 16, 4, 16], 8)] {
+        let packed = packed(&store);
+        let pack_layout = PackLayout::of(&store).unwrap();
+        let topology = store.topology();
+        for edge in 0..topology.edge_count() {
+            let r_edge = store.edge_resolution(edge).unwrap();
+            let [lower, _] = topology.edge_vertices[edge as usize];
+            for level in 1..r_edge.log2() {
+                let rl = r_edge.get() >> level;
+                let rp = 2 * rl;
+                for k in 1..rl {
+                    let s = f64::from(2 * k) / f64::from(rp);
+                    let along = |d: i32| {
+                        edge_truth(&packed, &pack_layout, &store, edge, level - 1, s + f64::from(d) / f64::from(rp))
+                    };
+                    let center = along(0);
+                    let mut neighbours = vec![along(-1), along(1)];
+                    for &(face, fk) in topology.faces_of_edge(edge) {
+                        let from_lower = topology.face_vertices[face as usize][usize::from(fk)] == lower;
+                        let p = if from_lower { 2 * k } else { rp - 2 * k };
+                        let inside = match fk {
+                            0 => [(p, 1), (p - 1, 1)],
+                            1 => [(rp - p - 1, p), (rp - p, p - 1)],
+                            _ => [(1, rp - p), (1, rp - p - 1)],
+                        };
+                        for (i, j) in inside {
+                            let w = [(rp - i - j) as f32, i as f32, j as f32].map(|w| w / rp as f32);
+                            neighbours.push(sample(&packed, face, w, Filter::Linear, level - 1).unwrap());
+                        }
+                    }
+                    let norm = 1.0 / (1.0 + 0.5 * neighbours.len() as f32);
+                    let expected: Rgba = std::array::from_fn(|c| {
+                        (center[c] + 0.5 * neighbours.iter().map(|n| n[c]).sum::<f32>()) * norm
+                    });
+                    let got = edge_truth(&packed, &pack_layout, &store, edge, level, s);
+                    assert!(
+                        max_diff(got, expected) <= 1e-5,
+                        "edge {edge} level {level} k {k}: {got:?} vs {expected:?}"
+                    );
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked > 50, "{checked}");
+}

@@ -93,7 +93,7 @@ use crate::colors::format::ColorFormat;
 use crate::colors::format::Rgba;
 use crate::colors::layout::{self, Resolution, SampleLocation};
 use crate::colors::store::ColorStore;
-use crate::packing::linear::PackedMesh;
+use crate::packing::linear::{FaceRecord, PackedMesh};
 use crate::packing::packer::{PackError, pack};
 
 /// How colours between samples are reconstructed.
@@ -211,14 +211,26 @@ impl MeshColorSource for PackedMesh {
 pub fn packed_sample_index(packed: &PackedMesh, face: u32, requested: u32, i: u32, j: u32) -> Option<u64> {
     let record = packed.face_records.get(face as usize)?;
     let corners = packed.indices.get(face as usize)?;
+    record_sample_index(record, corners, packed.vertex_levels, requested, i, j)
+}
+
+/// [`packed_sample_index`] from one face's record and corners.
+pub(crate) fn record_sample_index(
+    record: &FaceRecord,
+    corners: &[u32; 3],
+    vertex_levels: u32,
+    requested: u32,
+    i: u32,
+    j: u32,
+) -> Option<u64> {
     let r_face = record.resolution()?;
     let level = requested.min(r_face.log2());
     let r = r_face.at_level(level).ok()?;
     Some(match layout::classify_sample(r, i, j, [false; 3])? {
         SampleLocation::Vertex { corner } => {
             let vertex = u64::from(corners[usize::from(corner)]);
-            let last = packed.vertex_levels.checked_sub(1)?;
-            vertex * u64::from(packed.vertex_levels) + u64::from(requested.min(last))
+            let last = vertex_levels.checked_sub(1)?;
+            vertex * u64::from(vertex_levels) + u64::from(requested.min(last))
         }
         SampleLocation::Edge { face_edge, offset } => {
             let k = usize::from(face_edge);
@@ -243,6 +255,11 @@ pub fn packed_sample_index(packed: &PackedMesh, face: u32, requested: u32, i: u3
 pub fn packed_edge_index(packed: &PackedMesh, face: u32, k: u8, requested: u32, p: u32) -> Option<u64> {
     let record = packed.face_records.get(face as usize)?;
     let corners = packed.indices.get(face as usize)?;
+    record_edge_index(record, corners, k, requested, p)
+}
+
+/// [`packed_edge_index`] from one face's record and corners.
+pub(crate) fn record_edge_index(record: &FaceRecord, corners: &[u32; 3], k: u8, requested: u32, p: u32) -> Option<u64> {
     let k = usize::from(k);
     let (base, r_edge) = record.edge(k)?;
     let level = requested.min(r_edge.log2());
