@@ -334,80 +334,12 @@ pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessella
             lattice.get(row + j as usize).copied().unwrap_or(0)
         };
         let ratios = fine_ratios(store, face);
-        let face_edges = topology.face_edges[face as usize];
         for i in 0..res {
             for j in 0..res - i {
                 if let Some(segments) = fan_segments(&ratios, res, i, j) {
-                    let corners_ij = [(i, j), (i + 1, j), (i, j + 1)];
                     let ends = [at(i, j), at(i + 1, j), at(i, j + 1)];
-                    let corner_colors = ends.map(|v| out.colors.get(v as usize).copied().unwrap_or([0.0; 4]));
-                    let centroid = out.positions.len() as u32;
-                    let w = [f64::from(3 * (res - i - j) - 2), f64::from(3 * i + 1), f64::from(3 * j + 1)]
-                        .map(|w| w / f64::from(3 * res));
-                    out.positions.push(std::array::from_fn(|a| {
-                        (w[0] * f64::from(corner_positions[0][a])
-                            + w[1] * f64::from(corner_positions[1][a])
-                            + w[2] * f64::from(corner_positions[2][a])) as f32
-                    }));
-                    out.colors.push(std::array::from_fn(|c| {
-                        (corner_colors[0][c] + corner_colors[1][c] + corner_colors[2][c]) / 3.0
-                    }));
-                    out.samples.push(None);
-                    for side in 0..3 {
-                        let (start, end) = (ends[side], ends[(side + 1) % 3]);
-                        let m = segments[side];
-                        if m == 1 {
-                            out.triangles.push([centroid, start, end]);
-                            continue;
-                        }
-                        // Side `side` lies on face edge `side`; its start corner sits at
-                        // position q of the face's lattice along that edge.
-                        let q = match side {
-                            0 => i,
-                            1 => j,
-                            _ => res - j - 1,
-                        };
-                        let edge = face_edges[side];
-                        let Some(r_edge) = store.edge_resolution(edge) else {
-                            return Err(ExportError::MissingSample {
-                                face,
-                                i: corners_ij[side].0,
-                                j: corners_ij[side].1,
-                            });
-                        };
-                        let reversed = topology.is_reversed(face, side);
-                        let mut previous = start;
-                        for n in 1..=m {
-                            let vertex = if n == m {
-                                end
-                            } else {
-                                let p = q * m + n;
-                                let offset = layout::edge_storage_offset(r_edge, p, reversed);
-                                let (fi, fj) = layout::edge_sample_coords(r_edge, side as u8, p);
-                                let missing = ExportError::MissingSample { face, i: fi, j: fj };
-                                let slot_index = edge_base.get(edge as usize).map(|&b| b + offset as usize);
-                                let Some(slot) = slot_index.and_then(|k| edge_slots.get_mut(k)) else {
-                                    return Err(missing);
-                                };
-                                if *slot == UNASSIGNED {
-                                    let sample = SampleRef::Edge { edge, offset };
-                                    let Some(color) = store.get(sample) else {
-                                        return Err(missing);
-                                    };
-                                    if !color.iter().all(|c| c.is_finite()) {
-                                        return Err(ExportError::NonFiniteColor { face, i: fi, j: fj });
-                                    }
-                                    *slot = out.positions.len() as u32;
-                                    out.positions.push(lattice_position(&corner_positions, r_edge, fi, fj));
-                                    out.colors.push(color.map(|c| c.clamp(0.0, 1.0)));
-                                    out.samples.push(Some(sample));
-                                }
-                                *slot
-                            };
-                            out.triangles.push([centroid, previous, vertex]);
-                            previous = vertex;
-                        }
-                    }
+                    let fan = Fan { face, res, i, j, ends, segments, corner_positions: &corner_positions };
+                    fan.emit(store, &edge_base, &mut edge_slots, &mut out)?;
                 } else {
                     out.triangles.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
                 }
@@ -418,6 +350,94 @@ pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessella
         }
     }
     Ok(out)
+}
+
+/// One fanned sub-triangle `(i, j), (i+1, j), (i, j+1)` of `face` (module documentation).
+struct Fan<'a> {
+    face: u32,
+    res: u32,
+    i: u32,
+    j: u32,
+    /// glTF vertices of the three corners.
+    ends: [u32; 3],
+    /// Segments of each side (`R_e / R_f` on a fine side, else 1).
+    segments: [u32; 3],
+    corner_positions: &'a [[f32; 3]; 3],
+}
+
+impl Fan<'_> {
+    /// Appends the centroid vertex, the fan triangles and any edge-sample vertex not
+    /// yet written (shared through `edge_slots` with the finer face).
+    fn emit(
+        &self,
+        store: &ColorStore,
+        edge_base: &[usize],
+        edge_slots: &mut [u32],
+        out: &mut Tessellation,
+    ) -> Result<(), ExportError> {
+        let Fan { face, res, i, j, ends, segments, corner_positions } = *self;
+        let topology = store.topology();
+        let corner_colors = ends.map(|v| out.colors.get(v as usize).copied().unwrap_or([0.0; 4]));
+        let centroid = out.positions.len() as u32;
+        let w = [f64::from(3 * (res - i - j) - 2), f64::from(3 * i + 1), f64::from(3 * j + 1)]
+            .map(|w| w / f64::from(3 * res));
+        out.positions.push(std::array::from_fn(|a| {
+            (w[0] * f64::from(corner_positions[0][a])
+                + w[1] * f64::from(corner_positions[1][a])
+                + w[2] * f64::from(corner_positions[2][a])) as f32
+        }));
+        out.colors
+            .push(std::array::from_fn(|c| (corner_colors[0][c] + corner_colors[1][c] + corner_colors[2][c]) / 3.0));
+        out.samples.push(None);
+        for side in 0..3 {
+            let (start, end) = (ends[side], ends[(side + 1) % 3]);
+            let m = segments[side];
+            if m == 1 {
+                out.triangles.push([centroid, start, end]);
+                continue;
+            }
+            // Side `side` lies on face edge `side`; its start corner sits at position q of
+            // the face's lattice along that edge.
+            let q = [i, j, res - j - 1][side];
+            let edge = topology.face_edges.get(face as usize).map_or(u32::MAX, |e| e[side]);
+            let Some(r_edge) = store.edge_resolution(edge) else {
+                return Err(ExportError::MissingSample { face, i, j });
+            };
+            let reversed = topology.is_reversed(face, side);
+            let mut previous = start;
+            for n in 1..=m {
+                let vertex = if n == m {
+                    end
+                } else {
+                    let p = q * m + n;
+                    let offset = layout::edge_storage_offset(r_edge, p, reversed);
+                    let (fi, fj) = layout::edge_sample_coords(r_edge, side as u8, p);
+                    let missing = ExportError::MissingSample { face, i: fi, j: fj };
+                    let slot_index = edge_base.get(edge as usize).map(|&b| b + offset as usize);
+                    let Some(slot) = slot_index.and_then(|k| edge_slots.get_mut(k)) else {
+                        return Err(missing);
+                    };
+                    if *slot == UNASSIGNED {
+                        let sample = SampleRef::Edge { edge, offset };
+                        let Some(color) = store.get(sample) else {
+                            return Err(missing);
+                        };
+                        if !color.iter().all(|c| c.is_finite()) {
+                            return Err(ExportError::NonFiniteColor { face, i: fi, j: fj });
+                        }
+                        *slot = out.positions.len() as u32;
+                        out.positions.push(lattice_position(corner_positions, r_edge, fi, fj));
+                        out.colors.push(color.map(|c| c.clamp(0.0, 1.0)));
+                        out.samples.push(Some(sample));
+                    }
+                    *slot
+                };
+                out.triangles.push([centroid, previous, vertex]);
+                previous = vertex;
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Position of lattice point `(i, j)` on the face with `corners` at resolution `r`:

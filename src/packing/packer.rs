@@ -367,9 +367,7 @@ fn reduce_edges_and_vertices(store: &ColorStore, layout: &PackLayout, colors: &m
     let records: Vec<FaceRecord> = (0..topology.face_count()).map(|f| layout.face_record(store, f)).collect();
     for level in 1..levels {
         let previous = level - 1;
-        // What coarser faces show next to each edge sample at level − 1 (the seam rule):
-        // per edge, for k in 1..r_level, two colours per coarse face.
-        let coarse_neighbours: Vec<Vec<Rgba>> = {
+        let coarse_neighbours = {
             let view = ChainsView {
                 store,
                 records: &records,
@@ -380,28 +378,7 @@ fn reduce_edges_and_vertices(store: &ColorStore, layout: &PackLayout, colors: &m
                 vertex_section,
                 interior_start,
             };
-            edges
-                .iter()
-                .map(|info| {
-                    let mut out = Vec::new();
-                    if info.coarse_faces.is_empty() || info.log2 < level as u32 + 1 {
-                        return out;
-                    }
-                    let r_level = 1usize << (info.log2 - level as u32);
-                    let rp = 2 * r_level;
-                    for k in 1..r_level {
-                        for &(face, face_edge, reversed) in &info.coarse_faces {
-                            let p = if reversed { rp - 2 * k } else { 2 * k };
-                            for (i, j) in inside_neighbours(face_edge, p, rp) {
-                                let w = [(rp - i - j) as f32, i as f32, j as f32].map(|w| w / rp as f32);
-                                let color = sampler::sample(&view, face, w, Filter::Linear, previous as u32);
-                                out.push(color.unwrap_or([0.0; 4]));
-                            }
-                        }
-                    }
-                    out
-                })
-                .collect()
+            coarse_neighbours(&view, &edges, level as u32)
         };
         // Edges: each edge's chain is its own slice.
         {
@@ -465,6 +442,33 @@ fn reduce_edges_and_vertices(store: &ColorStore, layout: &PackLayout, colors: &m
             });
         }
     }
+}
+
+/// What coarser faces show next to each edge sample of level `level − 1` (the seam rule):
+/// per edge, for `k` in `1..r_level`, two colours per coarse face.
+fn coarse_neighbours(view: &ChainsView, edges: &[EdgeInfo], level: u32) -> Vec<Vec<Rgba>> {
+    edges
+        .iter()
+        .map(|info| {
+            let mut out = Vec::new();
+            if info.coarse_faces.is_empty() || info.log2 < level + 1 {
+                return out;
+            }
+            let r_level = 1usize << (info.log2 - level);
+            let rp = 2 * r_level;
+            for k in 1..r_level {
+                for &(face, face_edge, reversed) in &info.coarse_faces {
+                    let p = if reversed { rp - 2 * k } else { 2 * k };
+                    for (i, j) in inside_neighbours(face_edge, p, rp) {
+                        let w = [(rp - i - j) as f32, i as f32, j as f32].map(|w| w / rp as f32);
+                        let color = sampler::sample(view, face, w, Filter::Linear, level - 1);
+                        out.push(color.unwrap_or([0.0; 4]));
+                    }
+                }
+            }
+            out
+        })
+        .collect()
 }
 
 /// Level `level` of one edge chain from level `level − 1`.
