@@ -248,6 +248,8 @@ fn check_limits(vertices: u64, triangles: u64) -> Result<(), ExportError> {
 }
 
 /// Tessellates `store` on `positions` (one per store vertex): see the module documentation.
+/// Long: one pass over the faces that checks the limits, shares vertices through the slot
+/// maps and writes lattice and fan triangles; the fans themselves are [`Fan::emit`].
 pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessellation, ExportError> {
     let topology = store.topology();
     if topology.face_count() == 0 {
