@@ -323,6 +323,8 @@ fn inside_neighbours(face_edge: u8, p: usize, rp: usize) -> [(usize, usize); 2] 
 /// Edge MIP levels (eq. 2.6 on edges) and vertex MIP levels (eq. 2.5), level by level.
 /// The buffer splits into vertex / edge / interior sections: a pass writes one section
 /// in parallel chunks while reading the others.
+/// Long: one level loop over three borrowed sections (coarse-face neighbours, edges,
+/// vertices in parallel chunks); splitting it would re-split the buffer per helper.
 fn reduce_edges_and_vertices(store: &ColorStore, layout: &PackLayout, colors: &mut [Rgba], threads: usize) {
     let topology = store.topology();
     let levels = layout.vertex_levels as usize;
