@@ -52,18 +52,24 @@ const MESH_DATA_WIDTH_LOG2: u32 = 12u;
 @group(0) @binding(3) var face_records: texture_2d<u32>;
 @group(0) @binding(4) var atlas: texture_2d<f32>;
 
-// Per-face addressing at one MIP level: the colour-buffer index of every lattice point
-// (i, j) of resolution `r` follows from these (see `sample_index`).
+// Per-face addressing at one requested MIP level L: the colour-buffer index of every
+// lattice point (i, j) of resolution `r` follows from these (see `sample_index`). Every
+// shared element is read at a level that does not depend on the face reading it
+// (sampler.rs module docs): the face lattice at min(L, log2 R_f), vertices at
+// min(L, vertex_levels − 1), edge k at min(L, log2 R_e).
 struct LevelData {
-    // Resolution at this level, R_f >> level.
+    // Resolution of the face's lattice, R_f >> min(L, log2 R_f).
     r: u32,
-    // Colour index of corner c's vertex sample at this level.
+    // Colour index of corner c's vertex sample at min(L, vertex_levels − 1).
     vertex: vec3<u32>,
-    // Face edge k: the sample at position p (1..r-1 from the edge's start corner) is
-    // edge_start[k] + p · edge_step[k] (u32 wrapping; edge_step is −stride when the face
-    // walks the edge against its canonical direction).
+    // Face edge k at its level: the lattice point at position p (1..r-1 from the edge's
+    // start corner) is edge_start[k] + p · edge_step[k] (u32 wrapping; edge_step is
+    // −stride when the face walks the edge against its canonical direction), the edge's
+    // own sample at position p_e (1..r·stride − 1) is edge_start[k] ± p_e.
     edge_start: vec3<u32>,
     edge_step: vec3<u32>,
+    // r_e / r of each face edge at this level (> 1: a fine side, the seam rule applies).
+    stride: vec3<u32>,
     // Colour index of interior offset 0 at this level.
     interior: u32,
 }
@@ -141,20 +147,26 @@ fn face_data(face: u32, corners: vec3<u32>) -> FaceData {
     return f;
 }
 
-// The addressing of face `f` at `level` (<= log2 R_f), sampler::packed_sample_index with
-// everything that does not depend on (i, j) folded into start values.
-fn level_data(f: FaceData, level: u32) -> LevelData {
+// The addressing of face `f` at requested level `requested` (any value),
+// sampler::packed_sample_index / packed_edge_index with everything that does not depend on
+// (i, j) folded into start values.
+fn level_data(f: FaceData, requested: u32) -> LevelData {
     var d: LevelData;
+    let level = min(requested, f.log2_f);
     d.r = 1u << (f.log2_f - level);
-    d.vertex = f.vertex_base + vec3<u32>(min(level, max(u.vertex_levels, 1u) - 1u));
+    d.vertex = f.vertex_base + vec3<u32>(min(requested, max(u.vertex_levels, 1u) - 1u));
     for (var k = 0u; k < 3u; k++) {
         let log2_e = f.edge_log2[k];
-        let stride = 1u << (log2_e - f.log2_f);
-        let r_edge_level = 1u << (log2_e - level);
-        let start = f.edge_base[k] + edge_level_offset(log2_e, level);
+        let edge_level = min(requested, log2_e);
+        // r_e / r = 2^((log2 R_e − edge level) − (log2 R_f − face level)); equal to
+        // R_e / R_f whenever the lattice has edge points (r >= 2, both levels = requested).
+        let stride = 1u << ((log2_e - edge_level) - (f.log2_f - level));
+        let r_edge_level = 1u << (log2_e - edge_level);
+        let start = f.edge_base[k] + edge_level_offset(log2_e, edge_level);
         // Storage offset p·stride − 1 forwards, r_edge_level − 1 − p·stride reversed.
         d.edge_start[k] = select(start - 1u, start + r_edge_level - 1u, f.reversed[k]);
         d.edge_step[k] = select(stride, 0u - stride, f.reversed[k]);
+        d.stride[k] = stride;
     }
     d.interior = f.interior_base + interior_level_offset(f.log2_f, level);
     return d;
@@ -170,7 +182,7 @@ fn reversed_bits(reversed: vec3<bool>, shift: u32) -> u32 {
 }
 
 fn pack_level(f: FaceData, d: LevelData) -> array<vec4<u32>, 2> {
-    let s = f.edge_log2 - vec3<u32>(f.log2_f);
+    let s = countTrailingZeros(d.stride);
     let bits = d.r | (s.x << 13u) | (s.y << 17u) | (s.z << 21u) | reversed_bits(f.reversed, 25u);
     return array<vec4<u32>, 2>(vec4<u32>(bits, d.vertex), vec4<u32>(d.edge_start, d.interior));
 }
@@ -184,6 +196,7 @@ fn unpack_level(a: vec4<u32>, b: vec4<u32>) -> LevelData {
     let stride = vec3<u32>(1u) << ((vec3<u32>(a.x) >> vec3<u32>(13u, 17u, 21u)) & vec3<u32>(15u));
     let reversed = (vec3<u32>(a.x) & vec3<u32>(1u << 25u, 1u << 26u, 1u << 27u)) != vec3<u32>(0u);
     d.edge_step = select(stride, vec3<u32>(0u) - stride, reversed);
+    d.stride = stride;
     return d;
 }
 
@@ -255,7 +268,7 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
     if LEVEL_MODE == 1u {
         packed = pack_face(f);
     } else {
-        packed = pack_level(f, level_data(f, min(u.level, f.log2_f)));
+        packed = pack_level(f, level_data(f, u.level));
     }
     var out: VertexOut;
     out.clip = u.clip_from_world * vec4<f32>(p, 1.0);
@@ -358,11 +371,82 @@ fn sample_level(d: LevelData, bary: vec3<f32>) -> vec4<f32> {
         let j = select(select(s.j.x, s.j.y, pick1), s.j.z, pick2);
         return load_sample(sample_index(d, i, j));
     }
-    var out = vec4<f32>(0.0);
-    out += s.w.x * load_sample(sample_index(d, s.i.x, s.j.x));
-    out += s.w.y * load_sample(sample_index(d, s.i.y, s.j.y));
-    out += s.w.z * load_sample(sample_index(d, s.i.z, s.j.z));
-    return out;
+    let ca = load_sample(sample_index(d, s.i.x, s.j.x));
+    let cb = load_sample(sample_index(d, s.i.y, s.j.y));
+    let cc = load_sample(sample_index(d, s.i.z, s.j.z));
+    // sampler::sample_linear: only a "lower" sub-triangle (listed (i,j), (i+1,j), (i,j+1))
+    // has sides on the face's boundary; a side on an edge with r_e > r is a fine side.
+    let i = s.i.x;
+    let j = s.j.x;
+    let lower = s.j.x == s.j.y;
+    let on_side = vec3<bool>(lower && j == 0u, lower && i + j + 1u == d.r, lower && i == 0u);
+    let fine = on_side & (d.stride > vec3<u32>(1u));
+    if !any(fine) {
+        // No fine side: eq. 2.4 as before the seam rule.
+        var out = vec4<f32>(0.0);
+        out += s.w.x * ca;
+        out += s.w.y * cb;
+        out += s.w.z * cc;
+        return out;
+    }
+    return seam_fan(d, s, ca, cb, cc, fine);
+}
+
+// Colour index of the edge's own sample at position p (1..r_e − 1, from the face edge's
+// start corner) of face edge k at its level (sampler::packed_edge_index).
+fn edge_index(d: LevelData, k: u32, p: u32) -> u32 {
+    let unit = select(0u - 1u, 1u, d.edge_step[k] == d.stride[k]);
+    return d.edge_start[k] + p * unit;
+}
+
+// sampler::sample_linear's seam rule: the sub-triangle fanned from its centroid G; the
+// point lies in the sector of the side opposite its smallest weight; the colour is
+// γ·G + (1 − γ)·E(t), E the side's own edge samples interpolated (fine side) or the
+// lerp of the side's two corners.
+fn seam_fan(d: LevelData, s: Samples, ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, fine: vec3<bool>) -> vec4<f32> {
+    let a = s.w.x;
+    let b = s.w.y;
+    let c = s.w.z;
+    var k = 0u;
+    var gamma = 3.0 * c;
+    var num = b - c;
+    var start_color = ca;
+    var end_color = cb;
+    var q = s.i.x;
+    if !(c <= a && c <= b) {
+        if a <= b {
+            k = 1u;
+            gamma = 3.0 * a;
+            num = c - a;
+            start_color = cb;
+            end_color = cc;
+            q = s.j.x;
+        } else {
+            k = 2u;
+            gamma = 3.0 * b;
+            num = a - b;
+            start_color = cc;
+            end_color = ca;
+            q = d.r - s.j.x - 1u;
+        }
+    }
+    let den = 1.0 - gamma;
+    let t = select(0.0, clamp(num / den, 0.0, 1.0), den > 0.0);
+    var e0 = start_color;
+    var e1 = end_color;
+    var f = t;
+    if fine[k] {
+        let m = d.stride[k];
+        let x = t * f32(m);
+        let n = u32(clamp(floor(x), 0.0, f32(m - 1u)));
+        f = x - f32(n);
+        let p0 = q * m + n;
+        e0 = select(load_sample(edge_index(d, k, p0)), start_color, n == 0u);
+        e1 = select(load_sample(edge_index(d, k, p0 + 1u)), end_color, n + 1u == m);
+    }
+    let centroid = (ca + cb + cc) / 3.0;
+    let edge = (1.0 - f) * e0 + f * e1;
+    return gamma * centroid + (1.0 - gamma) * edge;
 }
 
 @fragment
@@ -383,11 +467,15 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
         let footprint = max(length(duv_dx * res_f), length(duv_dy * res_f));
         var lod = log2(footprint);
         lod = select(lod, 0.0, is_nan(lod));
-        lod = clamp(lod, 0.0, f32(f.log2_f));
+        // Clamped to the mesh's last level (vertex_levels − 1, = log2 R_f on uniform
+        // meshes): past its own last level a face keeps blending its vertices' coarser
+        // levels, as its finer neighbours do (sampler::sample_trilinear).
+        let last = max(u.vertex_levels, 1u) - 1u;
+        lod = clamp(lod, 0.0, f32(last));
         let l0 = u32(floor(lod));
         let t = lod - f32(l0);
         let c0 = sample_level(level_data(f, l0), bary);
-        let c1 = sample_level(level_data(f, min(l0 + 1u, f.log2_f)), bary);
+        let c1 = sample_level(level_data(f, min(l0 + 1u, last)), bary);
         color = select(c0, mix(c0, c1, t), t > 0.0);
     } else {
         color = sample_level(unpack_level(in.face0, in.face1), bary);

@@ -13,7 +13,7 @@ use std::process::Command;
 use std::sync::Mutex;
 
 use glam::Mat4;
-use meshpaint::colors::layout::Resolution;
+use meshpaint::colors::layout::{self, Resolution};
 use meshpaint::colors::store::{ColorStore, SampleRef};
 use meshpaint::io::document::Document;
 use meshpaint::io::export_gltf::{ExportError, GENERATOR, export_tessellated_glb, write_tessellated_glb};
@@ -130,12 +130,43 @@ fn expected_vertices(store: &ColorStore) -> u64 {
     for face in 0..topology.face_count() {
         let res = u64::from(store.face_resolution(face).unwrap().get());
         count += (res - 1) * res.saturating_sub(2) / 2;
+        // One centroid vertex per fanned sub-triangle.
+        count += fanned(store, face);
     }
     count
 }
 
+/// `R_e / R_f` of each face edge of `face` (> 1: a fine side, fanned sub-triangles).
+fn ratios(store: &ColorStore, face: u32) -> [u32; 3] {
+    let rf = store.face_resolution(face).unwrap().get();
+    store.topology().face_edges[face as usize].map(|e| store.edge_resolution(e).unwrap().get() / rf)
+}
+
+/// Fanned sub-triangles of `face` by inclusion–exclusion: `R_f` lower sub-triangles along
+/// each fine edge, minus the corner sub-triangles counted twice (R_f ≥ 2); at R_f = 1
+/// the single sub-triangle when any edge is fine.
+fn fanned(store: &ColorStore, face: u32) -> u64 {
+    let rf = u64::from(store.face_resolution(face).unwrap().get());
+    let fine = ratios(store, face).map(|m| m > 1);
+    if rf == 1 {
+        return u64::from(fine.iter().any(|&f| f));
+    }
+    let along: u64 = fine.iter().map(|&f| u64::from(f) * rf).sum();
+    // Corner c0 joins edges 2 and 0, c1 edges 0 and 1, c2 edges 1 and 2.
+    let corners = [(2, 0), (0, 1), (1, 2)].iter().filter(|&&(a, b)| fine[a] && fine[b]).count() as u64;
+    along - corners
+}
+
+/// Triangles: `R_f²` per face; a fan replaces one sub-triangle by 3 triangles plus one
+/// per extra segment of its fine sides: `R_f² + 2·fanned + Σ_k (R_e − R_f)`.
+fn expected_face_triangles(store: &ColorStore, face: u32) -> u64 {
+    let rf = u64::from(store.face_resolution(face).unwrap().get());
+    let extra: u64 = ratios(store, face).iter().map(|&m| rf * (u64::from(m) - 1)).sum();
+    rf * rf + 2 * fanned(store, face) + extra
+}
+
 fn expected_triangles(store: &ColorStore) -> u64 {
-    store.face_resolutions().iter().map(|res| u64::from(res.get()).pow(2)).sum()
+    (0..store.topology().face_count()).map(|f| expected_face_triangles(store, f)).sum()
 }
 
 // ---------------------------------------------------------------------------------------
@@ -244,11 +275,64 @@ fn check_round_trip(case: &Painted) -> SourceMesh {
     let mut vertex_of: HashMap<SampleRef, u32> = HashMap::new();
     let mut sample_of: HashMap<u32, SampleRef> = HashMap::new();
     let mut t = 0usize;
+    let mut centroids = 0usize;
     for face in 0..topology.face_count() {
         let res = store.face_resolution(face).unwrap().get();
         let corners = topology.face_vertices[face as usize].map(|v| case.positions[v as usize]);
+        let fine = ratios(store, face);
         for i in 0..res {
             for j in 0..res - i {
+                let on_side = [j == 0, i + j + 1 == res, i == 0];
+                if (0..3).any(|k| on_side[k] && fine[k] > 1) {
+                    // A fan from the centroid G: per side (i,j)→(i+1,j)→(i,j+1)→(i,j), one
+                    // triangle (G, a, b) per segment; a fine side's segments join the
+                    // edge's consecutive samples.
+                    let g = mesh.triangles[t][0];
+                    let ends = [(i, j), (i + 1, j), (i, j + 1)];
+                    let end_colors = ends.map(|(a, b)| store.face_sample(face, a, b).unwrap());
+                    let mean: [f32; 4] =
+                        std::array::from_fn(|c| (end_colors[0][c] + end_colors[1][c] + end_colors[2][c]) / 3.0);
+                    assert_eq!(mesh.colors[g as usize], mean, "{name}: face {face} ({i}, {j}) centroid colour");
+                    assert!(!sample_of.contains_key(&g), "{name}: the centroid is a vertex of its own");
+                    centroids += 1;
+                    for side in 0..3 {
+                        let m = if on_side[side] { fine[side] } else { 1 };
+                        let edge = topology.face_edges[face as usize][side];
+                        let r_edge = store.edge_resolution(edge).unwrap();
+                        let q = [i, j, res - j - 1][side];
+                        for n in 0..m {
+                            let got = mesh.triangles[t];
+                            t += 1;
+                            assert_eq!(got[0], g, "{name}: face {face} ({i}, {j}): one centroid per fan");
+                            for (slot, k) in [(1usize, n), (2, n + 1)] {
+                                let sample = if k == 0 {
+                                    store.face_sample_ref(face, ends[side].0, ends[side].1).unwrap()
+                                } else if k == m {
+                                    let (a, b) = ends[(side + 1) % 3];
+                                    store.face_sample_ref(face, a, b).unwrap()
+                                } else {
+                                    let p = q * m + k;
+                                    let reversed = topology.is_reversed(face, side);
+                                    SampleRef::Edge { edge, offset: layout::edge_storage_offset(r_edge, p, reversed) }
+                                };
+                                let vertex = got[slot];
+                                assert_eq!(*vertex_of.entry(sample).or_insert(vertex), vertex, "{name}: {sample:?}");
+                                assert_eq!(*sample_of.entry(vertex).or_insert(sample), sample, "{name}: {vertex}");
+                                assert_eq!(mesh.colors[vertex as usize], store.get(sample).unwrap(), "{name}");
+                            }
+                        }
+                    }
+                    if i + j + 2 <= res {
+                        // The upper neighbour follows as usual.
+                        let got = mesh.triangles[t];
+                        t += 1;
+                        for (k, (a, b)) in [(i + 1, j), (i + 1, j + 1), (i, j + 1)].into_iter().enumerate() {
+                            let sample = store.face_sample_ref(face, a, b).unwrap();
+                            assert_eq!(*vertex_of.entry(sample).or_insert(got[k]), got[k], "{name}: {sample:?}");
+                        }
+                    }
+                    continue;
+                }
                 let mut expected = vec![[(i, j), (i + 1, j), (i, j + 1)]];
                 if i + j + 2 <= res {
                     expected.push([(i + 1, j), (i + 1, j + 1), (i, j + 1)]);
@@ -287,7 +371,7 @@ fn check_round_trip(case: &Painted) -> SourceMesh {
         }
     }
     assert_eq!(t, mesh.triangles.len());
-    assert_eq!(sample_of.len(), vertices, "{name}: every vertex is used");
+    assert_eq!(sample_of.len() + centroids, vertices, "{name}: every vertex is used");
     mesh
 }
 
@@ -314,10 +398,12 @@ fn round_trip_at_uniform_resolution_matches_the_closed_form() {
 fn round_trip_with_mixed_resolutions() {
     for case in [mixed_grid(11), mixed_box(12)] {
         let mesh = check_round_trip(&case);
+        let centroids: u64 = (0..case.store.topology().face_count()).map(|f| fanned(&case.store, f)).sum();
+        assert!(centroids > 0, "{}: the mixed stores have fine sides", case.name);
         assert_eq!(
             mesh.positions_local.len() as u64,
-            case.store.sample_count(),
-            "{}: every stored sample is read",
+            case.store.sample_count() + centroids,
+            "{}: every stored sample is read, plus one centroid per fan",
             case.name
         );
     }
@@ -382,13 +468,15 @@ fn face_triangles(
     range: std::ops::Range<usize>,
     corners: [[f32; 3]; 3],
     res: u32,
+    grid: u32,
 ) -> Vec<LatticeTriangle> {
+    let g = f64::from(grid);
     mesh.triangles[range]
         .iter()
         .map(|triangle| {
             let coords = triangle.map(|vertex| {
                 let (u, v) = lattice_coords(mesh.positions_local[vertex as usize], corners, res);
-                let (ru, rv) = (u.round(), v.round());
+                let (ru, rv) = ((u * g).round() / g, (v * g).round() / g);
                 assert!(
                     (u - ru).abs() < 1e-3 && (v - rv).abs() < 1e-3,
                     "vertex {vertex} at ({u}, {v}) is not a lattice point"
@@ -415,8 +503,8 @@ fn check_linear_filter(case: &Painted, points: usize, seed: u64) {
     let mesh = import_gltf_slice(&bytes, None, "linear.glb").unwrap().meshes.remove(0);
     let topology = store.topology();
     let mut starts = vec![0usize];
-    for res in store.face_resolutions() {
-        starts.push(starts.last().unwrap() + (res.get() * res.get()) as usize);
+    for face in 0..topology.face_count() {
+        starts.push(starts.last().unwrap() + expected_face_triangles(store, face) as usize);
     }
     let mut rng = SplitMix64(seed);
     let mut checked = 0;
@@ -428,16 +516,28 @@ fn check_linear_filter(case: &Painted, points: usize, seed: u64) {
         if !well_shaped(corners) {
             continue;
         }
+        let fine = ratios(store, face);
+        let grid = 3 * fine.iter().copied().max().unwrap();
         let triangles = cache.entry(face).or_insert_with(|| {
-            let triangles = face_triangles(&mesh, starts[face as usize]..starts[face as usize + 1], corners, res);
-            // The sub-triangles tile the face with its winding: all positive, total R²/2.
+            let range = starts[face as usize]..starts[face as usize + 1];
+            // Without fine sides: lattice points; with them, fan centroids sit at thirds and
+            // fine edge samples at 1/m of the lattice.
+            let triangles = face_triangles(&mesh, range, corners, res, if grid == 3 { 1 } else { grid });
+            // The triangles tile the face with its winding: all positive, total R²/2.
             let mut total = 0.0;
             for (coords, _) in &triangles {
                 let (_, area) = barycentric_2d(*coords, 0.0, 0.0);
-                assert_eq!(area, 1.0, "{name}: face {face}: a unit sub-triangle with the face's winding");
+                if grid == 3 {
+                    assert_eq!(area, 1.0, "{name}: face {face}: a unit sub-triangle with the face's winding");
+                } else {
+                    assert!(area > 0.0, "{name}: face {face}: a fan triangle with the face's winding");
+                }
                 total += area / 2.0;
             }
-            assert_eq!(total, f64::from(res * res) / 2.0, "{name}: face {face}: the sub-triangles cover the face");
+            assert!(
+                (total - f64::from(res * res) / 2.0).abs() < 1e-9 * f64::from(res * res),
+                "{name}: face {face}: the sub-triangles cover the face"
+            );
             triangles
         });
         // Dyadic barycentrics (20 bits) sum to 1 exactly in f32, so sanitising leaves them.
@@ -870,4 +970,81 @@ fn exported_glb_reopens_in_meshpaint_with_the_sample_colours_at_its_vertices() {
     }
     // Sampling the reopened mesh at R = 1 with the linear filter is what the source shows.
     assert_eq!(reopened.store.topology().face_count() as usize, tessellation.triangles.len());
+}
+
+/// Seams, independently of the sampler: for every exported triangle edge, every exported
+/// vertex lying on it (a T-junction) must carry the colour the edge shows there — the
+/// linear interpolation of the edge's endpoint colours. The seamless export has no such
+/// vertex at all (no T-junctions); colours are checked for any that would exist.
+#[test]
+fn exported_triangle_edges_have_no_t_junctions_and_show_their_endpoint_interpolation() {
+    use meshpaint::io::export_gltf::tessellate;
+    let fins = {
+        let topology =
+            meshpaint::mesh::topology::Topology::build(6, &[[0, 1, 2], [1, 0, 3], [0, 1, 4], [2, 1, 5]]).unwrap();
+        let positions =
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.5, -1.0, 0.0], [0.5, 0.0, 1.0], [1.5, 1.0, 0.0]];
+        let mut store = ColorStore::with_resolutions(topology, [2, 32, 8, 1].map(r).to_vec(), [0.0; 4]).unwrap();
+        let mut rng = Rng(31);
+        store.fill_with(|_| rng.color());
+        Painted { name: "fins".into(), positions, store }
+    };
+    for case in [mixed_grid(41), mixed_box(42), fins] {
+        let t = tessellate(&case.positions, &case.store).unwrap();
+        let p = |v: u32| glam::DVec3::from_array(t.positions[v as usize].map(f64::from));
+        // Spatial hash of the vertices (cells of 1/64 of the bounding box).
+        let (mut lo, mut hi) = (glam::DVec3::splat(f64::INFINITY), glam::DVec3::splat(f64::NEG_INFINITY));
+        for v in 0..t.positions.len() as u32 {
+            lo = lo.min(p(v));
+            hi = hi.max(p(v));
+        }
+        let cell = ((hi - lo).max_element() / 64.0).max(1e-9);
+        let key = |q: glam::DVec3| ((q - lo) / cell).floor().as_ivec3();
+        let mut grid: HashMap<glam::IVec3, Vec<u32>> = HashMap::new();
+        for v in 0..t.positions.len() as u32 {
+            grid.entry(key(p(v))).or_default().push(v);
+        }
+        let mut edges = BTreeSet::new();
+        for tri in &t.triangles {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                edges.insert((a.min(b), a.max(b)));
+            }
+        }
+        let (mut on_edges, mut worst) = (0usize, 0.0f64);
+        for &(a, b) in &edges {
+            let (pa, pb) = (p(a), p(b));
+            let (k0, k1) = (key(pa.min(pb)), key(pa.max(pb)));
+            let length2 = (pb - pa).length_squared();
+            for x in k0.x..=k1.x {
+                for y in k0.y..=k1.y {
+                    for z in k0.z..=k1.z {
+                        for &v in grid.get(&glam::IVec3::new(x, y, z)).map_or(&[][..], Vec::as_slice) {
+                            if v == a || v == b {
+                                continue;
+                            }
+                            let s = (p(v) - pa).dot(pb - pa) / length2;
+                            let off = (pa + (pb - pa) * s - p(v)).length_squared();
+                            if s <= 1e-9 || s >= 1.0 - 1e-9 || off > 1e-12 * length2 {
+                                continue;
+                            }
+                            on_edges += 1;
+                            for c in 0..4 {
+                                let (ca, cb) = (f64::from(t.colors[a as usize][c]), f64::from(t.colors[b as usize][c]));
+                                let want = ca + (cb - ca) * s;
+                                worst = worst.max((f64::from(t.colors[v as usize][c]) - want).abs());
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        println!(
+            "{}: {} triangle edges, {on_edges} vertices on them, worst colour difference {worst:.3e}",
+            case.name,
+            edges.len()
+        );
+        assert!(worst <= 1e-6, "{}: a vertex on an edge shows another colour ({worst})", case.name);
+        assert_eq!(on_edges, 0, "{}: T-junctions", case.name);
+    }
 }

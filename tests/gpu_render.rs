@@ -747,3 +747,61 @@ fn no_adapter_is_an_error() {
     assert!(!output.status.success(), "{stderr}");
     assert!(stderr.contains("no GPU adapter"), "{stderr}");
 }
+
+/// Whether the linear reference at `bary` moves by more than ⅓ of an 8-bit step (in linear
+/// units) when the barycentrics move by `BARY_NOISE`, the interpolation error of a
+/// rasteriser on triangles thousands of pixels wide: at R = 4096 one lattice unit is a
+/// pixel and random colours change by up to 1 per unit, so such pixels cannot be called.
+fn ill_conditioned(packed: &PackedMesh, face: u32, bary: [f32; 3], level: u32) -> bool {
+    const BARY_NOISE: f32 = 5e-7;
+    let Some(center) = sample(packed, face, bary, Filter::Linear, level) else {
+        return true;
+    };
+    let d = BARY_NOISE;
+    let moves: [[f32; 3]; 6] = [[-d, d, 0.0], [d, -d, 0.0], [-d, 0.0, d], [d, 0.0, -d], [0.0, d, -d], [0.0, -d, d]];
+    moves.iter().any(|m| {
+        let moved = sample(packed, face, std::array::from_fn(|k| (bary[k] + m[k]).max(0.0)), Filter::Linear, level);
+        moved.is_none_or(|c| (0..4).any(|ch| (c[ch] - center[ch]).abs() > 1.0 / (3.0 * 255.0)))
+    })
+}
+
+/// The seam rule on the GPU: a view zoomed onto an edge shared by faces of different
+/// resolution (both sides of the edge fill the image), every fixed level, compared per
+/// pixel with the CPU reference — which itself agrees across the edge (tests/seams.rs).
+#[test]
+fn zoomed_mixed_resolution_seams_match_the_cpu_reference() {
+    // The shared edge 1–2 passes through the image centre (128, 128); the faces extend far
+    // beyond the image, so pixels near the edge cover a few of the fine face's samples.
+    let pixels = [[-2600.0, -2500.0], [2128.0, -1972.0], [-1772.0, 2123.0], [2700.0, 2600.0]];
+    let mut failures = Vec::new();
+    for (ra, rb, formats) in [
+        (64u64, 4u64, &ColorFormat::ALL[..]),
+        (2, 32, &[ColorFormat::Rgba8Srgb][..]),
+        (1, 16, &[ColorFormat::Rgba16F][..]),
+        (4096, 2, &[ColorFormat::Rgba8Srgb][..]),
+    ] {
+        let scene = square_scene(&pixels, vec![[0, 1, 2], [2, 1, 3]], vec![r(ra), r(rb)], [0.0, 0.0, 0.0], ra * 7 + rb);
+        let max_log2 = r(ra).log2().max(r(rb).log2());
+        for &format in formats {
+            let packed = scene.packed(format);
+            let mesh = upload(&packed, None);
+            let mut filters = vec![(FilterMode::Linear, 0)];
+            filters.extend((0..=max_log2 + 1).map(|level| (FilterMode::MipLevel(level), level)));
+            for (mode, level) in filters {
+                let name = format!("seam R={ra}|{rb} {} {}", format.name(), filter_name(mode));
+                let stats = compare(
+                    &name,
+                    &scene,
+                    &mesh,
+                    mode,
+                    |face, bary| sample(&packed, face, bary, Filter::Linear, level),
+                    |face, bary| ill_conditioned(&packed, face, bary, level),
+                );
+                if stats.over_limit > 0 || stats.coverage_errors > 0 || stats.compared < 30_000 {
+                    failures.push(format!("{name}: {stats:?}"));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}

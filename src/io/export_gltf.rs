@@ -8,8 +8,15 @@
 //! - **one vertex per sample** that a face reads. Samples shared between faces (mesh
 //!   vertices, edge samples) become one shared glTF vertex, keyed by the store's
 //!   [`SampleRef`]; a face coarser than its edge reads the edge with stride (exactly the
-//!   samples [`ColorStore::face_sample_ref`] returns), so its lattice joins the finer
-//!   neighbour's at every other (every `R_e / R_f`-th) edge vertex;
+//!   samples [`ColorStore::face_sample_ref`] returns) at its lattice points, and
+//!   - **seams**: every sub-triangle of a face with a side on a finer edge (`R_e > R_f`, a
+//!     "fine side") is fanned from its centroid instead (the seam rule of
+//!     [`crate::packing::sampler`]): one extra vertex at the centroid with the mean colour
+//!     of the sub-triangle's three corners, and one triangle from it to each segment of the
+//!     sub-triangle's boundary — a fine side contributes its `R_e / R_f` segments between
+//!     consecutive edge samples (the same glTF vertices the finer face uses), any other
+//!     side one segment. So no exported vertex lies inside another triangle's edge (no
+//!     T-junctions) and the fan is exactly the sampler's linear filter;
 //! - `POSITION` (float VEC3, with the `min`/`max` glTF requires): sample `(i, j)` of a face
 //!   with corners `c0, c1, c2` at resolution `R` sits at
 //!   `((R − i − j)/R)·c0 + (i/R)·c1 + (j/R)·c2`, computed in `f64` and rounded to `f32`;
@@ -18,8 +25,10 @@
 //!   forbids; the store's exact-inverse reduction can overshoot) are clamped to it;
 //! - indices (unsigned short when every index fits, else unsigned int): for each face in
 //!   face order, for `i` in `0..R`, for `j` in `0..R − i`, the sub-triangle
-//!   `(i, j), (i+1, j), (i, j+1)` and then, when `i + j ≤ R − 2`, the sub-triangle
-//!   `(i+1, j), (i+1, j+1), (i, j+1)` — `R²` triangles per face, with the face's winding;
+//!   `(i, j), (i+1, j), (i, j+1)` (or its fan, sides in the order (i,j)→(i+1,j)→(i,j+1)→(i,j),
+//!   each triangle `(G, start, end)`) and then, when `i + j ≤ R − 2`, the sub-triangle
+//!   `(i+1, j), (i+1, j+1), (i, j+1)` — `R²` triangles per face without fine sides, with the
+//!   face's winding;
 //! - a material with metallic factor 0 and roughness factor 1, so that viewers show the
 //!   colours as diffuse colour; no `NORMAL` (glTF viewers then use flat normals).
 //!
@@ -129,9 +138,10 @@ pub struct Tessellation {
     pub positions: Vec<[f32; 3]>,
     /// Vertex colours: the sample colours, linear RGBA, clamped to `[0, 1]`.
     pub colors: Vec<[f32; 4]>,
-    /// The sample each vertex shows.
-    pub samples: Vec<SampleRef>,
-    /// Triangles, `R_f²` per face in face order (see the module documentation).
+    /// The sample each vertex shows (`None`: the centroid of a fanned sub-triangle).
+    pub samples: Vec<Option<SampleRef>>,
+    /// Triangles in face order (`R_f²` per face without fine sides; see the module
+    /// documentation).
     pub triangles: Vec<[u32; 3]>,
 }
 
@@ -153,11 +163,56 @@ pub fn tessellation_counts(store: &ColorStore) -> (u64, u64) {
     for edge in 0..topology.edge_count() {
         vertices += store.edge_samples(edge).len() as u64;
     }
-    for &r in store.face_resolutions() {
+    for (face, &r) in store.face_resolutions().iter().enumerate() {
         vertices += u64::from(layout::interior_sample_count(r));
-        triangles += u64::from(r.get()) * u64::from(r.get());
+        let (fanned, fan_triangles) = fan_counts(&fine_ratios(store, face as u32), r.get());
+        vertices += fanned;
+        triangles += u64::from(r.get()) * u64::from(r.get()) - fanned + fan_triangles;
     }
     (vertices, triangles)
+}
+
+/// `R_e / R_f` of each face edge of `face` (1: not a fine side).
+fn fine_ratios(store: &ColorStore, face: u32) -> [u32; 3] {
+    let r_face = store.face_resolution(face).map_or(1, Resolution::get);
+    let edges = store.topology().face_edges.get(face as usize).copied().unwrap_or([u32::MAX; 3]);
+    edges.map(|edge| (store.edge_resolution(edge).map_or(1, Resolution::get) / r_face).max(1))
+}
+
+/// The face edge (if any) on which side `side` (0: (i,j)→(i+1,j), 1: (i+1,j)→(i,j+1),
+/// 2: (i,j+1)→(i,j)) of the lower sub-triangle at `(i, j)` lies, at resolution `res`.
+fn side_on_edge(res: u32, i: u32, j: u32, side: usize) -> bool {
+    match side {
+        0 => j == 0,
+        1 => i + j + 1 == res,
+        _ => i == 0,
+    }
+}
+
+/// Segments of each side of the lower sub-triangle at `(i, j)`: `R_e / R_f` on a fine
+/// side, else 1; `None` when the sub-triangle has no fine side (not fanned).
+fn fan_segments(ratios: &[u32; 3], res: u32, i: u32, j: u32) -> Option<[u32; 3]> {
+    let segments: [u32; 3] = std::array::from_fn(|side| if side_on_edge(res, i, j, side) { ratios[side] } else { 1 });
+    segments.iter().any(|&m| m > 1).then_some(segments)
+}
+
+/// Fanned sub-triangles of a face and the triangles their fans have (only lower
+/// sub-triangles along the boundary can be fanned).
+fn fan_counts(ratios: &[u32; 3], res: u32) -> (u64, u64) {
+    let mut boundary: Vec<(u32, u32)> = Vec::with_capacity(3 * res as usize);
+    for q in 0..res {
+        boundary.extend([(q, 0), (res - 1 - q, q), (0, q)]);
+    }
+    boundary.sort_unstable();
+    boundary.dedup();
+    let (mut fanned, mut triangles) = (0u64, 0u64);
+    for (i, j) in boundary {
+        if let Some(segments) = fan_segments(ratios, res, i, j) {
+            fanned += 1;
+            triangles += segments.iter().map(|&m| u64::from(m)).sum::<u64>();
+        }
+    }
+    (fanned, triangles)
 }
 
 /// Marks a sample that has no glTF vertex yet.
@@ -192,6 +247,8 @@ fn check_limits(vertices: u64, triangles: u64) -> Result<(), ExportError> {
 }
 
 /// Tessellates `store` on `positions` (one per store vertex): see the module documentation.
+/// Long: one pass over the faces that checks the limits, shares vertices through the slot
+/// maps and writes lattice and fan triangles; the fans themselves are [`Fan::emit`].
 pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessellation, ExportError> {
     let topology = store.topology();
     if topology.face_count() == 0 {
@@ -263,7 +320,7 @@ pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessella
                     let index = out.positions.len() as u32;
                     out.positions.push(lattice_position(&corner_positions, r, i, j));
                     out.colors.push(color.map(|c| c.clamp(0.0, 1.0)));
-                    out.samples.push(sample);
+                    out.samples.push(Some(sample));
                     if let Some(slot) = slot {
                         *slot = index;
                     }
@@ -277,9 +334,16 @@ pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessella
             let row = (i as usize * (2 * res as usize + 3 - i as usize)) / 2;
             lattice.get(row + j as usize).copied().unwrap_or(0)
         };
+        let ratios = fine_ratios(store, face);
         for i in 0..res {
             for j in 0..res - i {
-                out.triangles.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
+                if let Some(segments) = fan_segments(&ratios, res, i, j) {
+                    let ends = [at(i, j), at(i + 1, j), at(i, j + 1)];
+                    let fan = Fan { face, res, i, j, ends, segments, corner_positions: &corner_positions };
+                    fan.emit(store, &edge_base, &mut edge_slots, &mut out)?;
+                } else {
+                    out.triangles.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
+                }
                 if i + j + 2 <= res {
                     out.triangles.push([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
                 }
@@ -287,6 +351,94 @@ pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessella
         }
     }
     Ok(out)
+}
+
+/// One fanned sub-triangle `(i, j), (i+1, j), (i, j+1)` of `face` (module documentation).
+struct Fan<'a> {
+    face: u32,
+    res: u32,
+    i: u32,
+    j: u32,
+    /// glTF vertices of the three corners.
+    ends: [u32; 3],
+    /// Segments of each side (`R_e / R_f` on a fine side, else 1).
+    segments: [u32; 3],
+    corner_positions: &'a [[f32; 3]; 3],
+}
+
+impl Fan<'_> {
+    /// Appends the centroid vertex, the fan triangles and any edge-sample vertex not
+    /// yet written (shared through `edge_slots` with the finer face).
+    fn emit(
+        &self,
+        store: &ColorStore,
+        edge_base: &[usize],
+        edge_slots: &mut [u32],
+        out: &mut Tessellation,
+    ) -> Result<(), ExportError> {
+        let Fan { face, res, i, j, ends, segments, corner_positions } = *self;
+        let topology = store.topology();
+        let corner_colors = ends.map(|v| out.colors.get(v as usize).copied().unwrap_or([0.0; 4]));
+        let centroid = out.positions.len() as u32;
+        let w = [f64::from(3 * (res - i - j) - 2), f64::from(3 * i + 1), f64::from(3 * j + 1)]
+            .map(|w| w / f64::from(3 * res));
+        out.positions.push(std::array::from_fn(|a| {
+            (w[0] * f64::from(corner_positions[0][a])
+                + w[1] * f64::from(corner_positions[1][a])
+                + w[2] * f64::from(corner_positions[2][a])) as f32
+        }));
+        out.colors
+            .push(std::array::from_fn(|c| (corner_colors[0][c] + corner_colors[1][c] + corner_colors[2][c]) / 3.0));
+        out.samples.push(None);
+        for side in 0..3 {
+            let (start, end) = (ends[side], ends[(side + 1) % 3]);
+            let m = segments[side];
+            if m == 1 {
+                out.triangles.push([centroid, start, end]);
+                continue;
+            }
+            // Side `side` lies on face edge `side`; its start corner sits at position q of
+            // the face's lattice along that edge.
+            let q = [i, j, res - j - 1][side];
+            let edge = topology.face_edges.get(face as usize).map_or(u32::MAX, |e| e[side]);
+            let Some(r_edge) = store.edge_resolution(edge) else {
+                return Err(ExportError::MissingSample { face, i, j });
+            };
+            let reversed = topology.is_reversed(face, side);
+            let mut previous = start;
+            for n in 1..=m {
+                let vertex = if n == m {
+                    end
+                } else {
+                    let p = q * m + n;
+                    let offset = layout::edge_storage_offset(r_edge, p, reversed);
+                    let (fi, fj) = layout::edge_sample_coords(r_edge, side as u8, p);
+                    let missing = ExportError::MissingSample { face, i: fi, j: fj };
+                    let slot_index = edge_base.get(edge as usize).map(|&b| b + offset as usize);
+                    let Some(slot) = slot_index.and_then(|k| edge_slots.get_mut(k)) else {
+                        return Err(missing);
+                    };
+                    if *slot == UNASSIGNED {
+                        let sample = SampleRef::Edge { edge, offset };
+                        let Some(color) = store.get(sample) else {
+                            return Err(missing);
+                        };
+                        if !color.iter().all(|c| c.is_finite()) {
+                            return Err(ExportError::NonFiniteColor { face, i: fi, j: fj });
+                        }
+                        *slot = out.positions.len() as u32;
+                        out.positions.push(lattice_position(corner_positions, r_edge, fi, fj));
+                        out.colors.push(color.map(|c| c.clamp(0.0, 1.0)));
+                        out.samples.push(Some(sample));
+                    }
+                    *slot
+                };
+                out.triangles.push([centroid, previous, vertex]);
+                previous = vertex;
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Position of lattice point `(i, j)` on the face with `corners` at resolution `r`:

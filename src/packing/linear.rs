@@ -26,7 +26,8 @@
 //! The edge direction needs no bit: an edge's canonical direction runs from the lower to
 //! the higher vertex id, and the shader has both ids from the index buffer. A face with
 //! `R_f < R_e` reads the edge with stride `R_e / R_f` at the same level, so both faces see
-//! identical values at shared sample positions. Bases must stay below `2^28` samples
+//! identical values at shared sample positions; between them the seam rule of
+//! [`crate::packing::sampler`] interpolates the edge's own samples. Bases must stay below `2^28` samples
 //! ([`MAX_SAMPLES`]), 1 GiB of RGBA8.
 
 use bytemuck::{Pod, Zeroable};

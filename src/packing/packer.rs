@@ -18,11 +18,15 @@
 //! - **interior** (eq. 2.6): `C'_ij = ¼ (C_(2i)(2j) + ½ Σ six neighbours)`; the six
 //!   neighbours of an interior point of level `l` are interior points of level `l − 1`.
 //! - **edge** (eq. 2.6 on the edge): the centre, its two neighbours along the edge (an
-//!   endpoint vertex at the ends) and, for every incident face whose resolution equals the
-//!   edge's, that face's two interior neighbours. A manifold edge takes 6 neighbours
-//!   (weight ¼, exactly eq. 2.6), a **boundary** edge 4 (weight ⅓), a **non-manifold** edge
-//!   with `k` such faces `2 + 2k` (weight `1/(2 + k)`). Coarser faces have no samples at
-//!   those positions and do not contribute.
+//!   endpoint vertex at the ends) and, for every incident face, that face's two lattice
+//!   neighbours inside it at the edge's level-`(l − 1)` spacing. A face whose resolution
+//!   equals the edge's has interior samples there; a **coarser** face has none, and
+//!   contributes what it shows there at level `l − 1` — its linear filter with the seam
+//!   rule ([`crate::packing::sampler`]), so the chain filters the same reconstruction the
+//!   sampler draws. A manifold edge thus always takes 6 neighbours (weight ¼, exactly
+//!   eq. 2.6), a **boundary** edge 4 (weight ⅓), a **non-manifold** edge with `k` faces
+//!   `2 + 2k` (weight `1/(2 + k)`). Equal-resolution faces come first, coarser ones after
+//!   (so meshes of one resolution give the same bytes as before coarser faces counted).
 
 use thiserror::Error;
 
@@ -31,6 +35,7 @@ use crate::colors::layout::{self, Resolution};
 use crate::colors::store::{ColorStore, SampleRef};
 use crate::mesh::topology::{Topology, TopologyError};
 use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
+use crate::packing::sampler::{self, Filter, MeshColorSource};
 
 /// Errors of packing and unpacking.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -253,11 +258,73 @@ struct EdgeInfo {
     vertices: [u32; 2],
     /// Incident faces at the edge's resolution: (interior chain base, face edge, reversed).
     full_faces: Vec<(usize, u8, bool)>,
+    /// Incident faces coarser than the edge: (face, face edge, reversed).
+    coarse_faces: Vec<(u32, u8, bool)>,
+}
+
+/// The colour buffer while the edge and vertex chains are being built, read through the
+/// sampler's addressing (every level below the one being built is final).
+struct ChainsView<'a> {
+    store: &'a ColorStore,
+    records: &'a [FaceRecord],
+    vertex_levels: u32,
+    vertex_colors: &'a [Rgba],
+    edge_colors: &'a [Rgba],
+    interior_colors: &'a [Rgba],
+    vertex_section: usize,
+    interior_start: usize,
+}
+
+impl ChainsView<'_> {
+    fn at(&self, index: u64) -> Option<Rgba> {
+        let index = usize::try_from(index).ok()?;
+        if index < self.vertex_section {
+            self.vertex_colors.get(index).copied()
+        } else if index < self.interior_start {
+            self.edge_colors.get(index - self.vertex_section).copied()
+        } else {
+            self.interior_colors.get(index - self.interior_start).copied()
+        }
+    }
+}
+
+impl MeshColorSource for ChainsView<'_> {
+    fn face_resolution(&self, face: u32) -> Option<Resolution> {
+        self.store.face_resolution(face)
+    }
+
+    fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
+        let record = self.records.get(face as usize)?;
+        let corners = self.store.topology().face_vertices.get(face as usize)?;
+        self.at(sampler::record_sample_index(record, corners, self.vertex_levels, level, i, j)?)
+    }
+
+    fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution> {
+        Some(self.records.get(face as usize)?.edge(usize::from(k))?.1)
+    }
+
+    fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba> {
+        let record = self.records.get(face as usize)?;
+        let corners = self.store.topology().face_vertices.get(face as usize)?;
+        self.at(sampler::record_edge_index(record, corners, k, level, p)?)
+    }
+}
+
+/// The two lattice neighbours strictly inside the face of the point at position `p`
+/// along face edge `face_edge`, on a lattice of resolution `rp` (LATTICE_DIRECTIONS order).
+fn inside_neighbours(face_edge: u8, p: usize, rp: usize) -> [(usize, usize); 2] {
+    match face_edge {
+        0 => [(p, 1), (p - 1, 1)],
+        1 => [(rp - p - 1, p), (rp - p, p - 1)],
+        _ => [(1, rp - p), (1, rp - p - 1)],
+    }
 }
 
 /// Edge MIP levels (eq. 2.6 on edges) and vertex MIP levels (eq. 2.5), level by level.
 /// The buffer splits into vertex / edge / interior sections: a pass writes one section
 /// in parallel chunks while reading the others.
+/// Long: one level loop over three borrowed sections (coarse-face neighbours, edges,
+/// vertices in parallel chunks); splitting it would re-split the buffer per helper.
 fn reduce_edges_and_vertices(store: &ColorStore, layout: &PackLayout, colors: &mut [Rgba], threads: usize) {
     let topology = store.topology();
     let levels = layout.vertex_levels as usize;
@@ -273,11 +340,18 @@ fn reduce_edges_and_vertices(store: &ColorStore, layout: &PackLayout, colors: &m
                     (layout.interior_base[face as usize] as usize, k, topology.is_reversed(face, usize::from(k)))
                 })
                 .collect();
+            let coarse_faces = topology
+                .faces_of_edge(edge)
+                .iter()
+                .filter(|&&(face, _)| store.face_resolution(face) != Some(r_edge))
+                .map(|&(face, k)| (face, k, topology.is_reversed(face, usize::from(k))))
+                .collect();
             EdgeInfo {
                 log2: r_edge.log2(),
                 base: layout.edge_base[edge as usize] as usize,
                 vertices: topology.edge_vertices[edge as usize],
                 full_faces,
+                coarse_faces,
             }
         })
         .collect();
@@ -292,15 +366,29 @@ fn reduce_edges_and_vertices(store: &ColorStore, layout: &PackLayout, colors: &m
     let interior_colors: &[Rgba] = interior_colors;
     let interior_start = edge_section_end;
     let (vertex_edge_offsets, vertex_edge_list) = vertex_edges(topology);
+    let records: Vec<FaceRecord> = (0..topology.face_count()).map(|f| layout.face_record(store, f)).collect();
     for level in 1..levels {
         let previous = level - 1;
+        let coarse_neighbours = {
+            let view = ChainsView {
+                store,
+                records: &records,
+                vertex_levels: layout.vertex_levels,
+                vertex_colors: &*vertex_colors,
+                edge_colors: &*edge_colors,
+                interior_colors,
+                vertex_section,
+                interior_start,
+            };
+            coarse_neighbours(&view, &edges, level as u32)
+        };
         // Edges: each edge's chain is its own slice.
         {
             let vertex_colors: &[Rgba] = vertex_colors;
-            let mut chains: Vec<(&EdgeInfo, &mut [Rgba])> = Vec::with_capacity(edges.len());
+            let mut chains: Vec<(&EdgeInfo, &[Rgba], &mut [Rgba])> = Vec::with_capacity(edges.len());
             let mut rest: &mut [Rgba] = edge_colors;
             let mut cursor = vertex_section;
-            for info in &edges {
+            for (n, info) in edges.iter().enumerate() {
                 let len = layout::edge_chain_len(Resolution::from_log2(info.log2).unwrap_or(Resolution::ONE)) as usize;
                 if len == 0 {
                     continue;
@@ -309,13 +397,14 @@ fn reduce_edges_and_vertices(store: &ColorStore, layout: &PackLayout, colors: &m
                 let (chain, tail) = tail.split_at_mut(len);
                 rest = tail;
                 cursor = info.base + len;
-                chains.push((info, chain));
+                chains.push((info, &coarse_neighbours[n], chain));
             }
             in_parallel(&mut chains, threads, |part| {
                 let mut neighbours: Vec<Rgba> = Vec::with_capacity(16);
-                for (info, chain) in part.iter_mut() {
+                for (info, coarse, chain) in part.iter_mut() {
                     reduce_edge_level(
                         info,
+                        coarse,
                         chain,
                         level as u32,
                         vertex_colors,
@@ -357,10 +446,38 @@ fn reduce_edges_and_vertices(store: &ColorStore, layout: &PackLayout, colors: &m
     }
 }
 
+/// What coarser faces show next to each edge sample of level `level − 1` (the seam rule):
+/// per edge, for `k` in `1..r_level`, two colours per coarse face.
+fn coarse_neighbours(view: &ChainsView, edges: &[EdgeInfo], level: u32) -> Vec<Vec<Rgba>> {
+    edges
+        .iter()
+        .map(|info| {
+            let mut out = Vec::new();
+            if info.coarse_faces.is_empty() || info.log2 < level + 1 {
+                return out;
+            }
+            let r_level = 1usize << (info.log2 - level);
+            let rp = 2 * r_level;
+            for k in 1..r_level {
+                for &(face, face_edge, reversed) in &info.coarse_faces {
+                    let p = if reversed { rp - 2 * k } else { 2 * k };
+                    for (i, j) in inside_neighbours(face_edge, p, rp) {
+                        let w = [(rp - i - j) as f32, i as f32, j as f32].map(|w| w / rp as f32);
+                        let color = sampler::sample(view, face, w, Filter::Linear, level - 1);
+                        out.push(color.unwrap_or([0.0; 4]));
+                    }
+                }
+            }
+            out
+        })
+        .collect()
+}
+
 /// Level `level` of one edge chain from level `level − 1`.
 #[allow(clippy::too_many_arguments)]
 fn reduce_edge_level(
     info: &EdgeInfo,
+    coarse: &[Rgba],
     chain: &mut [Rgba],
     level: u32,
     vertex_colors: &[Rgba],
@@ -410,6 +527,9 @@ fn reduce_edge_level(
                 neighbours.push(interior_colors[start + interior_row_start(rp, i) + j - 1]);
             }
         }
+        // Coarser faces: what they show at those two points (computed beforehand).
+        let per_k = 2 * info.coarse_faces.len();
+        neighbours.extend_from_slice(coarse.get((k as usize - 1) * per_k..k as usize * per_k).unwrap_or(&[]));
         chain[level_start + k as usize - 1] = mip_filter(center, neighbours);
     }
 }
