@@ -985,7 +985,7 @@ fn exported_triangle_edges_have_no_t_junctions_and_show_their_endpoint_interpola
         let positions =
             vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.5, -1.0, 0.0], [0.5, 0.0, 1.0], [1.5, 1.0, 0.0]];
         let mut store = ColorStore::with_resolutions(topology, [2, 32, 8, 1].map(r).to_vec(), [0.0; 4]).unwrap();
-        let mut rng = Rng(31);
+        let mut rng = SplitMix64(31);
         store.fill_with(|_| rng.color());
         Painted { name: "fins".into(), positions, store }
     };
