@@ -361,7 +361,7 @@ fn srgb8_encoding_rounds_to_the_nearest_code_in_encoded_space() {
 
 #[test]
 fn store_mip_sampling_matches_packed_sampling_at_every_level_within_quantisation() {
-    use meshpaint::packing::sampler::StoreMips;
+    use meshpaint::packing::packer::StoreMips;
     let (positions, store) = mixed_octahedron_store(21);
     let mips = StoreMips::new(&store).unwrap();
     let packed8 = pack(&store, &positions, ColorFormat::Rgba8Srgb).unwrap();

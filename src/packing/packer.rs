@@ -621,3 +621,35 @@ pub fn unpack(packed: &PackedMesh) -> Result<ColorStore, PackError> {
     store.take_dirty();
     Ok(store)
 }
+
+/// A store with its MIP chains evaluated in `f32`, for level-`l` reference sampling.
+#[derive(Debug, Clone)]
+pub struct StoreMips {
+    chains: PackedMesh,
+}
+
+impl StoreMips {
+    /// Evaluates every MIP chain of `store` (no quantisation).
+    pub fn new(store: &ColorStore) -> Result<Self, PackError> {
+        let positions = vec![[0.0f32; 3]; store.topology().vertex_count as usize];
+        Ok(StoreMips { chains: pack(store, &positions, ColorFormat::Rgba32F)? })
+    }
+}
+
+impl MeshColorSource for StoreMips {
+    fn face_resolution(&self, face: u32) -> Option<Resolution> {
+        self.chains.face_resolution(face)
+    }
+
+    fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
+        self.chains.lattice_color(face, level, i, j)
+    }
+
+    fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution> {
+        self.chains.edge_resolution(face, k)
+    }
+
+    fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba> {
+        self.chains.edge_color(face, k, level, p)
+    }
+}

@@ -5,7 +5,7 @@
 //! with the seam rule below) at requested MIP level `level`; [`sample_trilinear`] blends
 //! two levels. Sources ([`MeshColorSource`]):
 //! - [`ColorStore`]: level 0, read straight from the editable maps;
-//! - [`StoreMips`]: every level of a store, its MIP chains evaluated in full `f32`
+//! - [`crate::packing::packer::StoreMips`]: every level of a store, its MIP chains evaluated in full `f32`
 //!   (the packer's filters with RGBA32F, whose quantisation is the identity);
 //! - [`PackedMesh`]: every level of packed buffers in any colour format.
 //!
@@ -89,12 +89,10 @@
 //!   extra loads only in fanned sub-triangles; frame time in the README / final report
 //!   (`meshpaint bench render`).
 
-use crate::colors::format::ColorFormat;
 use crate::colors::format::Rgba;
 use crate::colors::layout::{self, Resolution, SampleLocation};
 use crate::colors::store::ColorStore;
 use crate::packing::linear::{FaceRecord, PackedMesh};
-use crate::packing::packer::{PackError, pack};
 
 /// How colours between samples are reconstructed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -151,38 +149,6 @@ impl MeshColorSource for ColorStore {
         }
         let reversed = self.topology().is_reversed(face, usize::from(k));
         self.edge_samples(edge).get(layout::edge_storage_offset(r_edge, p, reversed) as usize).copied()
-    }
-}
-
-/// A store with its MIP chains evaluated in `f32`, for level-`l` reference sampling.
-#[derive(Debug, Clone)]
-pub struct StoreMips {
-    chains: PackedMesh,
-}
-
-impl StoreMips {
-    /// Evaluates every MIP chain of `store` (no quantisation).
-    pub fn new(store: &ColorStore) -> Result<Self, PackError> {
-        let positions = vec![[0.0f32; 3]; store.topology().vertex_count as usize];
-        Ok(StoreMips { chains: pack(store, &positions, ColorFormat::Rgba32F)? })
-    }
-}
-
-impl MeshColorSource for StoreMips {
-    fn face_resolution(&self, face: u32) -> Option<Resolution> {
-        self.chains.face_resolution(face)
-    }
-
-    fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
-        self.chains.lattice_color(face, level, i, j)
-    }
-
-    fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution> {
-        self.chains.edge_resolution(face, k)
-    }
-
-    fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba> {
-        self.chains.edge_color(face, k, level, p)
     }
 }
 
