@@ -673,13 +673,16 @@ impl<'a> StoreWriter<'a> {
     /// Writes `color` to `sample`, recording the old colour first. Returns whether the
     /// colour changed (`false` when it is bit-identical or the sample does not exist).
     pub fn set(&mut self, sample: SampleRef, color: Rgba) -> bool {
+        // Unchanged samples do not touch the history (no log slot is made for them).
+        let Some(old) = self.store.get(sample).filter(|&old| differs(color, old)) else {
+            return false;
+        };
         let (element, index) = match sample {
             SampleRef::Vertex(v) => (Element::Vertices, v),
             SampleRef::Edge { edge, offset } => (Element::Edge(edge), offset),
             SampleRef::Interior { face, offset } => (Element::Interior(face), offset),
         };
-        let mut out = self.element(element);
-        out.get(index).is_some_and(|old| out.write(index, old, color))
+        self.element(element).write(index, old, color)
     }
 
     /// The writer of one element's samples: the fast path for many writes to one element
