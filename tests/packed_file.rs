@@ -1,4 +1,4 @@
-//! Tests of the packed file format (src/packed_file.rs, docs/FORMAT.md).
+//! Tests of the packed file format (src/packing/file/, docs/FORMAT.md).
 //!
 //! Header offsets are hard-coded here from docs/FORMAT.md, so these tests check the
 //! documented layout, not just that the writer and the reader agree.
