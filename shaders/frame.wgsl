@@ -5,7 +5,7 @@
 // these names without declaring them (and cannot start with `enable` directives).
 
 // Keep in sync with `FrameUniforms` in src/render/uniforms.rs (same fields, same order,
-// 160 bytes; tests/shaders.rs compares the member offsets). The baseline reads
+// 176 bytes; tests/shaders.rs compares the member offsets). The baseline reads
 // clip_from_world, light, wire_color, tint (the glTF baseColorFactor), flags and wire_width.
 struct FrameUniforms {
     // clip ← (world − render origin)
@@ -16,6 +16,9 @@ struct FrameUniforms {
     wire_color: vec4<f32>,
     // Multiplies the base colour (the baseline's glTF baseColorFactor; 1 for mesh colors).
     tint: vec4<f32>,
+    // Trilinear level of detail (src/packing/lod.rs): xyz the eye relative to the render
+    // origin, w the world size of a pixel at unit depth, 2 tan(fov_y / 2) / height.
+    lod_eye: vec4<f32>,
     // 0 = nearest, 1 = linear. The mesh-colors pipeline is chosen by it: the shader reads
     // the override FILTER_KIND, which the renderer sets to the same value.
     filter_kind: u32,

@@ -51,6 +51,14 @@ const MESH_DATA_WIDTH_LOG2: u32 = 12u;
 // each word `base | log2 << 28`.
 @group(0) @binding(3) var face_records: texture_2d<u32>;
 @group(0) @binding(4) var atlas: texture_2d<f32>;
+// (nx, ny, nz, 0) of each vertex: the unit area-weighted normal (Rgba16Float), and the
+// vertex's sample density in `positions.w` — the trilinear level of detail's inputs
+// (keep in sync with `VertexLod` in src/packing/lod.rs).
+@group(0) @binding(5) var normals: texture_2d<f32>;
+
+// Keep in sync with `MIN_COSINE` and `LOD_TERM_LIMIT` in src/packing/lod.rs.
+const LOD_MIN_COSINE: f32 = 0.0625;
+const LOD_TERM_LIMIT: f32 = 64.0;
 
 // Per-face addressing at one requested MIP level L: the colour-buffer index of every
 // lattice point (i, j) of resolution `r` follows from these (see `sample_index`). Every
@@ -96,6 +104,9 @@ struct VertexOut {
     // LEVEL_MODE 0: `LevelData` at the face's fixed level; 1: `FaceData` (see pack_*).
     @location(2) @interpolate(flat) face0: vec4<u32>,
     @location(3) @interpolate(flat) face1: vec4<u32>,
+    // LEVEL_MODE 1: (view depth, μ) of the level of detail (src/packing/lod.rs), interpolated
+    // perspective-correctly, so lod = log2(depth) + μ is one function over the mesh.
+    @location(4) lod: vec2<f32>,
 }
 
 fn data_texel(k: u32) -> vec2<u32> {
@@ -106,6 +117,19 @@ fn face_corners(face: u32) -> vec3<u32> {
     let f = min(face, max(u.face_count, 1u) - 1u);
     let last = max(u.vertex_count, 1u) - 1u;
     return min(textureLoad(indices, data_texel(f), 0).xyz, vec3<u32>(last));
+}
+
+// The per-vertex term μ of the level of detail (src/packing/lod.rs): log2 of the pixel's
+// footprint at unit depth, stretched by 1 / |n · v̂| on surfaces seen at a grazing angle,
+// in samples (times the vertex's sample density), clamped to ±LOD_TERM_LIMIT.
+fn lod_term(v: u32, p: vec3<f32>) -> f32 {
+    let density = textureLoad(positions, data_texel(v), 0).w;
+    let n = textureLoad(normals, data_texel(v), 0).xyz;
+    let to_eye = u.lod_eye.xyz - p;
+    let distance = length(to_eye);
+    let cosine = select(0.0, abs(dot(n, to_eye)) / distance, distance > 0.0);
+    let term = log2(u.lod_eye.w * density / max(cosine, LOD_MIN_COSINE));
+    return clamp(select(term, -LOD_TERM_LIMIT, is_nan(term)), -LOD_TERM_LIMIT, LOD_TERM_LIMIT);
 }
 
 fn load_position(v: u32) -> vec3<f32> {
@@ -247,12 +271,15 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
     let p1 = load_position(c.y);
     let p2 = load_position(c.z);
     var p = p0;
+    var v = c.x;
     var bary = vec3<f32>(1.0, 0.0, 0.0);
     if corner == 1u {
         p = p1;
+        v = c.y;
         bary = vec3<f32>(0.0, 1.0, 0.0);
     } else if corner == 2u {
         p = p2;
+        v = c.z;
         bary = vec3<f32>(0.0, 0.0, 1.0);
     }
     // Face normal from the three positions (counter-clockwise front); a degenerate
@@ -273,6 +300,10 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
     var out: VertexOut;
     out.clip = u.clip_from_world * vec4<f32>(p, 1.0);
     out.bary = bary;
+    out.lod = vec2<f32>(0.0);
+    if LEVEL_MODE == 1u {
+        out.lod = vec2<f32>(out.clip.w, lod_term(v, p));
+    }
     // The fragment stage flips the sign for back faces: dot(−n, l) = −dot(n, l) exactly.
     out.shade = vec4<f32>(heat_color(f.log2_f), dot(normal, u.light.xyz));
     out.face0 = packed[0];
@@ -451,21 +482,16 @@ fn seam_fan(d: LevelData, s: Samples, ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32
 
 @fragment
 fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    // Derivatives first, in uniform control flow: lattice-coordinate footprint (per unit
-    // resolution; unused, hence compiled out, at a fixed level) and barycentric widths for
-    // the wireframe.
-    let duv_dx = dpdx(in.bary.yz);
-    let duv_dy = dpdy(in.bary.yz);
+    // Barycentric widths for the wireframe, in uniform control flow.
     let bary_width = fwidth(in.bary);
     let bary = sanitize_barycentric(in.bary);
 
     var color: vec4<f32>;
     if LEVEL_MODE == 1u {
-        // Automatic level: u = R_f·w1, v = R_f·w2; lod = log2 of the larger footprint.
+        // Automatic level, continuous over the mesh (src/packing/lod.rs):
+        // lod = log2(view depth) + μ, both interpolated from the face's vertices.
         let f = unpack_face(in.face0, in.face1);
-        let res_f = f32(1u << f.log2_f);
-        let footprint = max(length(duv_dx * res_f), length(duv_dy * res_f));
-        var lod = log2(footprint);
+        var lod = log2(max(in.lod.x, 1e-30)) + in.lod.y;
         lod = select(lod, 0.0, is_nan(lod));
         // Clamped to the mesh's last level (vertex_levels − 1, = log2 R_f on uniform
         // meshes): past its own last level a face keeps blending its vertices' coarser

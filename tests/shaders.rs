@@ -42,7 +42,7 @@ fn every_shader_parses_and_validates() {
 
 #[test]
 fn shaders_have_the_entry_points_and_bindings_the_renderer_uses() {
-    for ((name, source), bindings) in SOURCES.into_iter().zip([0..5u32, 0..3u32]) {
+    for ((name, source), bindings) in SOURCES.into_iter().zip([0..6u32, 0..3u32]) {
         let (module, _) = validate(name, source);
         let entry_points: Vec<&str> = module.entry_points.iter().map(|entry| entry.name.as_str()).collect();
         assert!(entry_points.contains(&"vs_main") && entry_points.contains(&"fs_main"), "{name}: {entry_points:?}");
@@ -55,7 +55,7 @@ fn shaders_have_the_entry_points_and_bindings_the_renderer_uses() {
             .collect();
         found.sort_unstable();
         assert_eq!(found, bindings.collect::<Vec<_>>(), "{name}");
-        // The uniform block is 160 bytes, as `FrameUniforms` on the Rust side.
+        // The uniform block is 176 bytes, as `FrameUniforms` on the Rust side.
         let uniform = module
             .global_variables
             .iter()
@@ -83,6 +83,7 @@ fn the_wgsl_frame_struct_matches_the_rust_struct_field_by_field() {
         light,
         wire_color,
         tint,
+        lod_eye,
         filter_kind,
         level_mode,
         level,

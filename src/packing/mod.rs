@@ -7,11 +7,13 @@
 //! | [`linear`] | the linear GPU layout: 16-byte face records, colour buffer with MIP chains |
 //! | [`packer`] | store → linear (MIP chains, eq. 2.5/2.6) and linear → store |
 //! | [`paint_layout`] | paint mode: level 0 in blocks with slack; dirty ranges and patched records |
+//! | [`lod`] | the level of detail of trilinear filtering, continuous over the mesh (per-vertex density and normal) |
 //! | [`sampler`] | the CPU reference sampler (nearest, linear, MIP level) on the store and on packed buffers: the truth the GPU is tested against |
 //! | [`file`] | the packed file format (docs/FORMAT.md): writer and hostile-input-proof reader |
 
 pub mod file;
 pub mod linear;
+pub mod lod;
 pub mod packer;
 pub mod paint_layout;
 pub mod sampler;

@@ -58,16 +58,17 @@
 //! bit-identical to eq. 2.4 as before (tested against a copy of the old function).
 //!
 //! **Trilinear** is the blend of two fixed levels, so it is continuous whenever both
-//! faces use the same `lod` ([`sample_trilinear`]; tested). The shader picks `lod` per
-//! face from screen-space derivatives, `log2(footprint · R_f)`: two faces of different
-//! `R` seeing the same footprint pick levels `log2(R_1 / R_2)` apart (and faces of any
-//! `R` with different screen-space shapes differ too, as before this rule), so GPU
-//! trilinear can still show a level-of-detail step across an edge — a limitation of
-//! per-face derivative LOD, like a texture's across a UV seam; making it per-edge
-//! consistent needs a LOD that is continuous over the mesh (e.g. interpolated per
-//! vertex), not done here. Its level is clamped to the mesh's last level
-//! (`vertex_levels − 1`, = `log2 R_f` on uniform meshes) so coarse faces keep following
-//! their vertices' chains as far as their finer neighbours do.
+//! faces use the same `lod` ([`sample_trilinear`]; tested). A per-face `lod` from
+//! screen-space derivatives, `log2(footprint · R_f)`, does not: two faces of different `R`
+//! seeing the same footprint pick levels `log2(R_1 / R_2)` apart (and faces of any `R`
+//! with different screen-space shapes differ too), a level-of-detail step along the edge.
+//! So the renderer's `lod` is one continuous function of the surface point, built from
+//! per-vertex terms ([`crate::packing::lod`]: view depth, the vertex's sample density, the
+//! view angle at the vertex), equal on both sides of every shared edge; tests/gpu_render.rs
+//! renders mixed-resolution edges with trilinear against this sampler at that `lod`. Its
+//! level is clamped to the mesh's last level (`vertex_levels − 1`, = `log2 R_f` on uniform
+//! meshes) so coarse faces keep following their vertices' chains as far as their finer
+//! neighbours do.
 //!
 //! **Nearest** stays discontinuous by nature: a face shows the value of its own nearest
 //! lattice sample, so along a mixed edge the coarser face shows cells `R_e / R_f` times

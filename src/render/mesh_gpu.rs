@@ -15,6 +15,7 @@ use super::{GpuContext, RenderError, Renderer};
 use crate::camera::BoundingSphere;
 use crate::colors::format::ColorFormat;
 use crate::packing::linear::{FaceRecord, PackedMesh};
+use crate::packing::lod::VertexLod;
 
 /// The default atlas width: `min(16384, max_texture_dimension_2d)`.
 ///
@@ -88,7 +89,8 @@ fn data_texture(
     format: wgpu::TextureFormat,
     bytes: &[u8],
 ) -> Result<wgpu::Texture, RenderError> {
-    let entries = bytes.len() as u64 / DATA_TEXEL_BYTES;
+    let texel_bytes = texel_bytes(format);
+    let entries = bytes.len() as u64 / texel_bytes;
     let rows = entries.div_ceil(u64::from(MESH_DATA_WIDTH)).max(1);
     let max_dimension = ctx.limits().max_texture_dimension_2d;
     let height = u32::try_from(rows).ok().filter(|&rows| rows <= max_dimension).ok_or_else(|| {
@@ -106,13 +108,18 @@ fn data_texture(
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
-    write_texel_rows(ctx, &texture, MESH_DATA_WIDTH, DATA_TEXEL_BYTES, 0, bytes);
+    write_texel_rows(ctx, &texture, MESH_DATA_WIDTH, texel_bytes, 0, bytes);
     Ok(texture)
 }
 
-/// Bytes of a texture's level 0 with 16-byte texels.
+/// Bytes per texel of a data-texture format (16 for the RGBA32 ones, 8 for the normals).
+fn texel_bytes(format: wgpu::TextureFormat) -> u64 {
+    format.block_copy_size(None).map_or(DATA_TEXEL_BYTES, u64::from)
+}
+
+/// Bytes of a data texture's level 0.
 fn data_texture_bytes(texture: &wgpu::Texture) -> u64 {
-    u64::from(texture.width()) * u64::from(texture.height()) * DATA_TEXEL_BYTES
+    u64::from(texture.width()) * u64::from(texture.height()) * texel_bytes(texture.format())
 }
 
 /// Where samples live in the colour atlas.
@@ -183,8 +190,11 @@ pub struct GpuMesh {
     pub format: ColorFormat,
     /// Where samples live in the atlas.
     pub atlas: AtlasLayout,
-    /// Rgba32Float: x, y, z (relative to the origin), 0 per vertex.
+    /// Rgba32Float: x, y, z (relative to the origin), sample density per vertex
+    /// ([`VertexLod`]).
     positions: wgpu::Texture,
+    /// Rgba16Float: the unit vertex normal ([`VertexLod`]), 0.
+    normals: wgpu::Texture,
     /// Rgba32Uint: c0, c1, c2, 0 per face.
     indices: wgpu::Texture,
     /// Rgba32Uint: the four words of each face's [`FaceRecord`].
@@ -220,12 +230,14 @@ impl GpuMesh {
 
         let bounds = BoundingSphere::of_points(&packed.positions);
         let origin = DVec3::from_array(bounds.center);
+        let lod = VertexLod::of(packed);
         let relative: Vec<[f32; 4]> = packed
             .positions
             .iter()
-            .map(|p| {
+            .zip(&lod.density)
+            .map(|(p, &density)| {
                 let p = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - origin;
-                [p.x as f32, p.y as f32, p.z as f32, 0.0]
+                [p.x as f32, p.y as f32, p.z as f32, density]
             })
             .collect();
         let corners: Vec<[u32; 4]> = packed.indices.iter().map(|&[c0, c1, c2]| [c0, c1, c2, 0]).collect();
@@ -234,6 +246,12 @@ impl GpuMesh {
             "positions (relative to the render origin)",
             wgpu::TextureFormat::Rgba32Float,
             bytemuck::cast_slice(&relative),
+        )?;
+        let normals = data_texture(
+            ctx,
+            "vertex normals",
+            wgpu::TextureFormat::Rgba16Float,
+            bytemuck::cast_slice(&lod.normal_bits),
         )?;
         let indices =
             data_texture(ctx, "faces' vertex ids", wgpu::TextureFormat::Rgba32Uint, bytemuck::cast_slice(&corners))?;
@@ -272,6 +290,7 @@ impl GpuMesh {
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&view(&indices)) },
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&view(&face_records)) },
                 wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&atlas_view) },
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&view(&normals)) },
             ],
         });
         let mesh = GpuMesh {
@@ -283,6 +302,7 @@ impl GpuMesh {
             format: packed.format,
             atlas,
             positions,
+            normals,
             indices,
             face_records,
             atlas_texture,
@@ -337,6 +357,7 @@ impl GpuMesh {
     pub fn gpu_bytes(&self) -> u64 {
         let atlas = u64::from(self.atlas.width) * u64::from(self.atlas.height) * self.format.bytes_per_sample() as u64;
         data_texture_bytes(&self.positions)
+            + data_texture_bytes(&self.normals)
             + data_texture_bytes(&self.indices)
             + data_texture_bytes(&self.face_records)
             + atlas

@@ -32,8 +32,9 @@ pub enum FilterMode {
     MipLevel(u32),
     /// The nearest sample at a fixed MIP level (clamped per face).
     NearestMipLevel(u32),
-    /// Automatic level from screen-space derivatives of the lattice coordinates, linear
-    /// within a level and blended between the two nearest levels.
+    /// Automatic level of detail, one continuous function over the mesh (view depth, sample
+    /// density and view angle per vertex; src/packing/lod.rs), linear within a level and
+    /// blended between the two nearest levels.
     #[default]
     Trilinear,
 }
@@ -229,6 +230,7 @@ impl Renderer {
                 data(1, wgpu::TextureSampleType::Float { filterable: false }),
                 data(2, wgpu::TextureSampleType::Uint),
                 data(3, wgpu::TextureSampleType::Uint),
+                data(5, wgpu::TextureSampleType::Float { filterable: false }),
                 layout_entry(
                     4,
                     wgpu::ShaderStages::FRAGMENT,
@@ -365,6 +367,9 @@ impl Renderer {
     pub fn uniforms(item: DrawItem<'_>, settings: &RenderSettings, width: u32, height: u32) -> FrameUniforms {
         let clip_from_world = settings.camera.clip_from_world_relative(item.origin(), width, height);
         let light = settings.light_direction().as_vec3();
+        let eye = (settings.camera.eye() - item.origin()).as_vec3();
+        let pixel_angle =
+            (2.0 * (settings.camera.fov_y_degrees.to_radians() * 0.5).tan() / f64::from(height.max(1))) as f32;
         let (filter_kind, level_mode, level) = settings.filter.uniform_fields();
         let mut flags = 0;
         if settings.shading == Shading::Lit {
@@ -381,6 +386,7 @@ impl Renderer {
             light: [light.x, light.y, light.z, settings.ambient.clamp(0.0, 1.0)],
             wire_color: settings.wire_color,
             tint: [1.0; 4],
+            lod_eye: [eye.x, eye.y, eye.z, pixel_angle],
             filter_kind,
             level_mode,
             level,

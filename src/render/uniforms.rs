@@ -5,7 +5,7 @@ use bytemuck::{Pod, Zeroable};
 /// Per-draw uniforms of both pipelines.
 ///
 /// Keep in sync with `struct FrameUniforms` in shaders/frame.wgsl, which both shaders
-/// include (same field names, same order, 160 bytes; tests/shaders.rs compares every
+/// include (same field names, same order, 176 bytes; tests/shaders.rs compares every
 /// member's offset with [`std::mem::offset_of!`]).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
@@ -18,6 +18,9 @@ pub struct FrameUniforms {
     pub wire_color: [f32; 4],
     /// Multiplies the base colour (the baseline's glTF `baseColorFactor`; 1 for mesh colors).
     pub tint: [f32; 4],
+    /// Trilinear level of detail (src/packing/lod.rs): xyz the camera's eye relative to the
+    /// render origin, w `κ = 2 tan(fov_y / 2) / height`, the world size of a pixel at unit depth.
+    pub lod_eye: [f32; 4],
     /// Reconstruction filter: [`FrameUniforms::FILTER_NEAREST`] or [`FrameUniforms::FILTER_LINEAR`].
     pub filter_kind: u32,
     /// [`FrameUniforms::LEVEL_FIXED`] or [`FrameUniforms::LEVEL_AUTO`] (trilinear).
@@ -45,7 +48,7 @@ pub struct FrameUniforms {
     pub _pad1: u32,
 }
 
-const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 160);
+const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 176);
 
 impl FrameUniforms {
     /// Nearest-sample reconstruction.
@@ -54,7 +57,7 @@ impl FrameUniforms {
     pub const FILTER_LINEAR: u32 = 1;
     /// Sample the fixed level [`FrameUniforms::level`].
     pub const LEVEL_FIXED: u32 = 0;
-    /// Choose the level per pixel from screen-space derivatives, blend two levels.
+    /// Choose the level per pixel (continuous over the mesh, src/packing/lod.rs), blend two levels.
     pub const LEVEL_AUTO: u32 = 1;
     /// Lambert + ambient shading with the face normal. The `FLAG_*` bits: keep in sync with
     /// the `FLAG_*` constants in shaders/frame.wgsl (tests/shaders.rs compares them).
