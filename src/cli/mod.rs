@@ -6,6 +6,7 @@ mod args;
 mod bench;
 mod export;
 mod info;
+mod optimize;
 mod pack;
 mod paint;
 mod render;
@@ -39,6 +40,9 @@ enum Command {
     },
     /// Pack a mesh's colours into linear buffers with MIP chains and write a packed file.
     Pack(pack::PackArgs),
+    /// Lower each face's resolution while every shown colour stays within an error bound
+    /// (0 = lossless) and write the result (.glb tessellated, any other name packed).
+    Optimize(optimize::OptimizeArgs),
     /// Render a mesh offscreen on the GPU (lavapipe without one) and write a PNG.
     Render(render::RenderArgs),
     /// Export a mesh's colours: OUT ending in .glb gets the mesh tessellated at each face's
@@ -64,6 +68,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Info(args) => info::run(args),
         Command::Pack(args) => pack::run(args),
         Command::Bench { what } => bench::run(what),
+        Command::Optimize(args) => optimize::run(args),
         Command::Render(args) => render::run(args),
         Command::Export(args) => export::run(args),
         Command::Paint(args) => paint::run(args),

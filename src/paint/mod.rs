@@ -1,6 +1,8 @@
-//! Painting: BVH picking, the brushes and their tools, and undo / redo per stroke.
+//! Painting: BVH picking, the brushes and their tools, optimize (lower R where nothing
+//! visible changes), and undo / redo per stroke.
 
 pub mod brush;
+pub mod optimize;
 pub mod picking;
 pub mod undo;
 
