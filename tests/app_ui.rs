@@ -545,3 +545,45 @@ fn resolution_brush_and_set_r_for_all_change_face_resolutions() {
     harness.run_steps(2);
     assert_eq!(resolutions(harness.state()).iter().filter(|r| r.get() == 16).count(), raised);
 }
+
+/// The Optimize button (E = 0): fewer samples, every shown colour kept (CPU reference
+/// sampler at random points), the memory in the status line, one undo step back.
+#[test]
+fn optimize_button_lowers_resolutions_losslessly_and_undoes() {
+    use meshpaint::packing::sampler::{Filter, sample};
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    let store = |editor: &Editor| editor.document.as_ref().unwrap().document.store.clone();
+    let before = store(harness.state());
+    harness.get_by_label("Optimize").click();
+    harness.run_steps(2);
+    let after = store(harness.state());
+    let status = format!("{:?}", harness.state().status);
+    assert!(after.sample_count() * 2 < before.sample_count(), "{status}");
+    assert!(status.contains("Optimize") && status.contains("samples") && status.contains("B"), "{status}");
+    let mut seed = 0x5eedu64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 40) as f32 / (1u64 << 24) as f32
+    };
+    for face in 0..before.topology().face_count() {
+        let (mut u, mut v) = (next(), next());
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
+        }
+        let bary = [1.0 - u - v, u, v];
+        let (a, b) = (
+            sample(&before, face, bary, Filter::Linear, 0).unwrap(),
+            sample(&after, face, bary, Filter::Linear, 0).unwrap(),
+        );
+        assert!((0..4).all(|c| (a[c] - b[c]).abs() <= 2e-6), "face {face}: {a:?} → {b:?}");
+    }
+    harness.get_by_label("Undo").click();
+    harness.run_steps(2);
+    assert_eq!(store(harness.state()).face_resolutions(), before.face_resolutions());
+    assert_eq!(store(harness.state()).sample_count(), before.sample_count());
+}

@@ -98,6 +98,8 @@ pub struct Editor {
     pub edit_generation: u64,
     /// The resolution of "Set R for all".
     pub resolution_for_all: Resolution,
+    /// The error bound of "Optimize" (0 = lossless; linear light, 0..1).
+    pub optimize_bound: f32,
     /// Autosave settings and state.
     pub autosave: AutosaveState,
     /// A load error to report once the built-in scene has replaced a failed start-up file.
@@ -151,6 +153,7 @@ impl Editor {
             upload_bytes_this_frame: 0,
             edit_generation: 0,
             resolution_for_all: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
+            optimize_bound: 0.0,
             autosave: AutosaveState::default(),
             fallback_error: None,
             last_directory: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),

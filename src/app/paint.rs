@@ -17,6 +17,7 @@ use crate::paint::brush::{
     self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, ResolutionOp, StrokeUpdate,
     Tool,
 };
+use crate::paint::optimize;
 use crate::paint::undo::UndoHistory;
 
 use super::editor::{Editor, JobOutput};
@@ -372,6 +373,39 @@ impl Editor {
         }
     }
 
+    /// Lowers face resolutions while every shown colour stays within `optimize_bound`
+    /// (`paint::optimize`), as one undo step; reports the memory before and after.
+    pub fn optimize_resolutions(&mut self) {
+        let bound = self.optimize_bound;
+        let result = self.with_paint(|_, store, _, history| optimize::optimize(store, history, bound));
+        match result {
+            Some(Ok(report)) => {
+                if report.step.is_some() {
+                    self.edit_generation += 1;
+                }
+                if let Some(open) = self.document.as_mut() {
+                    open.samples = open.document.store.sample_count();
+                }
+                // The store keeps RGBA32F samples: 16 bytes each.
+                let bytes = |samples: u64| human_bytes(samples.saturating_mul(16));
+                self.set_status(
+                    Severity::Info,
+                    format!(
+                        "Optimize (E = {bound}): {} faces lowered, samples {} to {} ({} to {}), largest change {:.2e}",
+                        thousands(report.faces_lowered.into()),
+                        thousands(report.samples_before),
+                        thousands(report.samples_after),
+                        bytes(report.samples_before),
+                        bytes(report.samples_after),
+                        report.max_error
+                    ),
+                );
+            }
+            Some(Err(error)) => self.set_status(Severity::Error, format!("Optimize: {error}")),
+            None => self.set_status(Severity::Info, "Optimize works in paint mode (Tab)."),
+        }
+    }
+
     /// Starts the radius (F) or strength (Shift+F) gesture at the pointer.
     pub fn start_gesture(&mut self, kind: GestureKind) {
         let pointer = self.viewport_pointer.unwrap_or_else(|| self.viewport.rect.center());
@@ -520,6 +554,18 @@ impl Editor {
                 self.resolution_for_all = r;
                 if ui.button("Set R for all").clicked() {
                     self.set_resolution_all(r);
+                }
+            });
+            ui.horizontal(|ui| {
+                ui.label("Error bound");
+                ui.add(egui::DragValue::new(&mut self.optimize_bound).range(0.0..=1.0).speed(0.001).max_decimals(3))
+                    .on_hover_text("Largest change of any shown colour channel (linear light, 0..1); 0 = lossless");
+                if ui
+                    .button("Optimize")
+                    .on_hover_text("Lower each face's R while what the mesh shows stays within the bound (undoable)")
+                    .clicked()
+                {
+                    self.optimize_resolutions();
                 }
             });
             ui.horizontal(|ui| {
