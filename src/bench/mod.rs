@@ -1,6 +1,7 @@
 //! Measurements behind `meshpaint bench …`: every figure we report comes from here, and
 //! each measures what the editor really does.
 
+pub mod adaptive;
 pub mod pack;
 pub mod paint;
 pub mod render;

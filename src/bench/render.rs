@@ -245,4 +245,10 @@ pub enum BenchRenderError {
     /// Packing the document failed.
     #[error(transparent)]
     Pack(#[from] crate::packing::packer::PackError),
+    /// Converting the scene into a document failed.
+    #[error(transparent)]
+    Document(#[from] crate::io::document::DocumentError),
+    /// The measurement needs a reference the file does not have.
+    #[error("{0}")]
+    NoReference(String),
 }

@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 
 use meshpaint::colors::format::ColorFormat;
 use meshpaint::colors::layout::Resolution;
+use meshpaint::io::adaptive::ResolutionRule;
 use meshpaint::io::document::{Document, SourceKind};
 use meshpaint::io::export_gltf::ExportSummary;
 use meshpaint::packing::file as packed_file;
@@ -21,6 +22,25 @@ const RESOLUTION_HELP: &str = "Uniform face resolution R for glTF input (a power
 pub(super) struct ResolutionArg {
     #[arg(long, short = 'r', default_value_t = 8, help = RESOLUTION_HELP)]
     pub(super) resolution: u64,
+    #[command(flatten)]
+    pub(super) adaptive: AdaptiveArgs,
+}
+
+// `--error E`, `--texel-density` and `--max-resolution R`: per-face resolution chosen by
+// the content of a textured glTF (src/io/adaptive.rs) instead of a uniform `-r`.
+#[derive(Debug, Clone, Copy, Default, clap::Args)]
+pub(super) struct AdaptiveArgs {
+    /// Per-face R for textured glTF: the lowest R whose reconstruction stays within E of the
+    /// texture (RMS over the face, linear light, 0..1); replaces -r.
+    #[arg(long, conflicts_with_all = ["resolution", "texel_density"])]
+    pub(super) error: Option<f32>,
+    /// Per-face R for textured glTF: one sample per texel along each face's longest UV edge;
+    /// replaces -r.
+    #[arg(long, conflicts_with = "resolution")]
+    pub(super) texel_density: bool,
+    /// The largest R that --error and --texel-density give a face.
+    #[arg(long, default_value_t = 64)]
+    pub(super) max_resolution: u64,
 }
 
 // `-r/--resolution` with R = 16 by default (`bench pack`). Not a const generic: clap keeps
@@ -33,14 +53,28 @@ pub(super) struct ResolutionArg16 {
 
 impl From<ResolutionArg16> for ResolutionArg {
     fn from(arg: ResolutionArg16) -> Self {
-        ResolutionArg { resolution: arg.resolution }
+        ResolutionArg { resolution: arg.resolution, adaptive: AdaptiveArgs::default() }
     }
 }
 
 impl ResolutionArg {
-    /// The checked resolution.
+    /// The checked uniform resolution.
     pub(super) fn get(self) -> Result<Resolution> {
         Resolution::new(self.resolution).context("--resolution")
+    }
+
+    /// The checked rule: `--error`, `--texel-density` or uniform `-r`.
+    pub(super) fn rule(self) -> Result<ResolutionRule> {
+        let AdaptiveArgs { error, texel_density, max_resolution } = self.adaptive;
+        let max = || Resolution::new(max_resolution).context("--max-resolution");
+        Ok(match (error, texel_density) {
+            (Some(bound), _) => {
+                anyhow::ensure!(bound.is_finite() && bound >= 0.0, "--error must be a number ≥ 0, got {bound}");
+                ResolutionRule::ErrorBound { bound, max: max()? }
+            }
+            (None, true) => ResolutionRule::TexelDensity { max: max()? },
+            (None, false) => ResolutionRule::Uniform(self.get()?),
+        })
     }
 }
 
@@ -133,8 +167,7 @@ pub(super) fn packed_format(format: Option<ColorFormat>, source: SourceKind) -> 
 
 /// Opens a glTF or packed file at `resolution`, logging the importer's warnings.
 pub(super) fn open(path: &Path, resolution: ResolutionArg) -> Result<Document> {
-    let resolution = resolution.get()?;
-    let document = Document::open(path, resolution)?;
+    let document = Document::open_with(path, resolution.rule()?)?;
     for warning in &document.warnings {
         log::warn!(target: LOG_TARGET, "{}: {warning}", path.display());
     }

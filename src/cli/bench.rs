@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Subcommand;
 
 use meshpaint::colors::format::ColorFormat;
@@ -40,6 +40,21 @@ pub(super) enum BenchCommand {
         #[arg(long, default_value_t = 20)]
         frames: usize,
     },
+    /// Samples and PSNR (against the UV-textured render) of uniform R = 1…32 next to the
+    /// per-face resolutions of --texel-density and --error bounds; one JSON object per line.
+    Adaptive {
+        /// A textured .glb / .gltf file.
+        file: PathBuf,
+        /// The largest R the adaptive rules give.
+        #[arg(long, default_value_t = 64)]
+        max_resolution: u64,
+        /// Image size (each view is rendered at 4× and box-filtered).
+        #[arg(long, default_value_t = 256)]
+        size: u32,
+        /// Camera views around the model.
+        #[arg(long, default_value_t = 3)]
+        views: u32,
+    },
     /// Picking and painting: BVH presets, pick latency, dab time and samples/s for brushes
     /// covering ~1k / 10k / 100k samples, upload bytes per dab, repack time.
     Paint {
@@ -59,6 +74,19 @@ pub(super) enum BenchCommand {
 
 pub(super) fn run(what: BenchCommand) -> Result<()> {
     match what {
+        BenchCommand::Adaptive { file, max_resolution, size, views } => {
+            let max = meshpaint::colors::layout::Resolution::new(max_resolution).context("--max-resolution")?;
+            let scene = meshpaint::mesh::import::import_gltf(&file)?;
+            let rules = meshpaint::bench::adaptive::default_rules(max);
+            let rows = meshpaint::bench::adaptive::bench_adaptive(&file, &scene, &rules, Some(max), size, views)?;
+            for row in rows {
+                let mut value = row.to_json();
+                value["bench"] = "adaptive".into();
+                value["file"] = file.display().to_string().into();
+                println!("{value}");
+            }
+            Ok(())
+        }
         BenchCommand::Pack { file, resolution, format, runs } => {
             let document = open(&file, resolution.into())?;
             let formats = if format.is_empty() { ColorFormat::ALL.to_vec() } else { format };

@@ -201,12 +201,65 @@ fn add_scaled(sum: &mut Rgba, weight: f32, color: Rgba) {
 
 /// What a face's material needs at bake time.
 #[derive(Debug, Clone, Copy)]
-struct FaceMaterial {
-    factor: Rgba,
+pub(crate) struct FaceMaterial {
+    pub(crate) factor: Rgba,
     /// Index into the pyramid cache, if the material has a usable texture.
-    texture: Option<usize>,
+    pub(crate) texture: Option<usize>,
     /// Longest UV edge of the face in texels of level 0 (0 without a texture).
-    longest_uv_edge_texels: f32,
+    pub(crate) longest_uv_edge_texels: f32,
+}
+
+/// Each face's material (by face id, `face_count` of them) and the pyramids of the
+/// textures in use (by texture index; `None` where unused or unreadable).
+pub(crate) fn face_materials(
+    mesh: &WeldedMesh,
+    scene: &Scene,
+    face_count: usize,
+) -> (Vec<FaceMaterial>, Vec<Option<TexturePyramid>>) {
+    // Pyramids, built once per texture in use.
+    let mut pyramids: Vec<Option<Option<TexturePyramid>>> = vec![None; scene.textures.len()];
+    let faces: Vec<FaceMaterial> = (0..face_count)
+        .map(|face| {
+            let material =
+                mesh.triangle_materials.get(face).copied().flatten().and_then(|m| scene.materials.get(m as usize));
+            let Some(material) = material else {
+                return FaceMaterial { factor: [1.0; 4], texture: None, longest_uv_edge_texels: 0.0 };
+            };
+            let texture = material.base_color_texture.map(|t| t as usize).filter(|&t| {
+                let Some(slot) = pyramids.get_mut(t) else {
+                    return false;
+                };
+                slot.get_or_insert_with(|| scene.textures.get(t).and_then(TexturePyramid::new)).is_some()
+            });
+            let longest = match (texture, mesh.corner_uvs.get(face)) {
+                (Some(t), Some(uvs)) => {
+                    let (w, h) = scene.textures.get(t).map_or((0, 0), |tex| (tex.width, tex.height));
+                    longest_uv_edge_texels(*uvs, w, h)
+                }
+                _ => 0.0,
+            };
+            FaceMaterial { factor: material.base_color_factor, texture, longest_uv_edge_texels: longest }
+        })
+        .collect();
+    (faces, pyramids.into_iter().map(Option::flatten).collect())
+}
+
+/// The base colour of a face with `material` at `uv` for samples of resolution
+/// `resolution` (the texture read trilinearly at the level matched to the sample spacing,
+/// module docs).
+pub(crate) fn material_color(
+    material: &FaceMaterial,
+    pyramids: &[Option<TexturePyramid>],
+    uv: [f32; 2],
+    resolution: u32,
+) -> Rgba {
+    let Some(pyramid) = material.texture.and_then(|t| pyramids.get(t)).and_then(Option::as_ref) else {
+        return material.factor;
+    };
+    let spacing = material.longest_uv_edge_texels / resolution.max(1) as f32;
+    let lod = if spacing > 1.0 { spacing.log2() } else { 0.0 };
+    let texel = pyramid.sample_trilinear(uv, lod);
+    std::array::from_fn(|c| material.factor[c] * texel[c])
 }
 
 /// Whether the materials of `mesh` carry a colour signal worth baking: a base-colour
@@ -231,32 +284,7 @@ pub fn has_base_color(mesh: &WeldedMesh, scene: &Scene) -> bool {
 /// sample spacing). `store` must be the store of `mesh` (same faces); faces the mesh does
 /// not describe get white. Marks everything dirty.
 pub fn bake_texture(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene) {
-    // Pyramids, built once per texture in use.
-    let mut pyramids: Vec<Option<Option<TexturePyramid>>> = vec![None; scene.textures.len()];
-    let faces: Vec<FaceMaterial> = (0..store.topology().face_count() as usize)
-        .map(|face| {
-            let material =
-                mesh.triangle_materials.get(face).copied().flatten().and_then(|m| scene.materials.get(m as usize));
-            let Some(material) = material else {
-                return FaceMaterial { factor: [1.0; 4], texture: None, longest_uv_edge_texels: 0.0 };
-            };
-            let texture = material.base_color_texture.map(|t| t as usize).filter(|&t| {
-                let Some(slot) = pyramids.get_mut(t) else {
-                    return false;
-                };
-                slot.get_or_insert_with(|| scene.textures.get(t).and_then(TexturePyramid::new)).is_some()
-            });
-            let longest = match (texture, mesh.corner_uvs.get(face)) {
-                (Some(t), Some(uvs)) => {
-                    let (w, h) = scene.textures.get(t).map_or((0, 0), |tex| (tex.width, tex.height));
-                    longest_uv_edge_texels(*uvs, w, h)
-                }
-                _ => 0.0,
-            };
-            FaceMaterial { factor: material.base_color_factor, texture, longest_uv_edge_texels: longest }
-        })
-        .collect();
-    let pyramids: Vec<Option<TexturePyramid>> = pyramids.into_iter().map(Option::flatten).collect();
+    let (faces, pyramids) = face_materials(mesh, scene, store.topology().face_count() as usize);
     let edge_resolution: Vec<u32> =
         (0..store.topology().edge_count()).map(|e| store.edge_resolution(e).map_or(1, |r| r.get())).collect();
     let face_resolution: Vec<u32> = store.face_resolutions().iter().map(|r| r.get()).collect();
@@ -266,25 +294,18 @@ pub fn bake_texture(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene) {
         let Some(material) = faces.get(face) else {
             return [1.0; 4];
         };
-        let Some(pyramid) = material.texture.and_then(|t| pyramids.get(t)).and_then(Option::as_ref) else {
-            return material.factor;
-        };
         let resolution = match site.sample {
             SampleRef::Edge { edge, .. } => edge_resolution.get(edge as usize).copied(),
             _ => face_resolution.get(face).copied(),
         }
-        .unwrap_or(1)
-        .max(1);
-        let spacing = material.longest_uv_edge_texels / resolution as f32;
-        let lod = if spacing > 1.0 { spacing.log2() } else { 0.0 };
+        .unwrap_or(1);
         let uv = mesh.corner_uvs.get(face).map_or([0.0; 2], |uvs| interpolate_uv(*uvs, site.barycentric));
-        let texel = pyramid.sample_trilinear(uv, lod);
-        std::array::from_fn(|c| material.factor[c] * texel[c])
+        material_color(material, &pyramids, uv, resolution)
     });
 }
 
 /// `w0·uv0 + w1·uv1 + w2·uv2`, non-finite UVs read as `(0, 0)`.
-fn interpolate_uv(uvs: [[f32; 2]; 3], w: [f32; 3]) -> [f32; 2] {
+pub(crate) fn interpolate_uv(uvs: [[f32; 2]; 3], w: [f32; 3]) -> [f32; 2] {
     let clean = |x: f32| if x.is_finite() { x } else { 0.0 };
     std::array::from_fn(|a| (0..3).map(|k| w[k] * clean(uvs[k][a])).sum())
 }

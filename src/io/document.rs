@@ -16,7 +16,8 @@ use thiserror::Error;
 
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::Resolution;
-use crate::colors::store::ColorStore;
+use crate::colors::store::{ColorStore, StoreError};
+use crate::io::adaptive::ResolutionRule;
 use crate::mesh::import::{ImportError, import_gltf};
 use crate::mesh::scene::Scene;
 use crate::mesh::topology::{Topology, TopologyError};
@@ -55,6 +56,14 @@ pub enum DocumentError {
     NoTriangles {
         /// The file.
         path: PathBuf,
+    },
+    /// The store refused the per-face resolutions.
+    #[error("{path}: {source}")]
+    Store {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: StoreError,
     },
     /// Packing or unpacking failed.
     #[error("{path}: {source}")]
@@ -233,6 +242,12 @@ impl Document {
     /// baked from them ([`crate::io::bake::bake_texture`]); otherwise it gets
     /// [`position_color`].
     pub fn open(path: &Path, gltf_resolution: Resolution) -> Result<Self, DocumentError> {
+        Self::open_with(path, ResolutionRule::Uniform(gltf_resolution))
+    }
+
+    /// Opens `path` as [`Document::open`] does, a glTF mesh at the per-face resolutions of
+    /// `rule` ([`crate::io::adaptive`]).
+    pub fn open_with(path: &Path, rule: ResolutionRule) -> Result<Self, DocumentError> {
         let mut head = [0u8; 8];
         let is_packed = {
             use std::io::Read;
@@ -245,7 +260,7 @@ impl Document {
             let packed = packed_file::read_file(path)?;
             return Self::from_packed(&packed).map_err(|source| DocumentError::Pack { path: path.to_owned(), source });
         }
-        Self::from_scene(import_gltf(path)?, gltf_resolution, path)
+        Self::from_scene_with(import_gltf(path)?, rule, path)
     }
 
     /// Opens `source`: the built-in scene or a file, as [`Document::open`] does.
@@ -272,13 +287,21 @@ impl Document {
     /// read with [`crate::mesh::import::import_gltf_slice`]) at uniform `gltf_resolution`, coloured
     /// as [`Document::open`] colours glTF files; `name` stands for the file in errors.
     pub fn from_scene(scene: Scene, gltf_resolution: Resolution, name: &Path) -> Result<Self, DocumentError> {
+        Self::from_scene_with(scene, ResolutionRule::Uniform(gltf_resolution), name)
+    }
+
+    /// A document from a glTF scene in memory at the per-face resolutions of `rule`.
+    pub fn from_scene_with(scene: Scene, rule: ResolutionRule, name: &Path) -> Result<Self, DocumentError> {
         let welded = weld_scene(&scene);
         let topology = Topology::build(welded.positions_world.len() as u32, &welded.triangles)
             .map_err(|source| DocumentError::Topology { path: name.to_owned(), source })?;
-        let mut store = ColorStore::uniform(topology, gltf_resolution, [1.0; 4]);
+        let face_count = topology.face_count() as usize;
+        let resolutions = crate::io::adaptive::face_resolutions(&welded, &scene, face_count, rule);
+        let mut store = ColorStore::with_resolutions(topology, resolutions, [1.0; 4])
+            .map_err(|source| DocumentError::Store { path: name.to_owned(), source })?;
         let has_base_color = crate::io::bake::has_base_color(&welded, &scene);
         if has_base_color {
-            crate::io::bake::bake_texture(&mut store, &welded, &scene);
+            crate::io::adaptive::bake_and_verify(&mut store, &welded, &scene, rule);
         } else if welded.vertex_colors.is_empty() {
             fill_with_position_colors(&mut store, &welded.positions_world);
         }

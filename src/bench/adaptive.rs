@@ -1,0 +1,199 @@
+//! `meshpaint bench adaptive`: samples and error of uniform resolutions next to the
+//! content-driven ones (texel density, error bounds), on a textured glTF.
+//!
+//! Error is measured against the UV-textured render of the same file (the baseline
+//! pipeline: the glTF UVs and base-colour texture with hardware trilinear filtering):
+//! both are rendered unlit at 4× the image size in each direction and box-filtered 4×4
+//! to the image size (so the figure measures the colour signal, not edge aliasing), from
+//! `views` cameras around the model (yaw 30° + k·360°/views, pitch 20°, framing
+//! distance). PSNR is over the RGB channels of the 8-bit sRGB images, on the pixels that
+//! either render covers; the row reports the mean over the views and the worst view.
+//! Mesh colors are packed in RGBA8 (the display and save format) and drawn with the
+//! linear filter at level 0, the reconstruction the conversion fits.
+
+use std::path::Path;
+use std::time::Instant;
+
+use image::RgbaImage;
+
+use crate::camera::default_camera;
+use crate::colors::format::ColorFormat;
+use crate::colors::layout::Resolution;
+use crate::io::adaptive::ResolutionRule;
+use crate::io::document::Document;
+use crate::mesh::scene::Scene;
+use crate::render::{DrawItem, FilterMode, Gpu, RenderSettings, Shading};
+
+use super::BenchRenderError;
+
+/// Supersampling factor per axis of both renders.
+pub const SUPERSAMPLE: u32 = 4;
+
+/// One measured conversion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdaptiveRow {
+    /// The rule, as [`ResolutionRule::describe`] writes it.
+    pub rule: ResolutionRule,
+    /// Level-0 samples.
+    pub samples: u64,
+    /// Samples with MIP chains (the packed colour buffer).
+    pub samples_with_mips: u64,
+    /// Bytes of the packed face records and colours (RGBA8).
+    pub packed_bytes: u64,
+    /// Seconds to convert (fit + bake) the scene.
+    pub convert_seconds: f64,
+    /// PSNR per view against the UV-textured render, dB.
+    pub psnr_db: Vec<f64>,
+    /// Face resolutions: smallest and largest.
+    pub resolution_range: (u32, u32),
+}
+
+impl AdaptiveRow {
+    /// As JSON (`resolution` is the integer R for uniform rows, `null` otherwise).
+    pub fn to_json(&self) -> serde_json::Value {
+        let (resolution, bound, rule) = match self.rule {
+            ResolutionRule::Uniform(r) => (Some(r.get()), None, "uniform"),
+            ResolutionRule::TexelDensity { .. } => (None, None, "texel-density"),
+            ResolutionRule::ErrorBound { bound, .. } => (None, Some(bound), "error"),
+            ResolutionRule::Budget { .. } => (None, None, "budget"),
+        };
+        let budget = match self.rule {
+            ResolutionRule::Budget { samples, .. } => Some(samples),
+            _ => None,
+        };
+        let mean = self.psnr_db.iter().sum::<f64>() / self.psnr_db.len().max(1) as f64;
+        let worst = self.psnr_db.iter().copied().fold(f64::INFINITY, f64::min);
+        serde_json::json!({
+            "rule": rule,
+            "describe": self.rule.describe(),
+            "resolution": resolution,
+            "error_bound": bound,
+            "sample_budget": budget,
+            "samples": self.samples,
+            "samples_with_mips": self.samples_with_mips,
+            "packed_bytes": self.packed_bytes,
+            "convert_seconds": self.convert_seconds,
+            "psnr_db": mean,
+            "psnr_db_worst_view": worst,
+            "psnr_db_per_view": self.psnr_db,
+            "resolution_min": self.resolution_range.0,
+            "resolution_max": self.resolution_range.1,
+        })
+    }
+}
+
+/// Measures every rule in `rules` on `scene` (read from `path`), `size`² images, `views`
+/// cameras; with `budget_max`, each uniform `R ≥ 4` is followed by the budget allocation
+/// (capped at `budget_max`) given a third of its samples. Fails when the scene has no
+/// base-colour texture (no reference).
+pub fn bench_adaptive(
+    path: &Path,
+    scene: &Scene,
+    rules: &[ResolutionRule],
+    budget_max: Option<Resolution>,
+    size: u32,
+    views: u32,
+) -> Result<Vec<AdaptiveRow>, BenchRenderError> {
+    let gpu = Gpu::new_headless()?;
+    let baseline = gpu
+        .upload_baseline(scene)?
+        .ok_or_else(|| BenchRenderError::NoReference(format!("{}: no base-colour texture", path.display())))?;
+    let big = size * SUPERSAMPLE;
+    let cameras: Vec<_> = (0..views.max(1))
+        .map(|k| default_camera(baseline.bounds, 30.0 + 360.0 * f64::from(k) / f64::from(views.max(1)), 20.0, None))
+        .collect();
+    let settings = |camera| {
+        let mut settings = RenderSettings::new(camera);
+        settings.shading = Shading::Unlit;
+        settings.filter = FilterMode::Linear;
+        settings.background = [0.0; 4];
+        settings
+    };
+    let references: Vec<RgbaImage> = cameras
+        .iter()
+        .map(|&camera| {
+            gpu.render_image(DrawItem::Baseline(&baseline), &settings(camera), big, big).map(|i| box_down(&i))
+        })
+        .collect::<Result<_, _>>()?;
+    let mut rows: Vec<AdaptiveRow> = Vec::new();
+    let mut queue: std::collections::VecDeque<ResolutionRule> = rules.iter().copied().collect();
+    while let Some(rule) = queue.pop_front() {
+        let started = Instant::now();
+        let document = Document::from_scene_with(scene.clone(), rule, path)?;
+        let convert_seconds = started.elapsed().as_secs_f64();
+        let packed = document.pack(ColorFormat::Rgba8Srgb)?;
+        let mesh = gpu.upload(&packed)?;
+        let mut psnr_db = Vec::new();
+        for (camera, reference) in cameras.iter().zip(&references) {
+            let image = box_down(&gpu.render_image(DrawItem::MeshColors(&mesh), &settings(*camera), big, big)?);
+            psnr_db.push(psnr(reference, &image));
+        }
+        let resolutions = document.store.face_resolutions();
+        let range = (
+            resolutions.iter().map(|r| r.get()).min().unwrap_or(1),
+            resolutions.iter().map(|r| r.get()).max().unwrap_or(1),
+        );
+        // Next to each uniform R ≥ 4: the budget allocation with a third of its samples.
+        if let (ResolutionRule::Uniform(r), Some(max)) = (rule, budget_max) {
+            if r.get() >= 4 {
+                queue.push_front(ResolutionRule::Budget { samples: document.store.sample_count() / 3, max });
+            }
+        }
+        rows.push(AdaptiveRow {
+            rule,
+            samples: document.store.sample_count(),
+            samples_with_mips: packed.sample_count(),
+            packed_bytes: packed.face_record_bytes() + packed.color_bytes(),
+            convert_seconds,
+            psnr_db,
+            resolution_range: range,
+        });
+    }
+    Ok(rows)
+}
+
+/// The rules `bench adaptive` measures by default: uniform R = 1…32, texel density and
+/// error bounds 0.05…0.0025, all capped at `max`.
+pub fn default_rules(max: Resolution) -> Vec<ResolutionRule> {
+    let mut rules: Vec<ResolutionRule> =
+        (0..=5).filter_map(|l| Resolution::from_log2(l).ok()).map(ResolutionRule::Uniform).collect();
+    rules.push(ResolutionRule::TexelDensity { max });
+    rules.extend([0.05f32, 0.02, 0.01, 0.005, 0.0025].map(|bound| ResolutionRule::ErrorBound { bound, max }));
+    rules
+}
+
+/// Box filter `SUPERSAMPLE × SUPERSAMPLE` (in 8-bit sRGB values, alpha averaged too).
+fn box_down(image: &RgbaImage) -> RgbaImage {
+    let (w, h) = (image.width() / SUPERSAMPLE, image.height() / SUPERSAMPLE);
+    RgbaImage::from_fn(w, h, |x, y| {
+        let mut sum = [0u32; 4];
+        for dy in 0..SUPERSAMPLE {
+            for dx in 0..SUPERSAMPLE {
+                let p = image.get_pixel(x * SUPERSAMPLE + dx, y * SUPERSAMPLE + dy).0;
+                for c in 0..4 {
+                    sum[c] += u32::from(p[c]);
+                }
+            }
+        }
+        let n = SUPERSAMPLE * SUPERSAMPLE;
+        image::Rgba(sum.map(|s| ((s + n / 2) / n) as u8))
+    })
+}
+
+/// PSNR in dB over RGB of the pixels either image covers (alpha > 0); `inf` when equal.
+pub fn psnr(a: &RgbaImage, b: &RgbaImage) -> f64 {
+    let (mut sum, mut count) = (0.0f64, 0u64);
+    for (pa, pb) in a.pixels().zip(b.pixels()) {
+        if pa.0[3] == 0 && pb.0[3] == 0 {
+            continue;
+        }
+        for c in 0..3 {
+            sum += (f64::from(pa.0[c]) - f64::from(pb.0[c])).powi(2);
+        }
+        count += 3;
+    }
+    if count == 0 || sum == 0.0 {
+        return f64::INFINITY;
+    }
+    10.0 * (255.0f64 * 255.0 / (sum / count as f64)).log10()
+}

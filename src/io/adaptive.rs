@@ -1,0 +1,467 @@
+//! Per-face resolution chosen by the content when a textured mesh is converted.
+//!
+//! # Rules ([`ResolutionRule`])
+//!
+//! - **Uniform** `R` on every face (the first round's behaviour).
+//! - **Texel density**: `R_f` = the smallest power of two ≥ the face's longest UV edge in
+//!   texels of the base-colour texture's level 0 (one sample per texel along that edge),
+//!   capped at `max`. Faces without a texture get `R = 1` (their colour is one constant).
+//! - **Error bound** `E`: `R_f` = the lowest power of two (up to `max`) whose
+//!   reconstruction stays within `E` of the texture on the face.
+//!
+//! # The error of a face at `R` (the metric behind `--error E`)
+//!
+//! The face's lattice at `R` is baked as [`crate::io::bake::bake_texture`] bakes it (the
+//! texture read trilinearly at the level matched to the sample spacing, in linear light,
+//! times the base-colour factor), and reconstructed with the linear filter (eq. 2.4) at
+//! the centroids of the `D²` sub-triangles of a denser lattice `D` — the *test points*,
+//! `D` = twice the smallest power of two ≥ the face's longest UV edge in texels, at least
+//! 8 and at most `2·max`, so every texel the face covers holds several points. The truth
+//! at a test point is the texture's level 0 read bilinearly there (what a magnified UV
+//! render shows) times the factor. The error is the **root mean square** of the
+//! differences over the test points and the four channels, in linear light (colour units:
+//! full range = 1; RMS 0.01 ≈ 40 dB PSNR in linear light). RMS, not the maximum, because a
+//! single texel spike should not force a whole face to the finest `R`; the PSNR the
+//! measurements report is an RMS measure too.
+//!
+//! The fit treats each face alone (its edges at its own `R`). In the mesh an edge takes
+//! the larger `R` of its two faces, which only adds texture samples along it. Faces are
+//! fitted in parallel (rayon).
+
+use rayon::prelude::*;
+
+use crate::colors::format::{Rgba, linear_to_srgb};
+use crate::colors::layout::{self, Resolution};
+use crate::colors::store::ColorStore;
+use crate::io::bake::{FaceMaterial, bake_texture, face_materials, interpolate_uv, material_color};
+use crate::mesh::scene::Scene;
+use crate::mesh::weld::WeldedMesh;
+use crate::packing::sampler::{Filter, sample};
+
+/// How faces get their resolution when a glTF mesh is converted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ResolutionRule {
+    /// The same `R` on every face.
+    Uniform(Resolution),
+    /// One sample per texel along each face's longest UV edge, up to `max`.
+    TexelDensity {
+        /// The largest `R` given.
+        max: Resolution,
+    },
+    /// The face resolutions that minimise the area-weighted squared error over the mesh
+    /// with at most `samples` level-0 samples (rate–distortion allocation, module docs).
+    Budget {
+        /// The level-0 sample budget.
+        samples: u64,
+        /// The largest `R` given.
+        max: Resolution,
+    },
+    /// The lowest `R` whose reconstruction error (RMS, linear light) is at most `bound`.
+    ErrorBound {
+        /// `E`, colour units (full range = 1).
+        bound: f32,
+        /// The largest `R` given.
+        max: Resolution,
+    },
+}
+
+impl ResolutionRule {
+    /// A short description for reports (`R = 8`, `texel density ≤ 64`, `error ≤ 0.01, R ≤ 64`).
+    pub fn describe(&self) -> String {
+        match self {
+            ResolutionRule::Uniform(r) => format!("R = {}", r.get()),
+            ResolutionRule::TexelDensity { max } => format!("texel density, R ≤ {}", max.get()),
+            ResolutionRule::ErrorBound { bound, max } => format!("error ≤ {bound}, R ≤ {}", max.get()),
+            ResolutionRule::Budget { samples, max } => format!("≤ {samples} samples, R ≤ {}", max.get()),
+        }
+    }
+}
+
+/// Each face's resolution under `rule` (`face_count` faces of `mesh`).
+pub fn face_resolutions(mesh: &WeldedMesh, scene: &Scene, face_count: usize, rule: ResolutionRule) -> Vec<Resolution> {
+    if let ResolutionRule::Uniform(r) = rule {
+        return vec![r; face_count];
+    }
+    let (materials, pyramids) = face_materials(mesh, scene, face_count);
+    let shared = shared_uvs(mesh);
+    if shared.len() != face_count {
+        return vec![Resolution::ONE; face_count];
+    }
+    if let ResolutionRule::Budget { samples, max } = rule {
+        return allocate_budget(mesh, &materials, &shared, &pyramids, samples, max);
+    }
+    (0..face_count)
+        .into_par_iter()
+        .map(|face| {
+            let material = &materials[face];
+            if material.texture.is_none() {
+                return Resolution::ONE;
+            }
+            let uvs = mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
+            match rule {
+                ResolutionRule::Uniform(r) | ResolutionRule::Budget { max: r, .. } => r,
+                ResolutionRule::TexelDensity { max } => power_of_two_at_least(material.longest_uv_edge_texels, max),
+                ResolutionRule::ErrorBound { bound, max } => {
+                    let fit = FaceFit::new(&materials, face, shared[face], &pyramids, uvs, max);
+                    (0..=max.log2())
+                        .filter_map(|log2| Resolution::from_log2(log2).ok())
+                        .find(|&r| fit.error(r) <= bound)
+                        .unwrap_or(max)
+                }
+            }
+        })
+        .collect()
+}
+
+/// Rate–distortion allocation (module docs): every face starts at `R = 1`; raises are taken
+/// in order of distortion removed per sample added until the next does not fit `budget`.
+/// Sample counts are exact as the store counts them (an edge holds the larger `R` of its
+/// faces), so the result never exceeds the budget (nor goes below the `R = 1` count, the
+/// least any mesh needs).
+fn allocate_budget(
+    mesh: &WeldedMesh,
+    materials: &[FaceMaterial],
+    shared: &[SharedUvs],
+    pyramids: &[Option<crate::io::bake::TexturePyramid>],
+    budget: u64,
+    max: Resolution,
+) -> Vec<Resolution> {
+    let face_count = materials.len();
+    let levels = max.log2() as usize + 1;
+    // Distortion per face and level: error² × world area.
+    let distortion: Vec<Vec<f64>> = (0..face_count)
+        .into_par_iter()
+        .map(|face| {
+            let material = &materials[face];
+            if material.texture.is_none() {
+                return vec![0.0; levels];
+            }
+            let uvs = mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
+            let area = world_area(mesh, face);
+            let fit = FaceFit::new(materials, face, shared[face], pyramids, uvs, max);
+            (0..levels)
+                .map(|l| Resolution::from_log2(l as u32).map_or(0.0, |r| f64::from(fit.error(r)).powi(2) * area))
+                .collect()
+        })
+        .collect();
+    // Topology: the three edges of each face, as vertex pairs.
+    let mut edge_ids = std::collections::HashMap::new();
+    let face_edges: Vec<[usize; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            [0, 1, 2].map(|k| {
+                let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+                let next = edge_ids.len();
+                *edge_ids.entry((a, b)).or_insert(next)
+            })
+        })
+        .collect();
+    let mut edge_faces: Vec<Vec<usize>> = vec![Vec::new(); edge_ids.len()];
+    for (face, edges) in face_edges.iter().enumerate() {
+        for &e in edges {
+            edge_faces[e].push(face);
+        }
+    }
+    let mut level = vec![0usize; face_count];
+    let edge_level = |level: &[usize], e: usize| edge_faces[e].iter().map(|&f| level[f]).max().unwrap_or(0);
+    // Samples added by raising `face` from its level to `to`.
+    let added = |level: &[usize], face: usize, to: usize| -> u64 {
+        let interior = |l: usize| {
+            let r = 1u64 << l;
+            (r.saturating_sub(1)) * (r.saturating_sub(2)) / 2
+        };
+        let mut added = interior(to) - interior(level[face]);
+        for &e in &face_edges[face] {
+            let current = edge_level(level, e);
+            if to > current {
+                added += (1u64 << to) - (1u64 << current);
+            }
+        }
+        added
+    };
+    let mut used: u64 = mesh.positions_world.len() as u64;
+    // The best raise of a face: the level with the most distortion removed per sample.
+    let best = |level: &[usize], face: usize| -> Option<(f64, usize, u64)> {
+        ((level[face] + 1)..levels)
+            .filter_map(|to| {
+                let gain = distortion[face][level[face]] - distortion[face][to];
+                let cost = added(level, face, to).max(1);
+                (gain > 0.0).then_some((gain / cost as f64, to, cost))
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+    };
+    let mut heap: std::collections::BinaryHeap<(OrderedRatio, usize, usize)> = (0..face_count)
+        .filter_map(|face| best(&level, face).map(|(ratio, to, _)| (OrderedRatio(ratio), face, to)))
+        .collect();
+    while let Some((_, face, to)) = heap.pop() {
+        // Stale entries (the face or a neighbour moved since): recompute.
+        let Some((ratio, now_to, cost)) = best(&level, face) else { continue };
+        if now_to != to {
+            heap.push((OrderedRatio(ratio), face, now_to));
+            continue;
+        }
+        if used + cost > budget {
+            continue;
+        }
+        used += cost;
+        level[face] = to;
+        if let Some((ratio, to, _)) = best(&level, face) {
+            heap.push((OrderedRatio(ratio), face, to));
+        }
+    }
+    level.iter().map(|&l| Resolution::from_log2(l as u32).unwrap_or(max)).collect()
+}
+
+/// A ratio ordered by `f64::total_cmp` (for the allocation's heap).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct OrderedRatio(f64);
+
+impl Eq for OrderedRatio {}
+
+impl PartialOrd for OrderedRatio {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for OrderedRatio {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+/// World-space area of `face` of `mesh` (0 for a missing face).
+fn world_area(mesh: &WeldedMesh, face: usize) -> f64 {
+    let Some(t) = mesh.triangles.get(face) else { return 0.0 };
+    let p = |k: usize| mesh.positions_world.get(t[k] as usize).map_or([0.0; 3], |p| p.map(f64::from));
+    let (a, b, c) = (p(0), p(1), p(2));
+    let (u, v) = ([b[0] - a[0], b[1] - a[1], b[2] - a[2]], [c[0] - a[0], c[1] - a[1], c[2] - a[2]]);
+    let cross = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+    0.5 * (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]).sqrt()
+}
+
+/// Bakes `store` (the store of `mesh`, at the resolutions [`face_resolutions`] chose for
+/// `rule`) and, for an error bound, checks every face as the mesh shows it — shared
+/// vertices and edges baked from their owner face, which across a UV seam maps them to
+/// other texels, and coarse faces fanned towards finer edges — raising `R` (up to `max`) of
+/// every face still over the bound and baking again, until none is. Returns the rounds.
+pub fn bake_and_verify(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene, rule: ResolutionRule) -> u32 {
+    bake_texture(store, mesh, scene);
+    let ResolutionRule::ErrorBound { bound, max } = rule else {
+        return 0;
+    };
+    let face_count = store.topology().face_count() as usize;
+    let (materials, pyramids) = face_materials(mesh, scene, face_count);
+    let shared = shared_uvs(mesh);
+    if shared.len() != face_count {
+        return 0;
+    }
+    let mut rounds = 0;
+    loop {
+        rounds += 1;
+        let shown: &ColorStore = store;
+        let over: Vec<u32> = (0..face_count)
+            .into_par_iter()
+            .filter(|&face| {
+                let material = &materials[face];
+                let r = shown.face_resolution(face as u32).unwrap_or(max);
+                if material.texture.is_none() || r >= max {
+                    return false;
+                }
+                let uvs = mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
+                let fit = FaceFit::new(&materials, face, shared[face], &pyramids, uvs, max);
+                fit.error_of(|bary| sample(shown, face as u32, bary, Filter::Linear, 0).unwrap_or([0.0; 4])) > bound
+            })
+            .map(|face| face as u32)
+            .collect();
+        if over.is_empty() {
+            return rounds;
+        }
+        for face in over {
+            let r = store.face_resolution(face).unwrap_or(max);
+            let raised = Resolution::from_log2(r.log2() + 1).unwrap_or(max).min(max);
+            // The face exists and `raised` is a valid resolution, so this cannot fail.
+            let _ = store.set_face_resolution(face, raised);
+        }
+        bake_texture(store, mesh, scene);
+    }
+}
+
+/// The smallest power of two `≥ x` (at least 1), capped at `max`.
+fn power_of_two_at_least(x: f32, max: Resolution) -> Resolution {
+    let wanted = if x.is_finite() && x > 1.0 { x.ceil() as u64 } else { 1 };
+    let log2 = wanted.next_power_of_two().trailing_zeros().min(max.log2());
+    Resolution::from_log2(log2).unwrap_or(max)
+}
+
+/// Where a face's shared samples are baked: the UVs and material of each element's owner
+/// face (the lowest face id containing it, as [`bake_texture`] bakes), in this face's
+/// orientation — across a UV seam the owner maps the element to other texels.
+#[derive(Debug, Clone, Copy)]
+struct SharedUvs {
+    /// Per corner: the owner's UV at that vertex and the owner face.
+    corners: [([f32; 2], usize); 3],
+    /// Per face edge k (corner k → k + 1): the owner's UVs at both ends and the owner face.
+    edges: [([f32; 2], [f32; 2], usize); 3],
+}
+
+/// The [`SharedUvs`] of every face of `mesh`.
+fn shared_uvs(mesh: &WeldedMesh) -> Vec<SharedUvs> {
+    let mut vertex_owner = vec![usize::MAX; mesh.positions_world.len()];
+    let mut edge_owner = std::collections::HashMap::new();
+    for (face, t) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            if let Some(owner) = vertex_owner.get_mut(t[k] as usize) {
+                *owner = (*owner).min(face);
+            }
+            let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+            edge_owner.entry((a, b)).or_insert(face);
+        }
+    }
+    let uv_of = |face: usize, vertex: u32| -> [f32; 2] {
+        let (Some(t), Some(uvs)) = (mesh.triangles.get(face), mesh.corner_uvs.get(face)) else { return [0.0; 2] };
+        t.iter().position(|&v| v == vertex).map_or([0.0; 2], |k| uvs[k])
+    };
+    mesh.triangles
+        .iter()
+        .enumerate()
+        .map(|(face, t)| {
+            let corners = [0, 1, 2].map(|k| {
+                let owner = vertex_owner.get(t[k] as usize).copied().filter(|&o| o != usize::MAX).unwrap_or(face);
+                (uv_of(owner, t[k]), owner)
+            });
+            let edges = [0, 1, 2].map(|k| {
+                let (start, end) = (t[k], t[(k + 1) % 3]);
+                let owner = edge_owner.get(&(start.min(end), start.max(end))).copied().unwrap_or(face);
+                (uv_of(owner, start), uv_of(owner, end), owner)
+            });
+            SharedUvs { corners, edges }
+        })
+        .collect()
+}
+
+/// One face's texture and test points, for [`FaceFit::error`].
+struct FaceFit<'a> {
+    /// Every face's material (shared samples use their owner's).
+    materials: &'a [FaceMaterial],
+    shared: SharedUvs,
+    material: &'a FaceMaterial,
+    pyramids: &'a [Option<crate::io::bake::TexturePyramid>],
+    uvs: [[f32; 2]; 3],
+    /// Barycentrics of the test points and the truth there.
+    points: Vec<([f32; 3], Rgba)>,
+}
+
+impl<'a> FaceFit<'a> {
+    fn new(
+        materials: &'a [FaceMaterial],
+        face: usize,
+        shared: SharedUvs,
+        pyramids: &'a [Option<crate::io::bake::TexturePyramid>],
+        uvs: [[f32; 2]; 3],
+        max: Resolution,
+    ) -> Self {
+        let material = &materials[face];
+        let texels = power_of_two_at_least(material.longest_uv_edge_texels, Resolution::MAX).get();
+        let dense = (2 * texels).clamp(8, 2 * max.get());
+        let n = dense as f32;
+        let level0 =
+            material.texture.and_then(|t| pyramids.get(t)).and_then(Option::as_ref).and_then(|p| p.levels().first());
+        let mut points = Vec::with_capacity((dense * dense) as usize);
+        for j in 0..dense {
+            for i in 0..dense - j {
+                let (u, v) = (i as f32, j as f32);
+                let mut centroids = vec![(u + 1.0 / 3.0, v + 1.0 / 3.0)];
+                if i + j + 2 <= dense {
+                    centroids.push((u + 2.0 / 3.0, v + 2.0 / 3.0));
+                }
+                for (cu, cv) in centroids {
+                    let bary = [(n - cu - cv) / n, cu / n, cv / n];
+                    let uv = interpolate_uv(uvs, bary);
+                    let texel = level0.map_or([1.0; 4], |level| level.sample_bilinear(uv));
+                    points.push((bary, std::array::from_fn(|c| material.factor[c] * texel[c])));
+                }
+            }
+        }
+        FaceFit { materials, shared, material, pyramids, uvs, points }
+    }
+
+    /// The error (module docs) of the colours `shown` returns at the test points.
+    fn error_of(&self, shown: impl Fn([f32; 3]) -> Rgba) -> f32 {
+        let mut sum = 0.0f64;
+        for (bary, truth) in &self.points {
+            sum += difference(shown(*bary), *truth);
+        }
+        (sum / (4 * self.points.len().max(1)) as f64).sqrt() as f32
+    }
+
+    /// The colour baked at lattice point `(i, j)` of resolution `res`: corners and edge
+    /// points from their owner's UVs and material, interior points from the face's own.
+    fn lattice_color(&self, i: u32, j: u32, res: u32) -> Rgba {
+        let n = res as f32;
+        let owner = |face: usize| self.materials.get(face).unwrap_or(self.material);
+        let lerp = |a: [f32; 2], b: [f32; 2], t: f32| [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
+        let corner = match (i, j) {
+            (0, 0) => Some(0),
+            (i, 0) if i == res => Some(1),
+            (0, j) if j == res => Some(2),
+            _ => None,
+        };
+        if let Some(k) = corner {
+            let (uv, face) = self.shared.corners[k];
+            return material_color(owner(face), self.pyramids, uv, res);
+        }
+        let edge = if j == 0 {
+            Some((0, i as f32 / n))
+        } else if i + j == res {
+            Some((1, j as f32 / n))
+        } else if i == 0 {
+            Some((2, (res - j) as f32 / n))
+        } else {
+            None
+        };
+        if let Some((k, t)) = edge {
+            let (start, end, face) = self.shared.edges[k];
+            return material_color(owner(face), self.pyramids, lerp(start, end, t), res);
+        }
+        let bary = [(n - i as f32 - j as f32) / n, i as f32 / n, j as f32 / n];
+        material_color(self.material, self.pyramids, interpolate_uv(self.uvs, bary), res)
+    }
+
+    /// The error (module docs) of the face alone, baked and reconstructed at `r`.
+    fn error(&self, r: Resolution) -> f32 {
+        let res = r.get();
+        let row = |j: u32| (j * (2 * res + 3 - j) / 2) as usize;
+        let mut lattice = Vec::with_capacity(((res + 1) * (res + 2) / 2) as usize);
+        for j in 0..=res {
+            for i in 0..=res - j {
+                lattice.push(self.lattice_color(i, j, res));
+            }
+        }
+        let mut sum = 0.0f64;
+        for (bary, truth) in &self.points {
+            let mut shown = [0.0f32; 4];
+            for s in layout::linear_samples(r, *bary) {
+                let color = lattice[row(s.j) + s.i as usize];
+                for c in 0..4 {
+                    shown[c] += s.weight * color[c];
+                }
+            }
+            sum += difference(shown, *truth);
+        }
+        (sum / (4 * self.points.len().max(1)) as f64).sqrt() as f32
+    }
+}
+
+/// Squared differences summed over the channels: RGB of the sRGB-encoded colours (module
+/// docs), alpha as is.
+fn difference(shown: Rgba, truth: Rgba) -> f64 {
+    (0..4)
+        .map(|c| {
+            let (a, b) =
+                if c < 3 { (linear_to_srgb(shown[c]), linear_to_srgb(truth[c])) } else { (shown[c], truth[c]) };
+            f64::from(a - b).powi(2)
+        })
+        .sum()
+}
