@@ -188,6 +188,7 @@ impl Editor {
     /// is ready, and stays for good if opening fails.
     pub fn open(&mut self, source: Source) {
         let resolution = self.import_resolution;
+        let budget = self.budget();
         let gpu = self.gpu.clone();
         let name = source.name();
         if let Source::File(path) = &source
@@ -198,13 +199,23 @@ impl Editor {
         let label = format!("Opening {name}");
         let kind = JobKind::Open { built_in: source == Source::BuiltIn };
         let started = self.jobs.start(kind, label.clone(), move |job| {
-            document::load(&source, resolution, gpu.as_deref(), job)
+            document::load(&source, resolution, &budget, gpu.as_deref(), job)
                 .map(|document| JobOutput::Loaded(Box::new(document)))
                 .map_err(|error| error_text(&error))
         });
         match started {
             Ok(()) => self.set_status(Severity::Info, format!("{label}…")),
             Err(message) => self.set_status(Severity::Error, message),
+        }
+    }
+
+    /// The budget every R-changing operation checks first: this machine's, with the GPU's
+    /// limits when there is a GPU.
+    pub fn budget(&self) -> crate::colors::budget::Budget {
+        let budget = crate::colors::budget::Budget::from_environment();
+        match &self.gpu {
+            Some(gpu) => budget.with_gpu(gpu.budget_limits()),
+            None => budget,
         }
     }
 
@@ -285,6 +296,7 @@ impl Editor {
                 self.mode = Mode::View;
                 self.gpu_paint_layout = false;
                 self.history.clear();
+                self.history.set_budget(Some((self.budget(), document.format)));
                 self.autosave.document_opened(&mut document, self.edit_generation);
                 self.document = Some(document);
                 self.scene_generation += 1;

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
+use meshpaint::colors::budget::Budget;
 use meshpaint::colors::format::ColorFormat;
 use meshpaint::colors::layout::Resolution;
 use meshpaint::io::document::{Document, SourceKind};
@@ -131,10 +132,16 @@ pub(super) fn packed_format(format: Option<ColorFormat>, source: SourceKind) -> 
     }
 }
 
-/// Opens a glTF or packed file at `resolution`, logging the importer's warnings.
-pub(super) fn open(path: &Path, resolution: ResolutionArg) -> Result<Document> {
+/// The budget of a command whose output is packed in `format` (the input's own when `None`).
+pub(super) fn budget(format: Option<ColorFormat>) -> Budget {
+    Budget { format, ..Budget::from_environment() }
+}
+
+/// Opens a glTF or packed file at `resolution` within `budget`, logging the importer's
+/// warnings.
+pub(super) fn open(path: &Path, resolution: ResolutionArg, budget: &Budget) -> Result<Document> {
     let resolution = resolution.get()?;
-    let document = Document::open(path, resolution)?;
+    let document = Document::open_within(path, resolution, budget)?;
     for warning in &document.warnings {
         log::warn!(target: LOG_TARGET, "{}: {warning}", path.display());
     }

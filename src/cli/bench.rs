@@ -7,7 +7,7 @@ use clap::Subcommand;
 
 use meshpaint::colors::format::ColorFormat;
 
-use super::args::{ResolutionArg, ResolutionArg16, open, parse_format};
+use super::args::{ResolutionArg, ResolutionArg16, budget, open, parse_format};
 
 #[derive(Debug, Subcommand)]
 pub(super) enum BenchCommand {
@@ -60,7 +60,7 @@ pub(super) enum BenchCommand {
 pub(super) fn run(what: BenchCommand) -> Result<()> {
     match what {
         BenchCommand::Pack { file, resolution, format, runs } => {
-            let document = open(&file, resolution.into())?;
+            let document = open(&file, resolution.into(), &budget(None))?;
             let formats = if format.is_empty() { ColorFormat::ALL.to_vec() } else { format };
             let mut results = Vec::new();
             for format in formats {
@@ -79,7 +79,7 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             Ok(())
         }
         BenchCommand::Paint { file, resolution, dabs, json } => {
-            let document = open(&file, resolution)?;
+            let document = open(&file, resolution, &budget(None))?;
             let options = meshpaint::bench::PaintBenchOptions { dabs, ..Default::default() };
             let mut report = meshpaint::bench::bench_paint(&document, &options)?;
             report["file"] = file.display().to_string().into();
@@ -92,7 +92,7 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             Ok(())
         }
         BenchCommand::Render { file, resolution, width, height, frames } => {
-            let document = open(&file, resolution)?;
+            let document = open(&file, resolution, &budget(None))?;
             let result = meshpaint::bench::bench_render(&file, &document, width, height, frames)?;
             let mut report = result.to_json();
             report["file"] = file.display().to_string().into();
