@@ -98,6 +98,9 @@ pub struct Editor {
     pub edit_generation: u64,
     /// The resolution of "Set R for all".
     pub resolution_for_all: Resolution,
+    /// A memory budget that replaces the machine's (tests set a small one; `None`:
+    /// [`crate::colors::budget::Budget::from_environment`]).
+    pub budget_override: Option<crate::colors::budget::Budget>,
     /// Autosave settings and state.
     pub autosave: AutosaveState,
     /// A load error to report once the built-in scene has replaced a failed start-up file.
@@ -151,6 +154,7 @@ impl Editor {
             upload_bytes_this_frame: 0,
             edit_generation: 0,
             resolution_for_all: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
+            budget_override: None,
             autosave: AutosaveState::default(),
             fallback_error: None,
             last_directory: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
@@ -212,7 +216,7 @@ impl Editor {
     /// The budget every R-changing operation checks first: this machine's, with the GPU's
     /// limits when there is a GPU.
     pub fn budget(&self) -> crate::colors::budget::Budget {
-        let budget = crate::colors::budget::Budget::from_environment();
+        let budget = self.budget_override.unwrap_or_else(crate::colors::budget::Budget::from_environment);
         match &self.gpu {
             Some(gpu) => budget.with_gpu(gpu.budget_limits()),
             None => budget,

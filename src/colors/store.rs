@@ -412,7 +412,9 @@ impl ColorStore {
         let interior: Vec<Rgba> = (0..layout::interior_sample_count(resolution))
             .filter_map(|offset| {
                 let (i, j) = layout::interior_sample_at(resolution, offset)?;
-                lattice.get(i, j)
+                // Resampled colours obey the store's rule too (rounding can leave alpha an
+                // ulp above 1), so a later `set` of a saved sample is bit-exact.
+                lattice.get(i, j).map(crate::colors::format::clamp_color)
             })
             .collect();
         self.interior_samples[face as usize] = interior;
@@ -466,7 +468,7 @@ impl ColorStore {
             r /= 2;
         }
         let inner = polyline.get(1..polyline.len().saturating_sub(1)).unwrap_or(&[]);
-        self.edge_samples[edge as usize] = inner.to_vec();
+        self.edge_samples[edge as usize] = inner.iter().map(|&c| crate::colors::format::clamp_color(c)).collect();
         self.edge_resolution[edge as usize] = target;
         self.resized_edges.mark(edge);
         self.dirty_edges.mark(edge);
