@@ -585,7 +585,8 @@ fn set_r_for_all_past_the_budget_is_refused_and_the_document_stays_valid() {
     let document = harness.state().document.as_ref().unwrap().document.clone();
     let packed = document.pack(meshpaint::colors::format::ColorFormat::Rgba8Srgb).unwrap();
     meshpaint::packing::file::write_file(file.path(), &packed).unwrap();
-    let reopened = meshpaint::io::document::Document::open(file.path(), meshpaint::colors::layout::Resolution::ONE).unwrap();
+    let reopened =
+        meshpaint::io::document::Document::open(file.path(), meshpaint::colors::layout::Resolution::ONE).unwrap();
     assert_eq!(reopened.store.face_resolutions(), document.store.face_resolutions());
 }
 
@@ -598,10 +599,15 @@ fn the_resolution_brush_stops_at_the_budget_with_one_message() {
     let center = harness.state().viewport.rect.center();
     left_drag(&mut harness, center - egui::vec2(60.0, 0.0), center + egui::vec2(60.0, 0.0));
     let editor = harness.state();
-    let raised = editor.document.as_ref().unwrap().document.store.face_resolutions().iter().filter(|r| r.get() == 16).count();
+    let raised =
+        editor.document.as_ref().unwrap().document.store.face_resolutions().iter().filter(|r| r.get() == 16).count();
     assert!(raised > 0, "some faces fit: {:?}", editor.status);
     assert_eq!(editor.status.severity, Severity::Error, "{:?}", editor.status);
-    assert!(editor.status.text.contains("raising face") && editor.status.text.contains("of memory"), "{:?}", editor.status);
+    assert!(
+        editor.status.text.contains("raising face") && editor.status.text.contains("of memory"),
+        "{:?}",
+        editor.status
+    );
     let store = &editor.document.as_ref().unwrap().document.store;
     let counts = meshpaint::colors::budget::SampleCounts::of_store(store);
     assert!(counts.estimated_bytes(meshpaint::colors::format::ColorFormat::Rgba8Srgb) <= 11_136_784 + 100_000);

@@ -3,7 +3,6 @@
 //! R for all, the resolution brush, undo / redo, the command line) on budgets small enough
 //! for CI, plus the finite-colour rule of the packed reader, the store and the blend modes.
 
-use std::path::PathBuf;
 use std::process::Command;
 
 use meshpaint::colors::budget::{Budget, BudgetError, MemorySource, SampleCounts, SampleTracker};
@@ -16,7 +15,7 @@ use meshpaint::packing::file as packed_file;
 use meshpaint::packing::linear::PackedMesh;
 use meshpaint::packing::packer::PackLayout;
 use meshpaint::packing::paint_layout::PaintLayout;
-use meshpaint::paint::brush::{self, BlendMode, BrushError, ResolutionOp};
+use meshpaint::paint::brush::{self, BlendMode, BrushError};
 use meshpaint::paint::undo::{UndoError, UndoHistory};
 
 mod common;
@@ -167,7 +166,6 @@ fn the_resolution_brush_stops_at_the_budget_and_undo_redo_respect_it() {
     // Undo back down always passes, however small the budget.
     history.set_budget(Some((Budget { max_samples: 1, ..memory(1) }, ColorFormat::Rgba8Srgb)));
     assert!(history.undo(&mut store).unwrap());
-    let _ = ResolutionOp::Raise;
 }
 
 #[test]
@@ -212,7 +210,7 @@ fn duck_with_instances(extra: usize) -> Vec<u8> {
         json["scenes"][scene]["nodes"].as_array_mut().unwrap().push((first + k).into());
     }
     let mut text = serde_json::to_vec(&json).unwrap();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let total = 12 + 8 + text.len() + rest.len();
@@ -281,6 +279,7 @@ fn the_command_line_refuses_each_reproduction_with_one_line() {
     let glb = output_dir().join("budget_out.glb");
     let glb = glb.to_str().unwrap();
     let packed_limit = "268 435 456";
+    let _ = std::fs::remove_file(out);
     for (args, needles) in [
         (vec!["pack", duck, "-r", "4096", "-o", out], vec!["R = 4096", packed_limit]),
         (vec!["pack", bunny, "-r", "64", "-o", out], vec!["R = 64", packed_limit]),
@@ -292,7 +291,7 @@ fn the_command_line_refuses_each_reproduction_with_one_line() {
     ] {
         assert_refused(&args, "2G", &needles);
     }
-    assert!(!std::path::Path::new(out).exists() || std::fs::metadata(out).is_ok());
+    assert!(!std::path::Path::new(out).exists(), "a refused command writes nothing");
     let many = output_dir().join("budget_cli_20000_nodes.glb");
     std::fs::write(&many, duck_with_instances(20_000)).unwrap();
     let many = many.to_str().unwrap();
@@ -412,5 +411,28 @@ fn the_store_blends_and_encoders_never_hold_a_non_finite_colour() {
         let decoded = format.decode(&bytes);
         assert!(meshpaint::colors::format::is_storable(decoded), "{format:?}: {decoded:?}");
     }
-    let _ = PathBuf::new();
+}
+
+#[test]
+fn gpu_texture_limits_and_texture_sizes_are_part_of_the_budget() {
+    use meshpaint::colors::budget::GpuLimits;
+    let duck = model("Duck/Duck.glb");
+    // A 256 × 256 atlas holds 65 536 samples; the Duck at R = 8 needs 179 018 with MIP chains
+    // and 187 436 in the paint-mode layout (the larger decides).
+    let small_gpu = memory(1 << 30).with_gpu(GpuLimits { max_texture_dimension_2d: 256 });
+    assert_eq!(small_gpu.sample_limit().0, 256 * 256);
+    let error = Document::open_within(&duck, r(8), &small_gpu).unwrap_err();
+    let text = error.to_string();
+    assert!(text.contains("187 436 samples in the paint-mode layout") && text.contains("65 536"), "{text}");
+    assert!(text.contains("colour atlas"), "{text}");
+    assert!(Document::open_within(&duck, r(2), &small_gpu).is_ok());
+    // Texture texels are checked from the image header: past the limit the texture is skipped
+    // with a warning naming its size and the limit.
+    let limits = meshpaint::mesh::import::ImportLimits { max_texels: 1000, ..Default::default() };
+    let scene = meshpaint::mesh::import::import_gltf_within(&duck, &limits).unwrap();
+    assert!(scene.textures.is_empty());
+    let warning = scene.warnings.iter().find(|w| w.contains("texels")).expect("a warning about the texture");
+    assert!(warning.contains("1000"), "{warning}");
+    let scene = meshpaint::mesh::import::import_gltf_within(&duck, &Default::default()).unwrap();
+    assert_eq!(scene.textures.len(), 1);
 }

@@ -183,3 +183,42 @@ fn a_stroke_on_an_inside_out_mesh_changes_the_samples_it_changes_on_the_outward_
     assert!(outward.len() > 100, "the stroke paints: {}", outward.len());
     assert_eq!(outward, inside_out);
 }
+
+/// The lit render of `mesh` (a grey icosphere, any winding) from a fixed camera.
+fn lit_render(mesh: &Mesh) -> image::RgbaImage {
+    use meshpaint::render::{DrawItem, GpuMesh, MeshUploadOptions, RenderSettings, Shading};
+    let gpu = common::gpu::shared();
+    let (positions, triangles) = mesh;
+    let store = ColorStore::uniform(topology(mesh), Resolution::new(2).unwrap(), [0.6, 0.6, 0.6, 1.0]);
+    let packed =
+        meshpaint::packing::packer::pack(&store, positions, meshpaint::colors::format::ColorFormat::Rgba32F).unwrap();
+    let uploaded = GpuMesh::upload(&gpu.ctx, &gpu.renderer, &packed, &MeshUploadOptions::default()).unwrap();
+    let _ = triangles;
+    let camera = OrbitCamera::framing(BoundingSphere::of_points(positions), 30.0, 20.0);
+    let mut settings = RenderSettings::new(camera);
+    settings.shading = Shading::Lit;
+    settings.background = [0.0; 4];
+    gpu.renderer.render_image(&gpu.ctx, DrawItem::MeshColors(&uploaded), &settings, 128, 128).unwrap()
+}
+
+#[test]
+fn the_lit_view_shades_an_inside_out_mesh_like_the_outward_one() {
+    // Two-sided Lambert: the side the eye sees is lit with the normal that faces the eye,
+    // whatever the winding, so the inside-out copy renders the same image (up to rounding).
+    let sphere = icosphere(3);
+    let outward = lit_render(&sphere);
+    let inside_out = lit_render(&rewound(&sphere, |_| true));
+    let mixed = lit_render(&rewound(&sphere, |f| f % 3 == 0));
+    let lit: Vec<u8> = outward.pixels().filter(|p| p[3] > 0).map(|p| p[0]).collect();
+    assert!(lit.len() > 4000, "the sphere covers the image: {}", lit.len());
+    let (darkest, brightest) = (lit.iter().min().unwrap(), lit.iter().max().unwrap());
+    assert!(brightest - darkest > 40, "the lighting varies over the sphere: {darkest}..{brightest}");
+    for (what, image) in [("inside out", &inside_out), ("mixed winding", &mixed)] {
+        let differing = outward
+            .pixels()
+            .zip(image.pixels())
+            .filter(|(a, b)| a.0.iter().zip(b.0.iter()).any(|(x, y)| x.abs_diff(*y) > 2))
+            .count();
+        assert!(differing <= 16, "{what}: {differing} pixels differ by more than 2 steps");
+    }
+}
