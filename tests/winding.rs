@@ -222,3 +222,23 @@ fn the_lit_view_shades_an_inside_out_mesh_like_the_outward_one() {
         assert!(differing <= 16, "{what}: {differing} pixels differ by more than 2 steps");
     }
 }
+
+#[test]
+fn info_reports_an_inside_out_mesh_in_text_and_json() {
+    // The octahedron at R = 1 written as a .glb, with the winding of the file reversed.
+    let inverted = rewound(&octahedron_mesh(), |_| true);
+    let store = ColorStore::uniform(topology(&inverted), Resolution::ONE, GREY);
+    let path = common::output_dir().join("winding_inverted_octahedron.glb");
+    meshpaint::io::export_gltf::write_tessellated_glb(&path, &inverted.0, &store).unwrap();
+    let bin = env!("CARGO_BIN_EXE_meshpaint");
+    let output = std::process::Command::new(bin).args(["info", path.to_str().unwrap(), "--json"]).output().unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let info: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(info["closed_components"], 1);
+    assert_eq!(info["inverted_components"], 1);
+    assert_eq!(info["inconsistent_edges"], 0);
+    assert!((info["closed_signed_volume"].as_f64().unwrap() + 4.0 / 3.0).abs() < 1e-5, "{info}");
+    let output = std::process::Command::new(bin).args(["info", path.to_str().unwrap()]).output().unwrap();
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(text.contains("orientation:") && text.contains("inside out"), "{text}");
+}
