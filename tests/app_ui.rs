@@ -586,4 +586,69 @@ fn optimize_button_lowers_resolutions_losslessly_and_undoes() {
     harness.run_steps(2);
     assert_eq!(store(harness.state()).face_resolutions(), before.face_resolutions());
     assert_eq!(store(harness.state()).sample_count(), before.sample_count());
+/// The Duck opened within a memory budget of `bytes`, in paint mode.
+fn duck_painting_within(bytes: u64) -> Harness<'static, Editor> {
+    let mut editor = new_editor();
+    editor.budget_override =
+        Some(meshpaint::colors::budget::Budget::with_memory(bytes, meshpaint::colors::budget::MemorySource::Set));
+    editor.open(Source::BuiltIn);
+    assert!(editor.wait_for_job(JOB_TIMEOUT), "opening the Duck timed out");
+    assert!(editor.document.is_some(), "the Duck did not open: {:?}", editor.status);
+    let mut harness = harness(editor);
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode, Mode::Paint);
+    harness
+}
+
+#[test]
+fn set_r_for_all_past_the_budget_is_refused_and_the_document_stays_valid() {
+    // 100 MB holds the Duck at R = 8 and 16 (about 11 and 37 MB estimated), not at R = 64.
+    let mut harness = duck_painting_within(100_000_000);
+    let resolutions = |editor: &Editor| editor.document.as_ref().unwrap().document.store.face_resolutions().to_vec();
+    let before = resolutions(harness.state());
+    harness.state_mut().resolution_for_all = meshpaint::colors::layout::Resolution::new(64).unwrap();
+    harness.get_by_label("Set R for all").click();
+    harness.run_steps(2);
+    let status = harness.state().status.clone();
+    assert_eq!(status.severity, Severity::Error, "{status:?}");
+    assert!(status.text.contains("R = 64 on every face") && status.text.contains("of memory"), "{status:?}");
+    assert_eq!(resolutions(harness.state()), before, "nothing changed");
+    assert_eq!(harness.state().history.undo_len(), 0, "no step recorded");
+    // R = 16 fits; the document still saves and reopens.
+    harness.state_mut().resolution_for_all = meshpaint::colors::layout::Resolution::new(16).unwrap();
+    harness.get_by_label("Set R for all").click();
+    harness.run_steps(2);
+    assert!(resolutions(harness.state()).iter().all(|r| r.get() == 16), "{:?}", harness.state().status);
+    let file = common::TempFile::new("app_ui_budget", "duck16.mpk");
+    let document = harness.state().document.as_ref().unwrap().document.clone();
+    let packed = document.pack(meshpaint::colors::format::ColorFormat::Rgba8Srgb).unwrap();
+    meshpaint::packing::file::write_file(file.path(), &packed).unwrap();
+    let reopened =
+        meshpaint::io::document::Document::open(file.path(), meshpaint::colors::layout::Resolution::ONE).unwrap();
+    assert_eq!(reopened.store.face_resolutions(), document.store.face_resolutions());
+}
+
+#[test]
+fn the_resolution_brush_stops_at_the_budget_with_one_message() {
+    // Just above the Duck at R = 8 (about 11.1 MB estimated): room for a few raised faces.
+    let mut harness = duck_painting_within(11_136_784 + 100_000);
+    harness.get_by_label("Resolution").click();
+    harness.run_steps(2);
+    let center = harness.state().viewport.rect.center();
+    left_drag(&mut harness, center - egui::vec2(60.0, 0.0), center + egui::vec2(60.0, 0.0));
+    let editor = harness.state();
+    let raised =
+        editor.document.as_ref().unwrap().document.store.face_resolutions().iter().filter(|r| r.get() == 16).count();
+    assert!(raised > 0, "some faces fit: {:?}", editor.status);
+    assert_eq!(editor.status.severity, Severity::Error, "{:?}", editor.status);
+    assert!(
+        editor.status.text.contains("raising face") && editor.status.text.contains("of memory"),
+        "{:?}",
+        editor.status
+    );
+    let store = &editor.document.as_ref().unwrap().document.store;
+    let counts = meshpaint::colors::budget::SampleCounts::of_store(store);
+    assert!(counts.estimated_bytes(meshpaint::colors::format::ColorFormat::Rgba8Srgb) <= 11_136_784 + 100_000);
 }

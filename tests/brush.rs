@@ -677,12 +677,12 @@ fn set_resolution_for_all_or_a_selection() {
     let scene = Scene::new(icosphere(1), 4, GREY, 0.0, 0.0);
     let mut store = scene.store.clone();
     let mut history = UndoHistory::default();
-    assert_eq!(brush::set_resolution(&mut store, &mut history, Some(&[1, 3, 5]), r(16)).unwrap(), 3);
+    assert_eq!(brush::set_resolution(&mut store, &mut history, Some(&[1, 3, 5]), r(16), None).unwrap(), 3);
     assert_eq!(store.face_resolution(3), Some(r(16)));
     assert_eq!(store.face_resolution(2), Some(r(4)));
-    assert_eq!(brush::set_resolution(&mut store, &mut history, None, r(2)).unwrap(), 80);
+    assert_eq!(brush::set_resolution(&mut store, &mut history, None, r(2), None).unwrap(), 80);
     assert!(store.face_resolutions().iter().all(|&x| x == r(2)));
-    assert!(brush::set_resolution(&mut store, &mut history, Some(&[999]), r(2)).is_err());
+    assert!(brush::set_resolution(&mut store, &mut history, Some(&[999]), r(2), None).is_err());
     assert_eq!(history.undo_len(), 2);
 }
 

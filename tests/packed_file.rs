@@ -67,7 +67,19 @@ fn tetrahedron(format: ColorFormat) -> PackedMesh {
         face_records.push(FaceRecord { interior: pack_word(interior_base, log2), edges: [edge(0), edge(1), edge(2)] });
     }
     let sample_count = next as usize;
-    let colors = (0..sample_count * format.bytes_per_sample()).map(|i| (i * 7 + i / 251) as u8).collect();
+    // Varied colours every format holds (docs/FORMAT.md "Colour values"): any bytes for
+    // RGBA8, channel values in [0, 1] encoded for the float formats.
+    let colors = match format {
+        ColorFormat::Rgba8Srgb => (0..sample_count * 4).map(|i| (i * 7 + i / 251) as u8).collect(),
+        _ => {
+            let channel = |i: usize| ((i * 7 + i / 251) % 256) as f32 / 255.0;
+            let mut out = Vec::new();
+            for k in 0..sample_count {
+                format.encode_into(std::array::from_fn(|c| channel(4 * k + c)), &mut out);
+            }
+            out
+        }
+    };
     PackedMesh { positions, indices, vertex_levels, face_records, format, colors }
 }
 

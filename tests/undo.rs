@@ -164,7 +164,7 @@ fn undo_restores_bit_exactly_and_redo_reapplies() {
     )
     .unwrap();
     states.push(snapshot(&store));
-    brush::set_resolution(&mut store, &mut history, Some(&[0, 1, 2, 50, 51, 52]), r(32)).unwrap();
+    brush::set_resolution(&mut store, &mut history, Some(&[0, 1, 2, 50, 51, 52]), r(32), None).unwrap();
     states.push(snapshot(&store));
     assert!(store.face_resolutions().contains(&r(16)) && store.face_resolutions().contains(&r(32)));
     let steps = states.len() - 1;

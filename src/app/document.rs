@@ -12,9 +12,10 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 
 use crate::camera::BoundingSphere;
+use crate::colors::budget::Budget;
 use crate::colors::format::ColorFormat;
 use crate::colors::layout::Resolution;
-use crate::io::document::{Displayed, Document, Source, SourceKind, open_for_display};
+use crate::io::document::{Displayed, Document, Source, SourceKind, open_for_display_within};
 use crate::paint::picking::{BvhPreset, MeshBvh};
 use crate::render::{Gpu, GpuMesh};
 
@@ -59,11 +60,17 @@ impl OpenDocument {
     }
 }
 
-/// Opens `source` for display ([`open_for_display`]: glTF at `resolution`, or packed),
-/// uploads it when `gpu` is given and builds the picking BVH.
-pub fn load(source: &Source, resolution: Resolution, gpu: Option<&Gpu>, job: &JobContext) -> Result<OpenDocument> {
+/// Opens `source` for display ([`open_for_display_within`] `budget`: glTF at `resolution`, or
+/// packed), uploads it when `gpu` is given and builds the picking BVH.
+pub fn load(
+    source: &Source,
+    resolution: Resolution,
+    budget: &Budget,
+    gpu: Option<&Gpu>,
+    job: &JobContext,
+) -> Result<OpenDocument> {
     let Displayed { document, packed, pack_time } =
-        open_for_display(source, resolution, &mut |fraction, stage| job.progress(fraction, stage))?;
+        open_for_display_within(source, resolution, budget, &mut |fraction, stage| job.progress(fraction, stage))?;
     let name = source.name();
     let gpu_mesh = match gpu {
         Some(gpu) => {

@@ -98,8 +98,11 @@ pub struct Editor {
     pub edit_generation: u64,
     /// The resolution of "Set R for all".
     pub resolution_for_all: Resolution,
-    /// The error bound of "Optimize" (0 = lossless; linear light, 0..1).
+    /// The error bound of "Optimize" (0 = lossless; colour units, 0..1).
     pub optimize_bound: f32,
+    /// A memory budget that replaces the machine's (tests set a small one; `None`:
+    /// [`crate::colors::budget::Budget::from_environment`]).
+    pub budget_override: Option<crate::colors::budget::Budget>,
     /// Autosave settings and state.
     pub autosave: AutosaveState,
     /// A load error to report once the built-in scene has replaced a failed start-up file.
@@ -154,6 +157,7 @@ impl Editor {
             edit_generation: 0,
             resolution_for_all: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
             optimize_bound: 0.0,
+            budget_override: None,
             autosave: AutosaveState::default(),
             fallback_error: None,
             last_directory: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
@@ -191,6 +195,7 @@ impl Editor {
     /// is ready, and stays for good if opening fails.
     pub fn open(&mut self, source: Source) {
         let resolution = self.import_resolution;
+        let budget = self.budget();
         let gpu = self.gpu.clone();
         let name = source.name();
         if let Source::File(path) = &source
@@ -201,13 +206,23 @@ impl Editor {
         let label = format!("Opening {name}");
         let kind = JobKind::Open { built_in: source == Source::BuiltIn };
         let started = self.jobs.start(kind, label.clone(), move |job| {
-            document::load(&source, resolution, gpu.as_deref(), job)
+            document::load(&source, resolution, &budget, gpu.as_deref(), job)
                 .map(|document| JobOutput::Loaded(Box::new(document)))
                 .map_err(|error| error_text(&error))
         });
         match started {
             Ok(()) => self.set_status(Severity::Info, format!("{label}…")),
             Err(message) => self.set_status(Severity::Error, message),
+        }
+    }
+
+    /// The budget every R-changing operation checks first: this machine's, with the GPU's
+    /// limits when there is a GPU.
+    pub fn budget(&self) -> crate::colors::budget::Budget {
+        let budget = self.budget_override.unwrap_or_else(crate::colors::budget::Budget::from_environment);
+        match &self.gpu {
+            Some(gpu) => budget.with_gpu(gpu.budget_limits()),
+            None => budget,
         }
     }
 
@@ -288,6 +303,7 @@ impl Editor {
                 self.mode = Mode::View;
                 self.gpu_paint_layout = false;
                 self.history.clear();
+                self.history.set_budget(Some((self.budget(), document.format)));
                 self.autosave.document_opened(&mut document, self.edit_generation);
                 self.document = Some(document);
                 self.scene_generation += 1;

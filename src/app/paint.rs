@@ -46,6 +46,7 @@ impl Editor {
             self.set_status(Severity::Warning, "Busy: wait for the running job to finish before painting.");
             return;
         }
+        let budget = self.budget();
         let Some(open) = self.document.as_mut() else {
             self.set_status(Severity::Error, "Nothing to paint: no document is open.");
             return;
@@ -72,6 +73,7 @@ impl Editor {
         let painter = {
             let mut painter = Painter::new(&document.positions);
             painter.set_settings(self.brush);
+            painter.set_budget(Some((budget, open.format)));
             painter
         };
         self.paint = Some(PaintSession {
@@ -83,6 +85,7 @@ impl Editor {
             swallow_primary: false,
             stroke_upload_bytes: 0,
             stroke_samples_changed: 0,
+            upload_failed: false,
         });
         self.gpu_paint_layout = true;
         self.mode = Mode::Paint;
@@ -231,7 +234,9 @@ impl Editor {
         };
         let doc = Arc::make_mut(&mut open.document);
         let dirty = doc.store.take_dirty();
-        if dirty.is_empty() {
+        if dirty.is_empty() || session.upload_failed {
+            // After a failed upload the GPU mesh is stale until paint mode ends (the repack
+            // uploads everything): reported once, not retried on every change.
             return;
         }
         let plan = session.layout.sync(&doc.store, &dirty);
@@ -270,7 +275,11 @@ impl Editor {
         self.upload_bytes_this_frame += bytes;
         self.scene_generation += 1;
         if let Some(error) = error {
-            self.set_status(Severity::Error, format!("Uploading the painted samples failed: {error}"));
+            session.upload_failed = true;
+            self.set_status(
+                Severity::Error,
+                format!("Uploading the painted samples failed: {error}. The view shows the colours before; leave paint mode (Tab) to upload them again."),
+            );
         }
     }
 
@@ -356,7 +365,11 @@ impl Editor {
 
     /// Sets the resolution of every face.
     pub fn set_resolution_all(&mut self, resolution: Resolution) {
-        let result = self.with_paint(|_, store, _, history| brush::set_resolution(store, history, None, resolution));
+        let budget = self.budget();
+        let format = self.document.as_ref().map_or_else(Default::default, |open| open.format);
+        let result = self.with_paint(|_, store, _, history| {
+            brush::set_resolution(store, history, None, resolution, Some((&budget, format)))
+        });
         match result {
             Some(Ok(changed)) => {
                 self.edit_generation += 1;

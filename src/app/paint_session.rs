@@ -52,6 +52,8 @@ pub struct PaintSession {
     pub swallow_primary: bool,
     /// Bytes uploaded by the current (or last) stroke.
     pub stroke_upload_bytes: u64,
+    /// An upload failed: the GPU mesh stays stale until paint mode ends (reported once).
+    pub upload_failed: bool,
     /// Samples changed by the current (or last) stroke.
     pub stroke_samples_changed: u64,
 }

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
+use meshpaint::colors::budget::Budget;
 use meshpaint::colors::format::ColorFormat;
 use meshpaint::colors::layout::Resolution;
 use meshpaint::io::adaptive::ResolutionRule;
@@ -38,7 +39,11 @@ pub(super) struct AdaptiveArgs {
     /// replaces -r.
     #[arg(long, conflicts_with = "resolution")]
     pub(super) texel_density: bool,
-    /// The largest R that --error and --texel-density give a face.
+    /// Per-face R for textured glTF within a budget of N level-0 samples: the resolutions
+    /// with the least texture error (area-weighted) that fit; replaces -r.
+    #[arg(long, value_name = "N", conflicts_with_all = ["resolution", "texel_density", "error"])]
+    pub(super) samples: Option<u64>,
+    /// The largest R that --error, --texel-density and --samples give a face.
     #[arg(long, default_value_t = 64)]
     pub(super) max_resolution: u64,
 }
@@ -65,8 +70,11 @@ impl ResolutionArg {
 
     /// The checked rule: `--error`, `--texel-density` or uniform `-r`.
     pub(super) fn rule(self) -> Result<ResolutionRule> {
-        let AdaptiveArgs { error, texel_density, max_resolution } = self.adaptive;
+        let AdaptiveArgs { error, texel_density, samples, max_resolution } = self.adaptive;
         let max = || Resolution::new(max_resolution).context("--max-resolution");
+        if let Some(samples) = samples {
+            return Ok(ResolutionRule::Budget { samples, max: max()? });
+        }
         Ok(match (error, texel_density) {
             (Some(bound), _) => {
                 anyhow::ensure!(bound.is_finite() && bound >= 0.0, "--error must be a number ≥ 0, got {bound}");
@@ -165,9 +173,15 @@ pub(super) fn packed_format(format: Option<ColorFormat>, source: SourceKind) -> 
     }
 }
 
-/// Opens a glTF or packed file at `resolution`, logging the importer's warnings.
-pub(super) fn open(path: &Path, resolution: ResolutionArg) -> Result<Document> {
-    let document = Document::open_with(path, resolution.rule()?)?;
+/// The budget of a command whose output is packed in `format` (the input's own when `None`).
+pub(super) fn budget(format: Option<ColorFormat>) -> Budget {
+    Budget { format, ..Budget::from_environment() }
+}
+
+/// Opens a glTF or packed file at `resolution` within `budget`, logging the importer's
+/// warnings.
+pub(super) fn open(path: &Path, resolution: ResolutionArg, budget: &Budget) -> Result<Document> {
+    let document = Document::open_within(path, resolution.rule()?, budget)?;
     for warning in &document.warnings {
         log::warn!(target: LOG_TARGET, "{}: {warning}", path.display());
     }

@@ -7,7 +7,7 @@ use clap::Subcommand;
 
 use meshpaint::colors::format::ColorFormat;
 
-use super::args::{ResolutionArg, ResolutionArg16, open, parse_format};
+use super::args::{ResolutionArg, ResolutionArg16, budget, open, parse_format};
 
 #[derive(Debug, Subcommand)]
 pub(super) enum BenchCommand {
@@ -88,7 +88,7 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             Ok(())
         }
         BenchCommand::Pack { file, resolution, format, runs } => {
-            let document = open(&file, resolution.into())?;
+            let document = open(&file, resolution.into(), &budget(None))?;
             let formats = if format.is_empty() { ColorFormat::ALL.to_vec() } else { format };
             let mut results = Vec::new();
             for format in formats {
@@ -107,7 +107,7 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             Ok(())
         }
         BenchCommand::Paint { file, resolution, dabs, json } => {
-            let document = open(&file, resolution)?;
+            let document = open(&file, resolution, &budget(None))?;
             let options = meshpaint::bench::PaintBenchOptions { dabs, ..Default::default() };
             let mut report = meshpaint::bench::bench_paint(&document, &options)?;
             report["file"] = file.display().to_string().into();
@@ -120,7 +120,7 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             Ok(())
         }
         BenchCommand::Render { file, resolution, width, height, frames } => {
-            let document = open(&file, resolution)?;
+            let document = open(&file, resolution, &budget(None))?;
             let result = meshpaint::bench::bench_render(&file, &document, width, height, frames)?;
             let mut report = result.to_json();
             report["file"] = file.display().to_string().into();

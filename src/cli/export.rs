@@ -6,7 +6,7 @@ use anyhow::Result;
 
 use meshpaint::colors::format::ColorFormat;
 
-use super::args::{OutputArgs, ResolutionArg, Written, open, parse_format};
+use super::args::{OutputArgs, ResolutionArg, Written, budget, open, parse_format};
 
 /// Arguments of `meshpaint export`.
 #[derive(Debug, clap::Args)]
@@ -27,9 +27,13 @@ pub(super) fn run(args: ExportArgs) -> Result<()> {
     if output.is_glb()? && format.is_some() {
         anyhow::bail!("--format applies to packed output only (.glb colours are always float, linear)");
     }
-    let document = open(&path, resolution)?;
     // Unlike `pack` and `paint`, a packed input does not keep its format here.
     let packed_format = format.unwrap_or_default();
+    let mut budget = budget(Some(packed_format));
+    if output.is_glb()? {
+        budget.output_check = Some(meshpaint::io::export_gltf::check_tessellation_counts);
+    }
+    let document = open(&path, resolution, &budget)?;
     match output.write(&document, &path, packed_format)? {
         Written::Glb(summary) => eprintln!(
             "{} → {}: {} faces, {} vertices (one per sample), {} triangles, {} B",

@@ -4,9 +4,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
+use meshpaint::colors::budget::{Budget, SampleCounts, bytes_text};
+use meshpaint::colors::format::ColorFormat;
 use meshpaint::colors::layout::Resolution;
+use meshpaint::io::adaptive::ResolutionRule;
 use meshpaint::colors::stats::MeshStats;
-use meshpaint::io::document::SourceKind;
+use meshpaint::io::document::{SourceKind, import_limits};
+use meshpaint::mesh::orientation::Orientation;
+use meshpaint::mesh::topology::Topology;
 use meshpaint::packing::file as packed_file;
 
 use super::args::{LOG_TARGET, ResolutionArg, open};
@@ -37,7 +42,8 @@ pub(super) fn run(args: InfoArgs) -> Result<()> {
     if !is_packed_file(&path)? {
         return gltf_info(&path, resolution, json);
     }
-    let document = open(&path, resolution)?;
+    let budget = Budget::from_environment();
+    let document = open(&path, resolution, &budget)?;
     let store = &document.store;
     let max_resolution = store.face_resolutions().iter().copied().max().unwrap_or(Resolution::ONE);
     let mut stats = MeshStats::new(store.topology(), document.degenerate_triangles_dropped, max_resolution);
@@ -53,23 +59,67 @@ pub(super) fn run(args: InfoArgs) -> Result<()> {
         extra.insert("face_record_bytes".into(), packed.face_record_bytes().into());
         extra.insert("color_bytes".into(), packed.color_bytes().into());
     }
+    extra.extend(Orientation::of(store.topology(), &document.positions).to_json());
+    let counts = SampleCounts::of_store(store);
+    extra.extend(budget_report("the packed mesh", &budget, &counts, document.display_format()));
     print_stats(&path, &stats, extra, json);
     Ok(())
 }
 
+/// `fits_budget`, the limits and the estimate of `counts` against `budget`, and the refusal
+/// message when it does not fit (what opening at this R would say).
+fn budget_report(
+    what: &str,
+    budget: &Budget,
+    counts: &SampleCounts,
+    format: ColorFormat,
+) -> serde_json::Map<String, serde_json::Value> {
+    let mut map = serde_json::Map::new();
+    let check = budget.check(what, counts, format);
+    map.insert("fits_budget".into(), check.is_ok().into());
+    map.insert("sample_limit".into(), budget.sample_limit().0.into());
+    map.insert("memory_budget_bytes".into(), budget.memory_bytes.into());
+    map.insert("estimated_bytes".into(), counts.estimated_bytes(format).into());
+    if let Err(error) = check {
+        map.insert("budget_refusal".into(), error.to_string().into());
+    }
+    map
+}
+
 /// A glTF file: counts need the welded topology only, not the samples, so this stays
-/// cheap at any R.
-fn gltf_info(path: &Path, resolution: ResolutionArg, json: bool) -> Result<()> {
-    let resolution = resolution.get()?;
-    let scene = meshpaint::mesh::import::import_gltf(path)?;
+/// cheap at any R (the triangles after instancing are checked while the file is read).
+fn gltf_info(path: &Path, resolution_arg: ResolutionArg, json: bool) -> Result<()> {
+    let resolution = resolution_arg.get()?;
+    let rule = resolution_arg.rule();
+    let budget = Budget::from_environment();
+    let scene = meshpaint::mesh::import::import_gltf_within(path, &import_limits(&budget))?;
     for warning in &scene.warnings {
         log::warn!(target: LOG_TARGET, "{}: {warning}", path.display());
     }
     let mesh = meshpaint::mesh::weld::weld_scene(&scene);
-    let topology = meshpaint::mesh::topology::Topology::build(mesh.positions_world.len() as u32, &mesh.triangles)
+    let topology = Topology::build(mesh.positions_world.len() as u32, &mesh.triangles)
         .with_context(|| format!("{}: building topology", path.display()))?;
-    let stats = MeshStats::new(&topology, mesh.degenerate_triangles_dropped, resolution);
-    print_stats(path, &stats, serde_json::Map::new(), json);
+    let mut stats = MeshStats::new(&topology, mesh.degenerate_triangles_dropped, resolution);
+    let mut extra = Orientation::of(&topology, &mesh.positions_world).to_json();
+    let rule = rule?;
+    let (counts, what) = match rule {
+        ResolutionRule::Uniform(_) => (SampleCounts::uniform_on(&topology, resolution), format!("R = {resolution} on every face")),
+        rule => {
+            // Content-driven resolutions: the fit runs (no samples are allocated).
+            let face_count = topology.face_count() as usize;
+            let resolutions = meshpaint::io::adaptive::face_resolutions(&mesh, &scene, face_count, rule);
+            let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);
+            stats.samples = counts.samples;
+            stats.samples_with_mips = counts.samples_with_mips;
+            let (min, max) = resolutions.iter().fold((u32::MAX, 0), |(lo, hi), r| (lo.min(r.get()), hi.max(r.get())));
+            extra.insert("rule".into(), rule.describe().into());
+            extra.insert("resolution_min".into(), min.into());
+            extra.insert("resolution_max".into(), max.into());
+            (counts, rule.describe())
+        }
+    };
+    extra.extend(budget_report(&what, &budget, &counts, ColorFormat::default()));
+    print_stats(path, &stats, extra, json);
     Ok(())
 }
 
@@ -81,7 +131,40 @@ fn print_stats(path: &Path, stats: &MeshStats, extra: serde_json::Map<String, se
         println!("{}", serde_json::Value::Object(object));
     } else {
         print!("{}:\n{}", path.display(), stats.to_text());
-        for (key, value) in extra {
+        let number = |key: &str| extra.get(key).and_then(serde_json::Value::as_u64).unwrap_or(0);
+        let orientation = Orientation {
+            components: number("components"),
+            closed_components: number("closed_components"),
+            inverted_components: number("inverted_components"),
+            closed_signed_volume: extra.get("closed_signed_volume").and_then(serde_json::Value::as_f64).unwrap_or(0.0),
+            inconsistent_edges: number("inconsistent_edges"),
+        };
+        print!("{}", orientation.to_text());
+        let fits = extra.get("fits_budget").and_then(serde_json::Value::as_bool).unwrap_or(false);
+        let verdict = match extra.get("budget_refusal").and_then(serde_json::Value::as_str) {
+            Some(refusal) => format!("exceeded: {refusal}"),
+            None if fits => "fits".to_owned(),
+            None => "unknown".to_owned(),
+        };
+        println!(
+            "budget:                       {verdict} (estimate {} of {}; at most {} samples with MIP chains)",
+            bytes_text(number("estimated_bytes")),
+            bytes_text(number("memory_budget_bytes")),
+            number("sample_limit")
+        );
+        const SHOWN: [&str; 10] = [
+            "components",
+            "closed_components",
+            "inverted_components",
+            "closed_signed_volume",
+            "inconsistent_edges",
+            "fits_budget",
+            "budget_refusal",
+            "sample_limit",
+            "memory_budget_bytes",
+            "estimated_bytes",
+        ];
+        for (key, value) in extra.iter().filter(|(key, _)| !SHOWN.contains(&key.as_str())) {
             println!("{key}: {value}");
         }
     }

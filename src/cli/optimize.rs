@@ -8,7 +8,7 @@ use meshpaint::colors::format::ColorFormat;
 use meshpaint::paint::UndoHistory;
 use meshpaint::paint::optimize::optimize;
 
-use super::args::{OutputArgs, ResolutionArg, Written, open, packed_format, parse_format};
+use super::args::{OutputArgs, ResolutionArg, Written, budget, open, packed_format, parse_format};
 
 /// Arguments of `meshpaint optimize`.
 #[derive(Debug, clap::Args)]
@@ -33,7 +33,7 @@ pub(super) struct OptimizeArgs {
 
 pub(super) fn run(args: OptimizeArgs) -> Result<()> {
     let OptimizeArgs { file: path, resolution, error, format, json, output } = args;
-    let mut document = open(&path, resolution)?;
+    let mut document = open(&path, resolution, &budget(format))?;
     let started = std::time::Instant::now();
     let report = optimize(&mut document.store, &mut UndoHistory::new(0), error)
         .with_context(|| format!("optimizing {}", path.display()))?;

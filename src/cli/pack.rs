@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use meshpaint::colors::format::ColorFormat;
 use meshpaint::packing::file as packed_file;
 
-use super::args::{ResolutionArg, open, packed_format, parse_format};
+use super::args::{ResolutionArg, budget, open, packed_format, parse_format};
 
 /// Arguments of `meshpaint pack`.
 #[derive(Debug, clap::Args)]
@@ -27,7 +27,7 @@ pub(super) struct PackArgs {
 
 pub(super) fn run(args: PackArgs) -> Result<()> {
     let PackArgs { file: path, resolution, format, output } = args;
-    let document = open(&path, resolution)?;
+    let document = open(&path, resolution, &budget(format))?;
     let format = packed_format(format, document.source);
     let packed = document.pack(format).with_context(|| format!("packing {}", path.display()))?;
     packed_file::write_file(&output, &packed)?;

@@ -8,7 +8,7 @@ use meshpaint::colors::format::{ColorFormat, Rgba};
 use meshpaint::colors::layout::Resolution;
 use meshpaint::paint::brush::{BlendMode, BrushRadius, BrushSettings, Falloff, PaintView, Painter, ResolutionOp, Tool};
 
-use super::args::{CameraArgs, OutputArgs, ResolutionArg, open, packed_format, parse_format};
+use super::args::{CameraArgs, OutputArgs, ResolutionArg, budget, open, packed_format, parse_format};
 
 /// Arguments of `meshpaint paint`.
 #[derive(Debug, clap::Args)]
@@ -132,7 +132,12 @@ pub(super) fn run(args: PaintArgs) -> Result<()> {
     let settings = brush_settings(&args, color)?;
 
     let started = std::time::Instant::now();
-    let mut document = open(&args.file, args.resolution)?;
+    let mut budget = budget(args.format);
+    if glb {
+        budget.output_check = Some(meshpaint::io::export_gltf::check_tessellation_counts);
+    }
+    let mut document = open(&args.file, args.resolution, &budget)?;
+    let format = packed_format(args.format, document.source);
     let CameraArgs { yaw, pitch, distance } = args.camera;
     let bounds = meshpaint::camera::BoundingSphere::of_points(&document.positions);
     let camera = meshpaint::camera::default_camera(bounds, yaw, pitch, distance);
@@ -151,6 +156,7 @@ pub(super) fn run(args: PaintArgs) -> Result<()> {
     };
     let mut painter = Painter::new(&document.positions);
     painter.set_settings(settings);
+    painter.set_budget(Some((budget, format)));
     let mut history = meshpaint::paint::undo::UndoHistory::default();
     let (update, _) =
         meshpaint::paint::brush::replay_stroke(&mut painter, &view, &mut document.store, &mut history, &stroke)?;
@@ -158,7 +164,7 @@ pub(super) fn run(args: PaintArgs) -> Result<()> {
     if glb {
         anyhow::ensure!(args.format.is_none(), "--format applies to packed output only");
     }
-    args.output.write(&document, &args.file, packed_format(args.format, document.source))?;
+    args.output.write(&document, &args.file, format)?;
     eprintln!(
         "{} → {}: {} cursor positions, {} dabs, {} samples covered, {} changed, {} faces resized ({:.2} s)",
         args.file.display(),

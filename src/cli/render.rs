@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 
 use meshpaint::camera::default_camera;
-use meshpaint::io::document::{Source, open_for_display};
+use meshpaint::colors::budget::Budget;
+use meshpaint::io::document::{Source, import_limits, open_for_display_within};
 use meshpaint::render::{DrawItem, FilterMode, Gpu, Overlays, RenderSettings, Shading};
 
 use super::args::{CameraArgs, LOG_TARGET, ResolutionArg};
@@ -93,8 +94,9 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
     };
     let started = std::time::Instant::now();
     let gpu = Gpu::new_headless()?;
+    let budget = Budget::from_environment().with_gpu(gpu.budget_limits());
     let (image, triangles, samples) = if args.baseline_uv {
-        let scene = meshpaint::mesh::import::import_gltf(&args.file)?;
+        let scene = meshpaint::mesh::import::import_gltf_within(&args.file, &import_limits(&budget))?;
         let mesh = gpu.upload_baseline(&scene)?.with_context(|| {
             format!(
                 "{}: --baseline-uv needs a glTF file with a base-colour texture, and no material has one",
@@ -105,7 +107,7 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
         (image, mesh.vertex_count / 3, 0)
     } else {
         let source = Source::File(args.file.clone());
-        let displayed = open_for_display(&source, args.resolution.get()?, &mut |_, _| {})?;
+        let displayed = open_for_display_within(&source, args.resolution.get()?, &budget, &mut |_, _| {})?;
         for warning in &displayed.document.warnings {
             log::warn!(target: LOG_TARGET, "{}: {warning}", args.file.display());
         }

@@ -7,7 +7,7 @@ use anyhow::Result;
 use meshpaint::colors::store::SampleRef;
 use meshpaint::packing::file as packed_file;
 
-use super::args::{ResolutionArg, open};
+use super::args::{ResolutionArg, budget, open};
 
 /// Arguments of the hidden `meshpaint autosave-soak` (used by tests/autosave.rs).
 #[derive(Debug, clap::Args)]
@@ -35,7 +35,7 @@ pub(super) struct SoakArgs {
 /// `recovery G` / `saved G` after each write returns.
 pub(super) fn run(args: SoakArgs) -> Result<()> {
     use std::io::Write;
-    let mut document = open(&args.file, args.resolution)?;
+    let mut document = open(&args.file, args.resolution, &budget(None))?;
     let mut stdout = std::io::stdout();
     let vertices = document.store.topology().vertex_count;
     anyhow::ensure!(vertices > 0, "{}: no vertices", args.file.display());

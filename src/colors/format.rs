@@ -17,6 +17,30 @@ pub type Rgba = [f32; 4];
 /// Opaque black.
 pub const BLACK: Rgba = [0.0, 0.0, 0.0, 1.0];
 
+/// The largest colour channel any format holds: RGBA16F's largest finite value. Every
+/// stored colour has R, G, B in `[0, MAX_CHANNEL]` and alpha in `[0, 1]` (docs/FORMAT.md,
+/// "Colour values"); writes into the store and encoders clamp to it, the packed reader
+/// refuses anything else.
+pub const MAX_CHANNEL: f32 = 65504.0;
+
+/// `color` clamped to what every format holds: R, G, B to `[0, MAX_CHANNEL]`, alpha to
+/// `[0, 1]`; NaN becomes 0 (so no NaN or infinity is ever stored, encoded or uploaded).
+#[inline(always)]
+pub fn clamp_color(color: Rgba) -> Rgba {
+    let channel = |x: f32, max: f32| if x.is_nan() { 0.0 } else { x.clamp(0.0, max) };
+    [
+        channel(color[0], MAX_CHANNEL),
+        channel(color[1], MAX_CHANNEL),
+        channel(color[2], MAX_CHANNEL),
+        channel(color[3], 1.0),
+    ]
+}
+
+/// Whether `color` is a storable colour (what [`clamp_color`] leaves unchanged).
+pub fn is_storable(color: Rgba) -> bool {
+    color[..3].iter().all(|c| (0.0..=MAX_CHANNEL).contains(c)) && (0.0..=1.0).contains(&color[3])
+}
+
 /// How packed colour samples are encoded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum ColorFormat {
@@ -70,8 +94,9 @@ impl ColorFormat {
         Self::ALL.into_iter().find(|format| format.name() == name)
     }
 
-    /// Appends the encoding of `color` to `out`.
+    /// Appends the encoding of `color` (clamped by [`clamp_color`]) to `out`.
     pub fn encode_into(self, color: Rgba, out: &mut Vec<u8>) {
+        let color = clamp_color(color);
         match self {
             ColorFormat::Rgba8Srgb => out.extend_from_slice(&encode_rgba8_srgb(color)),
             ColorFormat::Rgba16F => {
@@ -102,8 +127,9 @@ impl ColorFormat {
         }
     }
 
-    /// The colour after an encode/decode round trip (what the GPU will see).
+    /// The colour after an encode/decode round trip (what the GPU will see), clamped first.
     pub fn quantize(self, color: Rgba) -> Rgba {
+        let color = clamp_color(color);
         match self {
             ColorFormat::Rgba8Srgb => decode_rgba8_srgb(encode_rgba8_srgb(color)),
             ColorFormat::Rgba16F => color.map(|c| f16::from_f32(c).to_f32()),
@@ -111,11 +137,12 @@ impl ColorFormat {
         }
     }
 
-    /// Encodes `colors` into `out`, which must be exactly
+    /// Encodes `colors` (each clamped by [`clamp_color`]) into `out`, which must be exactly
     /// `colors.len() * bytes_per_sample()` long (extra input or output is ignored).
     pub fn encode_slice(self, colors: &[Rgba], out: &mut [u8]) {
         let size = self.bytes_per_sample();
         for (color, bytes) in colors.iter().zip(out.chunks_exact_mut(size)) {
+            let color = &clamp_color(*color);
             match self {
                 ColorFormat::Rgba8Srgb => bytes.copy_from_slice(&encode_rgba8_srgb(*color)),
                 ColorFormat::Rgba16F => {

@@ -1,6 +1,8 @@
 //! The mesh-colors core: layout math, colour formats, the editable store, exact
-//! resampling between resolutions and the sample budget of a mesh (`meshpaint info`).
+//! resampling between resolutions, the sample budget of a mesh (`meshpaint info`) and the
+//! limits every operation that creates samples checks first ([`budget`]).
 
+pub mod budget;
 pub mod format;
 pub mod layout;
 pub mod resample;

@@ -171,6 +171,7 @@ impl ColorStore {
 
     /// Builds the store; `face_resolution` has one entry per face.
     fn build(topology: Topology, face_resolution: Vec<Resolution>, color: Rgba) -> Self {
+        let color = crate::colors::format::clamp_color(color);
         let faces = topology.face_count() as usize;
         let edge_resolution: Vec<Resolution> = (0..topology.edge_count())
             .map(|edge| {
@@ -260,8 +261,8 @@ impl ColorStore {
         }
     }
 
-    /// Writes one sample and marks its element dirty. Returns `false` (and writes
-    /// nothing) when the sample does not exist.
+    /// Writes one sample, clamped by [`crate::colors::format::clamp_color`], and marks its
+    /// element dirty. Returns `false` (and writes nothing) when the sample does not exist.
     pub fn set(&mut self, sample: SampleRef, color: Rgba) -> bool {
         let slot = match sample {
             SampleRef::Vertex(v) => self.vertex_colors.get_mut(v as usize),
@@ -275,7 +276,8 @@ impl ColorStore {
         let Some(slot) = slot else {
             return false;
         };
-        *slot = color;
+        // The one rule for stored colours (docs/FORMAT.md): finite, within what the formats hold.
+        *slot = crate::colors::format::clamp_color(color);
         match sample {
             SampleRef::Vertex(v) => self.dirty_vertices.mark(v),
             SampleRef::Edge { edge, .. } => self.dirty_edges.mark(edge),
@@ -410,7 +412,9 @@ impl ColorStore {
         let interior: Vec<Rgba> = (0..layout::interior_sample_count(resolution))
             .filter_map(|offset| {
                 let (i, j) = layout::interior_sample_at(resolution, offset)?;
-                lattice.get(i, j)
+                // Resampled colours obey the store's rule too (rounding can leave alpha an
+                // ulp above 1), so a later `set` of a saved sample is bit-exact.
+                lattice.get(i, j).map(crate::colors::format::clamp_color)
             })
             .collect();
         self.interior_samples[face as usize] = interior;
@@ -464,7 +468,7 @@ impl ColorStore {
             r /= 2;
         }
         let inner = polyline.get(1..polyline.len().saturating_sub(1)).unwrap_or(&[]);
-        self.edge_samples[edge as usize] = inner.to_vec();
+        self.edge_samples[edge as usize] = inner.iter().map(|&c| crate::colors::format::clamp_color(c)).collect();
         self.edge_resolution[edge as usize] = target;
         self.resized_edges.mark(edge);
         self.dirty_edges.mark(edge);

@@ -65,6 +65,12 @@ pub enum ResolutionRule {
     },
 }
 
+impl From<Resolution> for ResolutionRule {
+    fn from(r: Resolution) -> Self {
+        ResolutionRule::Uniform(r)
+    }
+}
+
 impl ResolutionRule {
     /// A short description for reports (`R = 8`, `texel density ≤ 64`, `error ≤ 0.01, R ≤ 64`).
     pub fn describe(&self) -> String {

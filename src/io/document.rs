@@ -14,11 +14,12 @@ use std::time::{Duration, Instant};
 
 use thiserror::Error;
 
+use crate::colors::budget::{BYTES_PER_NODE, BYTES_PER_TEXEL, Budget, BudgetError, SampleCounts};
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::Resolution;
 use crate::colors::store::{ColorStore, StoreError};
 use crate::io::adaptive::ResolutionRule;
-use crate::mesh::import::{ImportError, import_gltf};
+use crate::mesh::import::{ImportError, ImportLimits, import_gltf_slice_within, import_gltf_within};
 use crate::mesh::scene::Scene;
 use crate::mesh::topology::{Topology, TopologyError};
 use crate::mesh::weld::weld_scene;
@@ -64,6 +65,14 @@ pub enum DocumentError {
         path: PathBuf,
         /// The cause.
         source: StoreError,
+    },
+    /// The request is past a limit of the budget (checked before anything is allocated).
+    #[error("{path}: {source}")]
+    Budget {
+        /// The file.
+        path: PathBuf,
+        /// The limit and the counts.
+        source: BudgetError,
     },
     /// Packing or unpacking failed.
     #[error("{path}: {source}")]
@@ -127,8 +136,19 @@ pub fn open_for_display(
     gltf_resolution: Resolution,
     progress: &mut dyn FnMut(f32, &str),
 ) -> Result<Displayed, DocumentError> {
+    open_for_display_within(source, gltf_resolution, &Budget::from_environment(), progress)
+}
+
+/// [`open_for_display`] within `budget` (the app adds its GPU's limits): every count is
+/// checked before the samples are allocated.
+pub fn open_for_display_within(
+    source: &Source,
+    gltf_resolution: Resolution,
+    budget: &Budget,
+    progress: &mut dyn FnMut(f32, &str),
+) -> Result<Displayed, DocumentError> {
     progress(0.05, "reading and importing");
-    let document = Document::open_source(source, gltf_resolution)?;
+    let document = Document::open_source_within(source, gltf_resolution, budget)?;
     let name = PathBuf::from(source.name());
     if document.store.topology().face_count() == 0 {
         return Err(DocumentError::NoTriangles { path: name });
@@ -235,19 +255,38 @@ fn apply_vertex_colors(store: &mut ColorStore, vertex_colors: &[[f32; 4]], multi
     });
 }
 
+/// The importer's limits within `budget`: triangles after instancing, nodes and texels.
+pub fn import_limits(budget: &Budget) -> ImportLimits {
+    let (max_triangles, reason) = budget.triangle_limit();
+    ImportLimits {
+        max_triangles,
+        max_nodes: (budget.memory_bytes / BYTES_PER_NODE).min(1 << 24),
+        max_texels: budget.memory_bytes / BYTES_PER_TEXEL,
+        reason,
+    }
+}
+
 impl Document {
-    /// Opens `path`: a packed file (by magic) or glTF at uniform `gltf_resolution`.
+    /// Opens `path`: a packed file (by magic) or glTF at uniform `gltf_resolution`, within
+    /// [`Budget::from_environment`].
     ///
     /// A glTF mesh whose materials carry a base-colour texture or a non-white factor is
     /// baked from them ([`crate::io::bake::bake_texture`]); otherwise it gets
     /// [`position_color`].
     pub fn open(path: &Path, gltf_resolution: Resolution) -> Result<Self, DocumentError> {
-        Self::open_with(path, ResolutionRule::Uniform(gltf_resolution))
+        Self::open_within(path, gltf_resolution, &Budget::from_environment())
     }
 
-    /// Opens `path` as [`Document::open`] does, a glTF mesh at the per-face resolutions of
-    /// `rule` ([`crate::io::adaptive`]).
-    pub fn open_with(path: &Path, rule: ResolutionRule) -> Result<Self, DocumentError> {
+    /// [`Document::open`] within `budget`, a glTF mesh at the per-face resolutions of `rule`
+    /// (a [`Resolution`] is uniform; [`crate::io::adaptive`]): a glTF file's triangles (after
+    /// instancing), nodes and textures are checked while it is read, its samples before the
+    /// store is allocated; a packed file's samples before it is unpacked.
+    pub fn open_within(
+        path: &Path,
+        rule: impl Into<ResolutionRule>,
+        budget: &Budget,
+    ) -> Result<Self, DocumentError> {
+        let rule = rule.into();
         let mut head = [0u8; 8];
         let is_packed = {
             use std::io::Read;
@@ -258,19 +297,32 @@ impl Document {
         };
         if is_packed {
             let packed = packed_file::read_file(path)?;
-            return Self::from_packed(&packed).map_err(|source| DocumentError::Pack { path: path.to_owned(), source });
+            return Self::from_packed_within(&packed, budget).map_err(|source| match source {
+                PackError::Budget(source) => DocumentError::Budget { path: path.to_owned(), source },
+                source => DocumentError::Pack { path: path.to_owned(), source },
+            });
         }
-        Self::from_scene_with(import_gltf(path)?, rule, path)
+        let scene = import_gltf_within(path, &import_limits(budget))?;
+        Self::from_scene_within(scene, rule, path, budget)
     }
 
     /// Opens `source`: the built-in scene or a file, as [`Document::open`] does.
     pub fn open_source(source: &Source, gltf_resolution: Resolution) -> Result<Self, DocumentError> {
+        Self::open_source_within(source, gltf_resolution, &Budget::from_environment())
+    }
+
+    /// [`Document::open_source`] within `budget`.
+    pub fn open_source_within(
+        source: &Source,
+        gltf_resolution: Resolution,
+        budget: &Budget,
+    ) -> Result<Self, DocumentError> {
         match source {
             Source::BuiltIn => {
-                let scene = crate::mesh::import::import_gltf_slice(BUILT_IN_GLB, None, "Duck.glb")?;
-                Self::from_scene(scene, gltf_resolution, Path::new(BUILT_IN_NAME))
+                let scene = import_gltf_slice_within(BUILT_IN_GLB, None, "Duck.glb", &import_limits(budget))?;
+                Self::from_scene_within(scene, gltf_resolution, Path::new(BUILT_IN_NAME), budget)
             }
-            Source::File(path) => Self::open(path, gltf_resolution),
+            Source::File(path) => Self::open_within(path, gltf_resolution, budget),
         }
     }
 
@@ -287,16 +339,39 @@ impl Document {
     /// read with [`crate::mesh::import::import_gltf_slice`]) at uniform `gltf_resolution`, coloured
     /// as [`Document::open`] colours glTF files; `name` stands for the file in errors.
     pub fn from_scene(scene: Scene, gltf_resolution: Resolution, name: &Path) -> Result<Self, DocumentError> {
-        Self::from_scene_with(scene, ResolutionRule::Uniform(gltf_resolution), name)
+        Self::from_scene_within(scene, gltf_resolution, name, &Budget::from_environment())
     }
 
-    /// A document from a glTF scene in memory at the per-face resolutions of `rule`.
-    pub fn from_scene_with(scene: Scene, rule: ResolutionRule, name: &Path) -> Result<Self, DocumentError> {
+    /// [`Document::from_scene`] within `budget`: the triangles are checked before welding,
+    /// the samples at `gltf_resolution` before the store is allocated.
+    pub fn from_scene_within(
+        scene: Scene,
+        rule: impl Into<ResolutionRule>,
+        name: &Path,
+        budget: &Budget,
+    ) -> Result<Self, DocumentError> {
+        let rule = rule.into();
+        let budget_error = |source| DocumentError::Budget { path: name.to_owned(), source };
+        budget.check_triangles("the scene", scene.instanced_triangle_count() as u64).map_err(budget_error)?;
         let welded = weld_scene(&scene);
         let topology = Topology::build(welded.positions_world.len() as u32, &welded.triangles)
             .map_err(|source| DocumentError::Topology { path: name.to_owned(), source })?;
-        let face_count = topology.face_count() as usize;
-        let resolutions = crate::io::adaptive::face_resolutions(&welded, &scene, face_count, rule);
+        let resolutions = match rule {
+            ResolutionRule::Uniform(r) => {
+                let counts = SampleCounts::uniform_on(&topology, r);
+                budget.check(&format!("R = {r} on every face"), &counts, ColorFormat::default()).map_err(budget_error)?;
+                vec![r; topology.face_count() as usize]
+            }
+            rule => {
+                // The budget rule stays within the packed limit by construction; every rule's
+                // result is checked before the store is allocated.
+                let resolutions =
+                    crate::io::adaptive::face_resolutions(&welded, &scene, topology.face_count() as usize, rule);
+                let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);
+                budget.check(&rule.describe(), &counts, ColorFormat::default()).map_err(budget_error)?;
+                resolutions
+            }
+        };
         let mut store = ColorStore::with_resolutions(topology, resolutions, [1.0; 4])
             .map_err(|source| DocumentError::Store { path: name.to_owned(), source })?;
         let has_base_color = crate::io::bake::has_base_color(&welded, &scene);
@@ -320,9 +395,14 @@ impl Document {
 
     /// A document from packed buffers (level 0 becomes the store).
     pub fn from_packed(packed: &PackedMesh) -> Result<Self, PackError> {
+        Self::from_packed_within(packed, &Budget::from_environment())
+    }
+
+    /// [`Document::from_packed`] within `budget` (checked before the store is allocated).
+    pub fn from_packed_within(packed: &PackedMesh, budget: &Budget) -> Result<Self, PackError> {
         Ok(Document {
             positions: packed.positions.clone(),
-            store: packer::unpack(packed)?,
+            store: packer::unpack_within(packed, budget)?,
             degenerate_triangles_dropped: 0,
             source: SourceKind::Packed(packed.format),
             warnings: Vec::new(),

@@ -230,6 +230,13 @@ fn use_u16_indices(vertices: u64) -> bool {
     vertices <= u64::from(u16::MAX)
 }
 
+/// Checks the GLB limits for the tessellation of a store with `counts` before the store
+/// exists (vertices: the level-0 samples; triangles: `Σ R_f²`; exact for uniform
+/// resolutions, which have no fans), as a [`crate::colors::budget::OutputCheck`].
+pub fn check_tessellation_counts(counts: &crate::colors::budget::SampleCounts) -> Result<(), String> {
+    check_limits(counts.samples, counts.tessellated_triangles).map_err(|error| error.to_string())
+}
+
 /// Checks the glTF / GLB limits for a tessellation of this size.
 fn check_limits(vertices: u64, triangles: u64) -> Result<(), ExportError> {
     let index_bytes = if use_u16_indices(vertices) { 2 } else { 4 };

@@ -1,8 +1,10 @@
-//! Meshes: what is read from a file, welded into one indexed mesh, and its topology.
+//! Meshes: what is read from a file, welded into one indexed mesh, its topology and its
+//! orientation (winding consistency, signed volume).
 //!
 //! `file ─ import ─▶ Scene ─ weld ─▶ WeldedMesh ─ topology ─▶ Topology`
 
 pub mod import;
+pub mod orientation;
 pub mod scene;
 pub mod topology;
 pub mod weld;

@@ -57,6 +57,9 @@ pub enum PackError {
     /// The packed mesh's triangles do not form a valid topology.
     #[error("packed mesh: {0}")]
     Topology(#[from] TopologyError),
+    /// The store the packed data describes is past the budget (checked before unpacking).
+    #[error(transparent)]
+    Budget(#[from] crate::colors::budget::BudgetError),
     /// The packed data is not in the canonical layout this packer writes.
     #[error("packed mesh is not in the canonical layout: {0}")]
     NotCanonical(String),
@@ -563,6 +566,12 @@ pub fn pack(store: &ColorStore, positions: &[[f32; 3]], format: ColorFormat) -> 
 /// Unpacks level 0 of a packed mesh into an editable store. The packed data must be in
 /// the canonical layout [`pack`] writes (checked record by record).
 pub fn unpack(packed: &PackedMesh) -> Result<ColorStore, PackError> {
+    unpack_within(packed, &crate::colors::budget::Budget::from_environment())
+}
+
+/// [`unpack`] within `budget`: the store's samples are counted from the face records and
+/// checked before the store is allocated.
+pub fn unpack_within(packed: &PackedMesh, budget: &crate::colors::budget::Budget) -> Result<ColorStore, PackError> {
     let topology = Topology::build(packed.positions.len() as u32, &packed.indices)?;
     if packed.face_records.len() != topology.face_count() as usize {
         return Err(PackError::NotCanonical(format!(
@@ -579,6 +588,10 @@ pub fn unpack(packed: &PackedMesh) -> Result<ColorStore, PackError> {
             record.resolution().ok_or_else(|| PackError::NotCanonical(format!("face {face} has an invalid resolution")))
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let counts = crate::colors::budget::SampleCounts::of_resolutions(&topology, |face| {
+        resolutions.get(face as usize).copied().unwrap_or(Resolution::ONE)
+    });
+    budget.check("the packed mesh", &counts, packed.format)?;
     let mut store = ColorStore::with_resolutions(topology, resolutions, [0.0; 4])
         .map_err(|error| PackError::NotCanonical(error.to_string()))?;
     let layout = PackLayout::of(&store)?;

@@ -48,7 +48,8 @@ use std::collections::VecDeque;
 
 use thiserror::Error;
 
-use crate::colors::format::Rgba;
+use crate::colors::budget::{Budget, BudgetError};
+use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::Resolution;
 use crate::colors::store::{ColorStore, SampleRef, StoreError};
 
@@ -70,6 +71,9 @@ pub enum UndoError {
     /// The store changed outside the history; the history was cleared.
     #[error("the colours changed outside the undo history ({0}); the history was cleared")]
     Mismatch(String),
+    /// The step would take the store past the budget; nothing changed and the step is kept.
+    #[error(transparent)]
+    Budget(#[from] BudgetError),
     /// The store refused a change.
     #[error(transparent)]
     Store(#[from] StoreError),
@@ -167,6 +171,23 @@ impl Step {
 
     fn recount(&mut self) {
         self.bytes = self.changes.iter().map(Change::bytes).sum();
+    }
+
+    /// Checks that applying the step backwards to `store` stays within `budget`, counting the
+    /// face resolutions it leaves (walking backwards, a face's first recorded state wins).
+    fn check_budget(&self, store: &ColorStore, budget: &Budget, format: ColorFormat) -> Result<(), BudgetError> {
+        if !self.changes.iter().any(|change| matches!(change, Change::Resolution(_))) {
+            return Ok(());
+        }
+        let mut resolutions = store.face_resolutions().to_vec();
+        for change in self.changes.iter().rev() {
+            if let Change::Resolution(state) = change
+                && let Some(slot) = resolutions.get_mut(state.face as usize)
+            {
+                *slot = state.resolution;
+            }
+        }
+        budget.check_resolutions(&format!("\"{}\"", self.label), store, &resolutions, format)
     }
 
     /// Applies the step backwards and returns the step that reverses it.
@@ -379,6 +400,8 @@ pub struct UndoHistory {
     cap_bytes: usize,
     generation: u64,
     dropped_steps: u64,
+    /// The budget undo and redo check resolution changes against, with the document's format.
+    budget: Option<(Budget, ColorFormat)>,
 }
 
 impl Default for UndoHistory {
@@ -398,7 +421,14 @@ impl UndoHistory {
             cap_bytes,
             generation: 0,
             dropped_steps: 0,
+            budget: None,
         }
+    }
+
+    /// The budget that undo and redo of resolution changes are checked against before they
+    /// change anything (`None`: no check), with the document's colour format.
+    pub fn set_budget(&mut self, budget: Option<(Budget, ColorFormat)>) {
+        self.budget = budget;
     }
 
     /// The memory cap in bytes.
@@ -605,6 +635,12 @@ impl UndoHistory {
         let Some(step) = self.undo.pop_back() else {
             return Ok(false);
         };
+        if let Some((budget, format)) = &self.budget
+            && let Err(error) = step.check_budget(store, budget, *format)
+        {
+            self.undo.push_back(step);
+            return Err(error.into());
+        }
         match step.apply_backwards(store) {
             Ok(inverse) => {
                 self.redo.push(inverse);
@@ -627,6 +663,12 @@ impl UndoHistory {
         let Some(step) = self.redo.pop() else {
             return Ok(false);
         };
+        if let Some((budget, format)) = &self.budget
+            && let Err(error) = step.check_budget(store, budget, *format)
+        {
+            self.redo.push(step);
+            return Err(error.into());
+        }
         match step.apply_backwards(store) {
             Ok(inverse) => {
                 self.undo.push_back(inverse);

@@ -71,6 +71,12 @@ impl Gpu {
         self.renderer.render_image(&self.ctx, item, settings, width, height)
     }
 
+    /// The device's limits as the sample budget needs them
+    /// ([`crate::colors::budget::Budget::with_gpu`]).
+    pub fn budget_limits(&self) -> crate::colors::budget::GpuLimits {
+        crate::colors::budget::GpuLimits { max_texture_dimension_2d: self.ctx.limits().max_texture_dimension_2d }
+    }
+
     /// A one-line description of the adapter.
     pub fn describe(&self) -> String {
         self.ctx.describe()

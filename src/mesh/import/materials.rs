@@ -93,6 +93,21 @@ impl Importer<'_, '_> {
         } else {
             return Err("it has neither a uri nor a bufferView".to_owned());
         };
+        // The size from the header, checked against the texel budget before decoding.
+        let (width, height) = image::ImageReader::new(std::io::Cursor::new(bytes.as_ref()))
+            .with_guessed_format()
+            .map_err(|err| err.to_string())?
+            .into_dimensions()
+            .map_err(|err| err.to_string())?;
+        let texels = u64::from(width) * u64::from(height);
+        let allowed = self.limits.max_texels.saturating_sub(self.texels.get());
+        if texels > allowed {
+            return Err(format!(
+                "{width}×{height} = {texels} texels, more than the {allowed} left of the {} allowed ({})",
+                self.limits.max_texels, self.limits.reason
+            ));
+        }
+        self.texels.set(self.texels.get() + texels);
         let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes.as_ref()))
             .with_guessed_format()
             .map_err(|err| err.to_string())?;

@@ -30,7 +30,10 @@
 //! (an unresolved POSITION accessor) checked beforehand and the whole import wrapped in
 //! `catch_unwind` as a last resort. Memory is bounded: decoded accessor data may not
 //! exceed a budget proportional to the input size, so a small file cannot claim huge
-//! counts; image decoding runs under `image` limits.
+//! counts; image decoding runs under `image` limits. The caller's [`ImportLimits`] bound the
+//! node count, the triangles after instancing (counted while walking the scene, before any
+//! instance is welded) and the texels of the textures (read from the image headers before
+//! decoding).
 //!
 //! Files: `container` (GLB chunks; buffer and image bytes from the BIN chunk, data URIs
 //! or external files), `schema` (the JSON: fix-ups, gltf-json validation), `accessor`
@@ -97,24 +100,67 @@ pub enum ImportError {
     },
 }
 
+/// Limits the importer checks before the work they bound (the caller derives them from its
+/// memory budget, see `colors::budget`): every limit past which a file is refused with a
+/// message naming the count and the limit.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ImportLimits {
+    /// Triangles over all mesh instances of the scene (after instancing, before welding).
+    pub max_triangles: u64,
+    /// Nodes in the file.
+    pub max_nodes: u64,
+    /// Texels of all decoded base-colour textures together (checked from the image
+    /// headers, before decoding).
+    pub max_texels: u64,
+    /// What decides the limits (for messages), e.g. "6.0 GiB of memory".
+    pub reason: String,
+}
+
+impl Default for ImportLimits {
+    /// The format's own limits: 32-bit face ids, 2^24 nodes, 2^28 texels.
+    fn default() -> Self {
+        ImportLimits {
+            max_triangles: u64::from(u32::MAX),
+            max_nodes: 1 << 24,
+            max_texels: 1 << 28,
+            reason: "32-bit face ids".to_owned(),
+        }
+    }
+}
+
 /// Loads a `.glb` or `.gltf` file (external buffers and images are resolved relative
-/// to the file's directory) into a [`Scene`]. See the module documentation for what is
-/// read, ignored and refused.
+/// to the file's directory) into a [`Scene`] within the default [`ImportLimits`]. See the
+/// module documentation for what is read, ignored and refused.
 pub fn import_gltf(path: &Path) -> Result<Scene, ImportError> {
+    import_gltf_within(path, &ImportLimits::default())
+}
+
+/// [`import_gltf`] within `limits`.
+pub fn import_gltf_within(path: &Path, limits: &ImportLimits) -> Result<Scene, ImportError> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|source| ImportError::Io {
         path: name.clone(),
         what: "the file".to_owned(),
         source,
     })?;
-    import_gltf_slice(&bytes, path.parent(), &name)
+    import_gltf_slice_within(&bytes, path.parent(), &name, limits)
 }
 
 /// Loads a glTF from memory. `base_dir` resolves relative URIs of external buffers and
 /// images (`None` refuses them); `name_for_messages` names the file in errors and
 /// warnings, and a name ending in `.glb` marks content that must be binary glTF.
 pub fn import_gltf_slice(bytes: &[u8], base_dir: Option<&Path>, name_for_messages: &str) -> Result<Scene, ImportError> {
-    let result = catch_unwind(AssertUnwindSafe(|| import_inner(bytes, base_dir, name_for_messages, false)));
+    import_gltf_slice_within(bytes, base_dir, name_for_messages, &ImportLimits::default())
+}
+
+/// [`import_gltf_slice`] within `limits`.
+pub fn import_gltf_slice_within(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    name_for_messages: &str,
+    limits: &ImportLimits,
+) -> Result<Scene, ImportError> {
+    let result = catch_unwind(AssertUnwindSafe(|| import_inner(bytes, base_dir, name_for_messages, false, limits)));
     match result {
         Ok(outcome) => outcome.map_err(|err| err.into_error(name_for_messages)),
         Err(payload) => {
@@ -160,7 +206,13 @@ const BUDGET_PER_INPUT_BYTE: u64 = 32;
 
 /// The import; `every_mesh` (for tests) also instances, at the identity, every mesh
 /// the scene does not use, so that all of a file's data is read.
-fn import_inner(bytes: &[u8], base_dir: Option<&Path>, name: &str, every_mesh: bool) -> Result<Scene, Fail> {
+fn import_inner(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    name: &str,
+    every_mesh: bool,
+    limits: &ImportLimits,
+) -> Result<Scene, Fail> {
     let is_glb = bytes.starts_with(b"glTF");
     let (json_bytes, bin) = if is_glb {
         container::split_glb(bytes).map_err(Fail::Gltf)?
@@ -176,6 +228,14 @@ fn import_inner(bytes: &[u8], base_dir: Option<&Path>, name: &str, every_mesh: b
     };
     let schema::ParsedJson { root, warnings, lights } = schema::parse_json(json_bytes)?;
     container::check_glb_buffer(&root, bin)?;
+    if root.nodes.len() as u64 > limits.max_nodes {
+        return invalid(format!(
+            "the file has {} nodes, more than the {} allowed ({})",
+            root.nodes.len(),
+            limits.max_nodes,
+            limits.reason
+        ));
+    }
 
     let budget = BUDGET_BASE.saturating_add((bytes.len() as u64).saturating_mul(BUDGET_PER_INPUT_BYTE));
 
@@ -189,6 +249,8 @@ fn import_inner(bytes: &[u8], base_dir: Option<&Path>, name: &str, every_mesh: b
         mesh_map: HashMap::new(),
         material_map: HashMap::new(),
         image_map: HashMap::new(),
+        limits,
+        texels: std::cell::Cell::new(0),
     };
     importer.check_node_graph()?;
     importer.traverse_scene()?;
@@ -225,6 +287,10 @@ struct Importer<'a, 'b> {
     material_map: HashMap<usize, u32>,
     /// glTF image index → index into `scene.textures` (`None`: not decodable).
     image_map: HashMap<usize, Option<u32>>,
+    /// The limits checked before the work they bound.
+    limits: &'a ImportLimits,
+    /// Texels of the textures decoded so far.
+    texels: std::cell::Cell<u64>,
 }
 
 impl Importer<'_, '_> {
@@ -283,7 +349,8 @@ mod tests {
         for file in files {
             let bytes = std::fs::read(&file).unwrap();
             let name = file.display().to_string();
-            let outcome = catch_unwind(AssertUnwindSafe(|| import_inner(&bytes, file.parent(), &name, true)));
+            let limits = ImportLimits::default();
+            let outcome = catch_unwind(AssertUnwindSafe(|| import_inner(&bytes, file.parent(), &name, true, &limits)));
             match outcome {
                 Ok(Ok(scene)) => {
                     loaded += 1;

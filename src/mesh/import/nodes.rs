@@ -35,6 +35,7 @@ impl Importer<'_, '_> {
             stack.push((node.value(), Mat4::IDENTITY));
         }
         let mut non_triangle = 0usize;
+        let mut triangles = 0u64;
         while let Some((index, parent_world)) = stack.pop() {
             let Some(node) = root.nodes.get(index) else {
                 return invalid(format!("scene {scene_index} refers to node {index}, which does not exist"));
@@ -62,11 +63,21 @@ impl Importer<'_, '_> {
             if let Some(mesh) = node.mesh
                 && let Some(mesh_index) = self.mesh_for(mesh.value(), &mut non_triangle)?
             {
-                self.scene.instances.push(Instance { mesh: mesh_index, world_from_local: world });
+                let mesh_triangles = self.scene.meshes.get(mesh_index as usize).map_or(0, |m| m.triangles.len());
+                triangles = triangles.saturating_add(mesh_triangles as u64);
+                if triangles <= self.limits.max_triangles {
+                    self.scene.instances.push(Instance { mesh: mesh_index, world_from_local: world });
+                }
             }
             for child in node.children.iter().flatten().rev() {
                 stack.push((child.value(), world));
             }
+        }
+        if triangles > self.limits.max_triangles {
+            return invalid(format!(
+                "scene {scene_index} instances {triangles} triangles, more than the {} allowed ({})",
+                self.limits.max_triangles, self.limits.reason
+            ));
         }
         if non_triangle > 0 {
             self.scene

@@ -183,6 +183,17 @@ pub enum PackedFileError {
         /// Its position.
         position: [f32; 3],
     },
+    /// A colour the formats cannot hold: NaN, infinite, negative, above
+    /// [`crate::colors::format::MAX_CHANNEL`], or an alpha outside `[0, 1]`.
+    #[error(
+        "sample {sample} has colour {color:?}: colours must be finite, R, G, B in [0, 65504] and alpha in [0, 1] (docs/FORMAT.md, \"Colour values\")"
+    )]
+    BadColor {
+        /// Index of the sample in the colour buffer.
+        sample: u64,
+        /// Its decoded colour.
+        color: [f32; 4],
+    },
     /// A triangle refers to a vertex that does not exist.
     #[error("index {corner} of triangle {triangle} is {index} but there are {vertex_count} vertices")]
     IndexOutOfRange {

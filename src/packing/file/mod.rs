@@ -33,7 +33,9 @@
 //!    section lengths;
 //! 5. the content: finite positions, indices in range, no repeated corners, and every
 //!    face record within the limits and its chains inside the colour buffer (the bounds
-//!    that make any GPU read derived from the records safe).
+//!    that make any GPU read derived from the records safe), and every colour storable
+//!    (finite, R, G, B in `[0, 65504]`, alpha in `[0, 1]`: a file with any other colour is
+//!    refused, never repaired).
 //!
 //! Deeper layout consistency (e.g. two faces agreeing on a shared edge's chain base) is
 //! the unpacker's job ([`crate::packing::packer`]), not this module's.
@@ -237,6 +239,22 @@ fn check_content(mesh: &PackedMesh, sample_count: u64) -> Result<(), PackedFileE
     }
     for (face, record) in (0u64..).zip(&mesh.face_records) {
         check_record(face, record, mesh.vertex_levels, sample_count)?;
+    }
+    check_colors(mesh)
+}
+
+/// Refuses a colour the formats cannot hold (RGBA8 always can): NaN, infinity, negative
+/// channels, channels above [`crate::colors::format::MAX_CHANNEL`], alpha outside `[0, 1]`.
+fn check_colors(mesh: &PackedMesh) -> Result<(), PackedFileError> {
+    if mesh.format == ColorFormat::Rgba8Srgb {
+        return Ok(());
+    }
+    let size = mesh.format.bytes_per_sample();
+    for (sample, bytes) in (0u64..).zip(mesh.colors.chunks_exact(size)) {
+        let color = mesh.format.decode(bytes);
+        if !crate::colors::format::is_storable(color) {
+            return Err(PackedFileError::BadColor { sample, color });
+        }
     }
     Ok(())
 }

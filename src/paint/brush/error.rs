@@ -36,6 +36,9 @@ pub enum BrushError {
     /// Recording the undo step failed.
     #[error(transparent)]
     Undo(#[from] UndoError),
+    /// A resolution change is past the budget (refused before it was made).
+    #[error(transparent)]
+    Budget(#[from] crate::colors::budget::BudgetError),
     /// The store refused a change.
     #[error(transparent)]
     Store(#[from] StoreError),

@@ -5,6 +5,8 @@
 use glam::DVec3;
 
 use crate::camera::OrbitCamera;
+use crate::colors::budget::{Budget, SampleTracker};
+use crate::colors::format::ColorFormat;
 use crate::colors::store::ColorStore;
 use crate::paint::picking::{MeshBvh, RayHit};
 use crate::paint::undo::{StepSummary, StoreWriter, UndoHistory};
@@ -93,6 +95,10 @@ pub struct Painter {
     mirror_plane_x: f64,
     stroke: Option<StrokeState>,
     scratch: Scratch,
+    /// The budget resolution changes are checked against, with the document's format.
+    budget: Option<(Budget, ColorFormat)>,
+    /// The sample counts during a resolution stroke (built at its first resize).
+    tracker: Option<SampleTracker>,
 }
 
 impl Painter {
@@ -105,7 +111,21 @@ impl Painter {
             .filter(|x| x.is_finite())
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
         let mirror_plane_x = if min <= max { 0.5 * (min + max) } else { 0.0 };
-        Painter { settings: BrushSettings::default(), mirror_plane_x, stroke: None, scratch: Scratch::default() }
+        Painter {
+            settings: BrushSettings::default(),
+            mirror_plane_x,
+            stroke: None,
+            scratch: Scratch::default(),
+            budget: None,
+            tracker: None,
+        }
+    }
+
+    /// The budget the resolution brush checks each face's change against before making it
+    /// (`None`: no check), with the colour format of the document.
+    pub fn set_budget(&mut self, budget: Option<(Budget, ColorFormat)>) {
+        self.budget = budget;
+        self.tracker = None;
     }
 
     /// The settings the next stroke uses.
@@ -145,6 +165,7 @@ impl Painter {
         history.begin_step(store, settings.label())?;
         self.scratch.fit(store);
         self.scratch.next_stroke();
+        self.tracker = None;
         self.stroke = Some(StrokeState { settings, last_cursor_px: cursor_px, since_dab_px: 0.0, world_per_px: None });
         let mut update = StrokeUpdate::default();
         if let Err(error) = self.dab_at_cursor(view, store, history, cursor_px, &mut update) {
@@ -203,6 +224,7 @@ impl Painter {
     /// Ends the stroke and closes its undo step. `None` when no stroke was in progress.
     pub fn end_stroke(&mut self, history: &mut UndoHistory) -> Option<StepSummary> {
         self.stroke.take()?;
+        self.tracker = None;
         history.end_step()
     }
 
@@ -258,6 +280,7 @@ impl Painter {
         if self.stroke.is_none() {
             self.scratch.fit(store);
             self.scratch.next_stroke();
+            self.tracker = None;
         }
         self.dab_with(&settings, view, &mut StoreWriter::new(store, history), center_world, radius_world)
     }
@@ -296,18 +319,31 @@ impl Painter {
             faces.dedup();
         }
         let all_mask = (1u8 << count) - 1;
-        self.scratch.face_masks.clear();
-        for &face in &faces {
-            let mask = if settings.backface_culling {
+        let mut masks = std::mem::take(&mut self.scratch.face_masks);
+        masks.clear();
+        if settings.backface_culling {
+            // The side the ray hits is the front: faces are oriented consistently with their
+            // component, then the hit face's side towards the eye decides (inside-out and
+            // mixed-winding meshes paint what the cursor shows).
+            let flips = self.scratch.face_flips(store);
+            let hit = view.bvh.cast(eye, center - eye, f64::INFINITY);
+            let hit_side = hit.map_or(1.0, |hit| {
+                let flipped = flips.get(hit.face as usize).copied().unwrap_or(false);
+                if hit.front_facing != flipped { 1.0 } else { -1.0 }
+            });
+            for &face in &faces {
                 let corners = store.topology().face_vertices.get(face as usize).copied().unwrap_or_default();
                 let [p0, p1, p2] = corners.map(|v| position(view.positions, v));
-                let normal = (p1 - p0).cross(p2 - p0);
-                (0..count).filter(|&k| normal.dot(footprint.eyes[k] - p0) > 0.0).fold(0u8, |m, k| m | 1 << k)
-            } else {
-                all_mask
-            };
-            self.scratch.face_masks.push(mask);
+                let side = if flips.get(face as usize).copied().unwrap_or(false) { -hit_side } else { hit_side };
+                let normal = (p1 - p0).cross(p2 - p0) * side;
+                masks.push(
+                    (0..count).filter(|&k| normal.dot(footprint.eyes[k] - p0) > 0.0).fold(0u8, |m, k| m | 1 << k),
+                );
+            }
+        } else {
+            masks.resize(faces.len(), all_mask);
         }
+        self.scratch.face_masks = masks;
         self.scratch.faces = faces;
         let stats = match settings.tool {
             Tool::Paint => {
@@ -315,15 +351,30 @@ impl Painter {
                 paint_faces(&footprint, &op, view.positions, writer, &mut self.scratch)
             }
             Tool::Blur => blur_faces(&footprint, view.positions, writer, &mut self.scratch),
-            Tool::Resolution(op) => resize_faces(op, writer, &mut self.scratch)?,
+            Tool::Resolution(op) => {
+                let budget = match &self.budget {
+                    Some((budget, format)) => {
+                        let tracker = self.tracker.get_or_insert_with(|| SampleTracker::new(writer.store()));
+                        Some((budget, *format, tracker))
+                    }
+                    None => None,
+                };
+                resize_faces(op, writer, &mut self.scratch, budget)?
+            }
         };
         Ok(stats)
     }
 }
 
 /// The resolution dab: applies `op` to every face in `scratch.faces` not yet changed in this
-/// stroke.
-fn resize_faces(op: ResolutionOp, writer: &mut StoreWriter, scratch: &mut Scratch) -> Result<DabStats, BrushError> {
+/// stroke; with a budget, each change is checked first (O(the face's edges)) and the first
+/// one past it stops the dab with [`BrushError::Budget`].
+fn resize_faces(
+    op: ResolutionOp,
+    writer: &mut StoreWriter,
+    scratch: &mut Scratch,
+    mut budget: Option<(&Budget, ColorFormat, &mut SampleTracker)>,
+) -> Result<DabStats, BrushError> {
     let stroke = scratch.stroke;
     let mut stats = DabStats { faces: scratch.faces.len() as u32, ..DabStats::default() };
     for &face in &scratch.faces {
@@ -336,6 +387,9 @@ fn resize_faces(op: ResolutionOp, writer: &mut StoreWriter, scratch: &mut Scratc
             continue;
         }
         if let Some(target) = op.apply(current) {
+            if let Some((budget, format, tracker)) = budget.as_mut() {
+                tracker.admit(writer.store(), face, target, budget, *format)?;
+            }
             *slot = stroke;
             if writer.set_face_resolution(face, target)? {
                 stats.faces_resized += 1;

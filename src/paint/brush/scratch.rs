@@ -23,6 +23,9 @@ pub(super) struct Scratch {
     /// Resolution tool: the stroke number in which each face was last changed.
     pub(super) face_stroke: Vec<u32>,
     pub(super) stroke: u32,
+    /// Backface culling: per face, whether its winding is read reversed to agree with its
+    /// component ([`crate::mesh::orientation::face_flips`]); built on first use.
+    pub(super) face_flipped: Vec<bool>,
 }
 
 impl Scratch {
@@ -36,9 +39,20 @@ impl Scratch {
             self.edge_stamp = vec![0; e];
             self.edge_mask = vec![0; e];
             self.face_stroke = vec![0; f];
+            self.face_flipped = Vec::new();
             self.stamp = 0;
             self.stroke = 0;
         }
+    }
+
+    /// The per-face flips of `store`'s mesh (computed once per mesh).
+    pub(super) fn face_flips(&mut self, store: &ColorStore) -> &[bool] {
+        let faces = store.topology().face_count() as usize;
+        if self.face_flipped.len() != faces {
+            let flips = crate::mesh::orientation::face_flips(store.topology());
+            self.face_flipped = flips.into_iter().map(|(_, flipped)| flipped).collect();
+        }
+        &self.face_flipped
     }
 
     fn next_stamp(&mut self) -> u32 {

@@ -102,8 +102,9 @@ impl BlendMode {
         Self::ALL.into_iter().find(|m| m.name() == name)
     }
 
-    /// `old · (1 − w) + target · w` with this mode's target; `base` is the base colour of
-    /// the sample (used by [`BlendMode::EraseToBase`] only).
+    /// `old · (1 − w) + target · w` with this mode's target, clamped by
+    /// [`crate::colors::format::clamp_color`]; `base` is the base colour of the sample (used by
+    /// [`BlendMode::EraseToBase`] only).
     #[inline]
     pub fn blend(self, old: Rgba, color: Rgba, base: Rgba, weight: f32) -> Rgba {
         let target = match self {
@@ -113,12 +114,13 @@ impl BlendMode {
             BlendMode::EraseToBase => base,
         };
         let keep = 1.0 - weight;
-        [
+        // Clamped to what the formats hold (`MAX_CHANNEL`, alpha 1): Add cannot make infinity.
+        crate::colors::format::clamp_color([
             old[0] * keep + target[0] * weight,
             old[1] * keep + target[1] * weight,
             old[2] * keep + target[2] * weight,
             old[3] * keep + target[3] * weight,
-        ]
+        ])
     }
 }
 

@@ -1,7 +1,8 @@
 //! One-shot tools: the eyedropper, fill (all faces, or the faces connected to one) and
 //! "set resolution", each written through one [`StoreWriter`] as its own undo step.
 
-use crate::colors::format::Rgba;
+use crate::colors::budget::{Budget, SampleCounts};
+use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::Resolution;
 use crate::colors::store::ColorStore;
 use crate::packing::sampler::{self, Filter};
@@ -103,15 +104,36 @@ pub fn fill(
 
 /// Sets the resolution of `faces` (every face when `None`) to `resolution`, as one undo step
 /// labelled "set resolution". Returns the number of faces changed.
+///
+/// With a `budget` (and the document's colour format), the samples of the result are counted
+/// first — closed form for every face, one pass otherwise — and a result past the budget is
+/// refused with [`BrushError::Budget`] before any face changes.
 pub fn set_resolution(
     store: &mut ColorStore,
     history: &mut UndoHistory,
     faces: Option<&[u32]>,
     resolution: Resolution,
+    budget: Option<(&Budget, ColorFormat)>,
 ) -> Result<u32, BrushError> {
     let face_count = store.topology().face_count();
     if let Some(&bad) = faces.and_then(|list| list.iter().find(|&&f| f >= face_count)) {
         return Err(BrushError::NoSuchFace(bad));
+    }
+    if let Some((budget, format)) = budget {
+        match faces {
+            None => {
+                let counts = SampleCounts::uniform_on(store.topology(), resolution);
+                budget.check(&format!("R = {resolution} on every face"), &counts, format)?;
+            }
+            Some(list) => {
+                let mut resolutions = store.face_resolutions().to_vec();
+                for &face in list {
+                    resolutions[face as usize] = resolution;
+                }
+                let what = format!("R = {resolution} on {} faces", list.len());
+                budget.check_resolutions(&what, store, &resolutions, format)?;
+            }
+        }
     }
     history.begin_step(store, "set resolution")?;
     let mut changed = 0;
