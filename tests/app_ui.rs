@@ -586,6 +586,8 @@ fn optimize_button_lowers_resolutions_losslessly_and_undoes() {
     harness.run_steps(2);
     assert_eq!(store(harness.state()).face_resolutions(), before.face_resolutions());
     assert_eq!(store(harness.state()).sample_count(), before.sample_count());
+}
+
 /// The Duck opened within a memory budget of `bytes`, in paint mode.
 fn duck_painting_within(bytes: u64) -> Harness<'static, Editor> {
     let mut editor = new_editor();

@@ -127,6 +127,7 @@ fn plain(tool: Tool, color: Rgba, radius: BrushRadius) -> BrushSettings {
         occlusion: false,
         backface_culling: false,
         mirror_x: false,
+        follow_resolution: None,
     }
 }
 

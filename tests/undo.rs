@@ -106,6 +106,7 @@ fn settings(tool: Tool, blend: BlendMode, color: Rgba, radius_px: f64) -> BrushS
         occlusion: true,
         backface_culling: true,
         mirror_x: true,
+        follow_resolution: None,
     }
 }
 

@@ -107,6 +107,7 @@ fn culling_paints_the_visible_side(mesh: Mesh, what: &str) {
         occlusion: false,
         backface_culling: true,
         mirror_x: false,
+        follow_resolution: None,
     });
     let eye = camera.eye();
     let center = DVec3::from_array(camera.target) + camera.eye_direction();

@@ -119,7 +119,8 @@ pub fn bench_adaptive(
     let mut queue: std::collections::VecDeque<ResolutionRule> = rules.iter().copied().collect();
     while let Some(rule) = queue.pop_front() {
         let started = Instant::now();
-        let document = Document::from_scene_within(scene.clone(), rule, path, &crate::colors::budget::Budget::from_environment())?;
+        let document =
+            Document::from_scene_within(scene.clone(), rule, path, &crate::colors::budget::Budget::from_environment())?;
         let convert_seconds = started.elapsed().as_secs_f64();
         let packed = document.pack(ColorFormat::Rgba8Srgb)?;
         let mesh = gpu.upload(&packed)?;

@@ -7,8 +7,8 @@ use anyhow::{Context, Result};
 use meshpaint::colors::budget::{Budget, SampleCounts, bytes_text};
 use meshpaint::colors::format::ColorFormat;
 use meshpaint::colors::layout::Resolution;
-use meshpaint::io::adaptive::ResolutionRule;
 use meshpaint::colors::stats::MeshStats;
+use meshpaint::io::adaptive::ResolutionRule;
 use meshpaint::io::document::{SourceKind, import_limits};
 use meshpaint::mesh::orientation::Orientation;
 use meshpaint::mesh::topology::Topology;
@@ -103,7 +103,9 @@ fn gltf_info(path: &Path, resolution_arg: ResolutionArg, json: bool) -> Result<(
     let mut extra = Orientation::of(&topology, &mesh.positions_world).to_json();
     let rule = rule?;
     let (counts, what) = match rule {
-        ResolutionRule::Uniform(_) => (SampleCounts::uniform_on(&topology, resolution), format!("R = {resolution} on every face")),
+        ResolutionRule::Uniform(_) => {
+            (SampleCounts::uniform_on(&topology, resolution), format!("R = {resolution} on every face"))
+        }
         rule => {
             // Content-driven resolutions: the fit runs (no samples are allocated).
             let face_count = topology.face_count() as usize;

@@ -54,6 +54,10 @@ pub(super) struct PaintArgs {
     /// Also paint mirrored across x = centre of the mesh bounds.
     #[arg(long)]
     mirror_x: bool,
+    /// Resolution follows the brush: raise faces under each dab to the R that resolves it
+    /// (spacing ≤ radius / 4), up to this R.
+    #[arg(long, value_name = "MAX_R")]
+    follow_resolution: Option<u64>,
     #[command(flatten)]
     camera: CameraArgs,
     /// View width in pixels.
@@ -117,6 +121,10 @@ fn brush_settings(args: &PaintArgs, color: Rgba) -> Result<BrushSettings> {
         occlusion: !args.no_occlusion,
         backface_culling: !args.no_backface_culling,
         mirror_x: args.mirror_x,
+        follow_resolution: args
+            .follow_resolution
+            .map(|max| Resolution::new(max).context("--follow-resolution"))
+            .transpose()?,
     };
     settings.validate()?;
     Ok(settings)

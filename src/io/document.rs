@@ -281,11 +281,7 @@ impl Document {
     /// (a [`Resolution`] is uniform; [`crate::io::adaptive`]): a glTF file's triangles (after
     /// instancing), nodes and textures are checked while it is read, its samples before the
     /// store is allocated; a packed file's samples before it is unpacked.
-    pub fn open_within(
-        path: &Path,
-        rule: impl Into<ResolutionRule>,
-        budget: &Budget,
-    ) -> Result<Self, DocumentError> {
+    pub fn open_within(path: &Path, rule: impl Into<ResolutionRule>, budget: &Budget) -> Result<Self, DocumentError> {
         let rule = rule.into();
         let mut head = [0u8; 8];
         let is_packed = {
@@ -359,7 +355,9 @@ impl Document {
         let resolutions = match rule {
             ResolutionRule::Uniform(r) => {
                 let counts = SampleCounts::uniform_on(&topology, r);
-                budget.check(&format!("R = {r} on every face"), &counts, ColorFormat::default()).map_err(budget_error)?;
+                budget
+                    .check(&format!("R = {r} on every face"), &counts, ColorFormat::default())
+                    .map_err(budget_error)?;
                 vec![r; topology.face_count() as usize]
             }
             rule => {

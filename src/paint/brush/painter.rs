@@ -16,7 +16,8 @@ use super::error::BrushError;
 use super::footprint::Footprint;
 use super::kernels::{DabStats, PaintOp, paint_faces};
 use super::scratch::{Scratch, position};
-use super::settings::{BlendMode, BrushRadius, BrushSettings, ResolutionOp, Tool};
+use super::settings::{BlendMode, BrushRadius, BrushSettings, ResolutionOp, Tool, resolution_for_brush};
+use crate::colors::layout::Resolution;
 
 /// Smallest distance between dabs along a stroke, pixels.
 pub const MIN_SPACING_PX: f64 = 0.25;
@@ -345,6 +346,9 @@ impl Painter {
         }
         self.scratch.face_masks = masks;
         self.scratch.faces = faces;
+        if let (Some(max), Tool::Paint | Tool::Blur) = (settings.follow_resolution, settings.tool) {
+            self.follow_brush(max, radius_world, view, writer)?;
+        }
         let stats = match settings.tool {
             Tool::Paint => {
                 let op = PaintOp { blend: settings.blend, color: settings.color, base: view.base };
@@ -363,6 +367,42 @@ impl Painter {
             }
         };
         Ok(stats)
+    }
+}
+
+impl Painter {
+    /// Resolution follows the brush ([`BrushSettings::follow_resolution`]): raises the faces
+    /// of the dab (those facing the eye, `scratch.face_masks` ≠ 0) that cannot resolve
+    /// `radius_world`, each checked against the budget first.
+    fn follow_brush(
+        &mut self,
+        max: Resolution,
+        radius_world: f64,
+        view: &PaintView,
+        writer: &mut StoreWriter,
+    ) -> Result<(), BrushError> {
+        for (k, &face) in self.scratch.faces.iter().enumerate() {
+            if self.scratch.face_masks.get(k).copied().unwrap_or(0) == 0 {
+                continue;
+            }
+            let store = writer.store();
+            let Some(current) = store.face_resolution(face) else { continue };
+            let corners = store.topology().face_vertices.get(face as usize).copied().unwrap_or_default();
+            let [p0, p1, p2] = corners.map(|v| position(view.positions, v));
+            let longest = (p1 - p0).length().max((p2 - p1).length()).max((p0 - p2).length());
+            let target = resolution_for_brush(longest, radius_world, max);
+            if target <= current {
+                continue;
+            }
+            if let Some((budget, format)) = &self.budget {
+                let tracker = self.tracker.get_or_insert_with(|| SampleTracker::new(writer.store()));
+                tracker.admit(writer.store(), face, target, budget, *format)?;
+            }
+            writer.set_face_resolution(face, target)?;
+        }
+        // The sample scratch follows the resized store.
+        self.scratch.fit(writer.store());
+        Ok(())
     }
 }
 

@@ -203,6 +203,22 @@ pub struct BrushSettings {
     pub backface_culling: bool,
     /// Also paint mirrored across the plane `x =` centre of the mesh bounds.
     pub mirror_x: bool,
+    /// Resolution follows the brush (paint and blur): before a dab, each face under it whose
+    /// sample spacing (longest edge / R) is coarser than a quarter of the radius is raised
+    /// to the smallest power of two that resolves it, `R ≥ 4 · longest edge / radius`,
+    /// capped at this value (`None`: off). Never lowers a face.
+    pub follow_resolution: Option<Resolution>,
+}
+
+/// The resolution a face needs to resolve a brush of `radius_world` (sample spacing at most a
+/// quarter of the radius along its longest edge), capped at `max`.
+pub fn resolution_for_brush(longest_edge: f64, radius_world: f64, max: Resolution) -> Resolution {
+    let wanted = 4.0 * longest_edge / radius_world;
+    if !(wanted.is_finite() && wanted > 1.0) {
+        return if wanted.is_finite() { Resolution::ONE } else { max };
+    }
+    let log2 = (wanted.ceil() as u64).next_power_of_two().trailing_zeros().min(max.log2());
+    Resolution::from_log2(log2).unwrap_or(max)
 }
 
 impl Default for BrushSettings {
@@ -218,6 +234,7 @@ impl Default for BrushSettings {
             occlusion: true,
             backface_culling: true,
             mirror_x: false,
+            follow_resolution: None,
         }
     }
 }
