@@ -707,6 +707,12 @@ fn brush_settings_ui(ui: &mut egui::Ui, brush: &mut BrushSettings, bounds_radius
     ui.checkbox(&mut brush.occlusion, "Occlusion").on_hover_text("Paint only what the eye sees");
     ui.checkbox(&mut brush.backface_culling, "Backface culling");
     ui.checkbox(&mut brush.mirror_x, "X mirror");
+    // Resolution follows the brush: faces under a dab are raised until their sample spacing
+    // is at most a quarter of the radius (up to R = 64).
+    let mut follow = brush.follow_resolution.is_some();
+    ui.checkbox(&mut follow, "Resolution follows the brush")
+        .on_hover_text("Raise the faces under each dab to the R that resolves the brush (spacing at most a quarter of the radius, R up to 64)");
+    brush.follow_resolution = follow.then(|| Resolution::from_log2(6).unwrap_or(Resolution::MAX));
 }
 
 /// A labelled combo box of resolutions 1 … 64.

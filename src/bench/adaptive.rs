@@ -135,10 +135,10 @@ pub fn bench_adaptive(
             resolutions.iter().map(|r| r.get()).max().unwrap_or(1),
         );
         // Next to each uniform R ≥ 4: the budget allocation with a third of its samples.
-        if let (ResolutionRule::Uniform(r), Some(max)) = (rule, budget_max) {
-            if r.get() >= 4 {
-                queue.push_front(ResolutionRule::Budget { samples: document.store.sample_count() / 3, max });
-            }
+        if let (ResolutionRule::Uniform(r), Some(max)) = (rule, budget_max)
+            && r.get() >= 4
+        {
+            queue.push_front(ResolutionRule::Budget { samples: document.store.sample_count() / 3, max });
         }
         rows.push(AdaptiveRow {
             rule,
