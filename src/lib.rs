@@ -12,7 +12,7 @@
 //!
 //! | folder | holds |
 //! |---|---|
-//! | [`mesh`] | [`mesh::scene`] (imported data), [`mesh::import`] (glTF → scene, every bad input refused with a message), [`mesh::weld`] (one indexed mesh, bitwise-equal positions merged per instance), [`mesh::topology`] (edges, incidence, boundary / non-manifold, valence) |
+//! | [`mesh`] | [`mesh::scene`] (imported data), [`mesh::import`] (glTF → scene, every bad input refused with a message), [`mesh::formats`] (OBJ / PLY / STL → scene, the same refusals), [`mesh::weld`] (one indexed mesh, bitwise-equal positions merged per instance), [`mesh::topology`] (edges, incidence, boundary / non-manifold, valence) |
 //! | [`colors`] | the mesh-colors core: [`colors::layout`] (sample counts, classification, MIP offsets, filtering), [`colors::format`] (linear RGBA, sRGB, RGBA8 / 16F / 32F), [`colors::store`] (the map-based store with per-face R and dirty tracking), [`colors::resample`] (exact 2× refine / reduce), [`colors::stats`] (the sample budget `info` prints) |
 //! | [`packing`] | [`packing::linear`] (16-byte face records, colour buffer with MIP chains), [`packing::packer`] (store ⇄ linear, eq. 2.5/2.6), [`packing::paint_layout`] (paint-mode blocks with slack, dirty ranges), [`packing::sampler`] (the CPU reference sampler, the truth the GPU is tested against), [`packing::file`] (the packed file format) |
 //! | [`paint`] | [`paint::picking`] (obvhs BVH, watertight rays), [`paint::brush`] (colour / blur / resolution brushes, tools, replay), [`paint::undo`] (per stroke, memory cap) |

@@ -14,7 +14,7 @@ use super::args::{LOG_TARGET, ResolutionArg, open};
 /// Arguments of `meshpaint info`.
 #[derive(Debug, clap::Args)]
 pub(super) struct InfoArgs {
-    /// A .glb / .gltf file or a packed file.
+    /// A .glb / .gltf, .obj, .ply, .stl or packed file.
     file: PathBuf,
     #[command(flatten)]
     resolution: ResolutionArg,
@@ -57,11 +57,11 @@ pub(super) fn run(args: InfoArgs) -> Result<()> {
     Ok(())
 }
 
-/// A glTF file: counts need the welded topology only, not the samples, so this stays
+/// A mesh file (glTF, OBJ, PLY, STL): counts need the welded topology only, not the samples, so this stays
 /// cheap at any R.
 fn gltf_info(path: &Path, resolution: ResolutionArg, json: bool) -> Result<()> {
     let resolution = resolution.get()?;
-    let scene = meshpaint::mesh::import::import_gltf(path)?;
+    let (scene, _) = meshpaint::io::document::import_scene(path)?;
     for warning in &scene.warnings {
         log::warn!(target: LOG_TARGET, "{}: {warning}", path.display());
     }

@@ -13,7 +13,7 @@ use super::args::{CameraArgs, LOG_TARGET, ResolutionArg};
 /// Arguments of `meshpaint render`.
 #[derive(Debug, clap::Args)]
 pub(super) struct RenderArgs {
-    /// A .glb / .gltf file or a packed file.
+    /// A .glb / .gltf, .obj, .ply, .stl or packed file.
     file: PathBuf,
     /// Output PNG.
     #[arg(long, short = 'o')]
@@ -94,7 +94,7 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
     let started = std::time::Instant::now();
     let gpu = Gpu::new_headless()?;
     let (image, triangles, samples) = if args.baseline_uv {
-        let scene = meshpaint::mesh::import::import_gltf(&args.file)?;
+        let (scene, _) = meshpaint::io::document::import_scene(&args.file)?;
         let mesh = gpu.upload_baseline(&scene)?.with_context(|| {
             format!(
                 "{}: --baseline-uv needs a glTF file with a base-colour texture, and no material has one",

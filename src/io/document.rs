@@ -1,7 +1,7 @@
-//! A document: one mesh with its mesh colors, opened from glTF or a packed file.
+//! A document: one mesh with its mesh colors, opened from glTF, OBJ, PLY, STL or a packed file.
 //!
-//! Opening chooses the loader by content (the packed magic), not by extension. A glTF
-//! mesh is welded, given a uniform resolution, and coloured: without a texture it gets
+//! Opening chooses the loader by content (the packed magic, PLY's magic line), then by
+//! extension for OBJ and STL, else glTF. An imported mesh is welded, given a uniform resolution, and coloured: without a texture it gets
 //! a deterministic colour from position so the result is visibly non-uniform. A packed
 //! file is unpacked into the editable store.
 //!
@@ -17,6 +17,7 @@ use thiserror::Error;
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::Resolution;
 use crate::colors::store::ColorStore;
+use crate::mesh::formats::{FormatError, MeshFormat, import_mesh_file};
 use crate::mesh::import::{ImportError, import_gltf};
 use crate::mesh::scene::Scene;
 use crate::mesh::topology::{Topology, TopologyError};
@@ -39,6 +40,9 @@ pub enum DocumentError {
     /// The glTF importer refused the file.
     #[error(transparent)]
     Import(#[from] ImportError),
+    /// The OBJ / PLY / STL importer refused the file.
+    #[error(transparent)]
+    Format(#[from] FormatError),
     /// The packed-file reader or writer refused the file.
     #[error(transparent)]
     PackedFile(#[from] PackedFileError),
@@ -71,7 +75,7 @@ pub enum DocumentError {
 pub enum Source {
     /// The Duck embedded in the binary ([`BUILT_IN_GLB`]).
     BuiltIn,
-    /// A .glb / .gltf or packed file.
+    /// A .glb / .gltf, .obj, .ply, .stl or packed file.
     File(PathBuf),
 }
 
@@ -136,6 +140,8 @@ pub fn open_for_display(
 pub enum SourceKind {
     /// A .glb / .gltf file.
     Gltf,
+    /// An OBJ, PLY or STL file.
+    Mesh(MeshFormat),
     /// A packed file, in this colour format.
     Packed(ColorFormat),
 }
@@ -226,26 +232,46 @@ fn apply_vertex_colors(store: &mut ColorStore, vertex_colors: &[[f32; 4]], multi
     });
 }
 
+/// The first bytes of `path` (fewer when the file is shorter).
+fn read_head(path: &Path) -> Result<Vec<u8>, DocumentError> {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(16);
+    let file = std::fs::File::open(path).map_err(|source| DocumentError::Io { path: path.to_owned(), source })?;
+    file.take(16).read_to_end(&mut head).map_err(|source| DocumentError::Io { path: path.to_owned(), source })?;
+    Ok(head)
+}
+
+/// Imports a mesh file that is not packed: OBJ / PLY / STL ([`MeshFormat::detect`]) or
+/// glTF. The one import path of `Document::open`, `info` and `render --baseline-uv`.
+pub fn import_scene(path: &Path) -> Result<(Scene, SourceKind), DocumentError> {
+    let head = read_head(path)?;
+    import_scene_after(path, &head)
+}
+
+fn import_scene_after(path: &Path, head: &[u8]) -> Result<(Scene, SourceKind), DocumentError> {
+    match MeshFormat::detect(path, head) {
+        Some(format) => Ok((import_mesh_file(path, format)?, SourceKind::Mesh(format))),
+        None => Ok((import_gltf(path)?, SourceKind::Gltf)),
+    }
+}
+
 impl Document {
-    /// Opens `path`: a packed file (by magic) or glTF at uniform `gltf_resolution`.
+    /// Opens `path`: a packed file (by magic), an OBJ / PLY / STL file
+    /// ([`MeshFormat::detect`]) or glTF, meshes at uniform `gltf_resolution`.
     ///
-    /// A glTF mesh whose materials carry a base-colour texture or a non-white factor is
+    /// A mesh whose materials carry a base-colour texture or a non-white factor is
     /// baked from them ([`crate::io::bake::bake_texture`]); otherwise it gets
-    /// [`position_color`].
+    /// [`position_color`]. Vertex colours (glTF COLOR_0, OBJ and PLY colours) are applied.
     pub fn open(path: &Path, gltf_resolution: Resolution) -> Result<Self, DocumentError> {
-        let mut head = [0u8; 8];
-        let is_packed = {
-            use std::io::Read;
-            let mut file =
-                std::fs::File::open(path).map_err(|source| DocumentError::Io { path: path.to_owned(), source })?;
-            let read = file.read(&mut head).unwrap_or(0);
-            packed_file::looks_like_packed(&head[..read])
-        };
-        if is_packed {
+        let head = read_head(path)?;
+        if packed_file::looks_like_packed(&head) {
             let packed = packed_file::read_file(path)?;
             return Self::from_packed(&packed).map_err(|source| DocumentError::Pack { path: path.to_owned(), source });
         }
-        Self::from_scene(import_gltf(path)?, gltf_resolution, path)
+        let (scene, kind) = import_scene_after(path, &head)?;
+        let mut document = Self::from_scene(scene, gltf_resolution, path)?;
+        document.source = kind;
+        Ok(document)
     }
 
     /// Opens `source`: the built-in scene or a file, as [`Document::open`] does.
@@ -264,7 +290,7 @@ impl Document {
     pub fn display_format(&self) -> ColorFormat {
         match self.source {
             SourceKind::Packed(format) => format,
-            SourceKind::Gltf => ColorFormat::default(),
+            SourceKind::Gltf | SourceKind::Mesh(_) => ColorFormat::default(),
         }
     }
 

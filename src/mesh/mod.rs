@@ -2,6 +2,7 @@
 //!
 //! `file ─ import ─▶ Scene ─ weld ─▶ WeldedMesh ─ topology ─▶ Topology`
 
+pub mod formats;
 pub mod import;
 pub mod scene;
 pub mod topology;
