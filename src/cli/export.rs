@@ -8,6 +8,8 @@ use anyhow::{Context, Result};
 use meshpaint::colors::format::ColorFormat;
 use meshpaint::io::bake_uv::{bake_uv_texture, default_padding};
 use meshpaint::io::document::{Document, SourceKind, import_scene};
+use meshpaint::io::export_fit::{FitOptions, write_fitted_glb};
+use meshpaint::io::export_gltf::ColorEncoding;
 use meshpaint::io::export_textured::{TexturedMesh, encode_png, textured_glb};
 use meshpaint::mesh::weld::weld_scene;
 
@@ -31,13 +33,35 @@ pub(super) struct ExportArgs {
     /// which has no UVs). Its welded mesh must be FILE's.
     #[arg(long, value_name = "SOURCE", requires = "texture")]
     uvs: Option<PathBuf>,
+    /// .glb: tessellate every face at R >> LEVEL (at least 1); the error is reported.
+    #[arg(long, value_name = "LEVEL", conflicts_with_all = ["max_vertices", "texture"])]
+    level: Option<u32>,
+    /// .glb: the finest level whose tessellation has at most N vertices.
+    #[arg(long, value_name = "N", conflicts_with = "texture")]
+    max_vertices: Option<u64>,
+    /// .glb COLOR_0: auto (normalized u8 or u16 when no colour changes, else float; the
+    /// default with --level / --max-vertices), float, u16 or u8.
+    #[arg(long, value_enum, conflicts_with = "texture")]
+    colors: Option<ColorsArg>,
     #[command(flatten)]
     output: OutputArgs,
+}
+
+/// `--colors` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum ColorsArg {
+    Auto,
+    Float,
+    U16,
+    U8,
 }
 
 pub(super) fn run(args: ExportArgs) -> Result<()> {
     if let Some(size) = args.texture {
         return export_texture(&args, size);
+    }
+    if args.level.is_some() || args.max_vertices.is_some() || args.colors.is_some() {
+        return export_fitted(&args);
     }
     let ExportArgs { file: path, resolution, format, output, .. } = args;
     if output.is_glb()? && format.is_some() {
@@ -125,6 +149,38 @@ fn export_texture(args: &ExportArgs, size: u32) -> Result<()> {
         out.display(),
         bake.faces_without_uvs.len(),
         bytes.len()
+    );
+    Ok(())
+}
+
+/// `--level`, `--max-vertices`, `--colors`: the tessellated .glb fitted to the content.
+fn export_fitted(args: &ExportArgs) -> Result<()> {
+    let (path, out) = (&args.file, &args.output.output);
+    anyhow::ensure!(args.output.is_glb()?, "--level, --max-vertices and --colors apply to .glb output");
+    anyhow::ensure!(args.format.is_none(), "--format applies to packed output only");
+    let document = open(path, args.resolution)?;
+    let encoding = match args.colors.unwrap_or(ColorsArg::Auto) {
+        ColorsArg::Auto => None,
+        ColorsArg::Float => Some(ColorEncoding::Float),
+        ColorsArg::U16 => Some(ColorEncoding::Unorm16),
+        ColorsArg::U8 => Some(ColorEncoding::Unorm8),
+    };
+    let options = FitOptions { level: args.level.unwrap_or(0), max_vertices: args.max_vertices, encoding };
+    let summary = write_fitted_glb(out, &document.positions, &document.store, document.display_format(), options)
+        .with_context(|| format!("exporting {}", path.display()))?;
+    let (colors, as_float) = summary.color_bytes;
+    eprintln!(
+        "{} → {}: level {}, {} vertices, {} triangles, COLOR_0 {:?} ({colors} B instead of {as_float} B as float), \
+         error against the full-resolution colours: max {} / RMS {:.2} 8-bit steps, {} B",
+        path.display(),
+        out.display(),
+        summary.level,
+        summary.vertices,
+        summary.triangles,
+        summary.encoding,
+        summary.error_steps.0,
+        summary.error_steps.1,
+        summary.bytes
     );
     Ok(())
 }

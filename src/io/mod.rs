@@ -5,6 +5,7 @@ pub mod autosave;
 pub mod bake;
 pub mod bake_uv;
 pub mod document;
+pub mod export_fit;
 pub mod export_gltf;
 pub mod export_textured;
 
