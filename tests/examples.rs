@@ -86,18 +86,19 @@ fn view_packed_renders_what_meshpaint_render_renders() {
     let mixed_document = Document::open(&mixed, Resolution::ONE).unwrap();
     let resolutions = mixed_document.store.face_resolutions();
     assert!(resolutions.iter().min() < resolutions.iter().max(), "the raise stroke left one resolution");
-    let suzanne = dir.join("suzanne16f.mpk");
+    // The textured Fox in RGBA16F.
+    let fox = dir.join("fox16f.mpk");
     run(&[
         "pack",
-        model("Suzanne/monkey.glb").to_str().unwrap(),
+        model("Fox/Fox.glb").to_str().unwrap(),
         "-o",
-        suzanne.to_str().unwrap(),
+        fox.to_str().unwrap(),
         "--format",
         "rgba16f",
         "-r",
         "4",
     ]);
-    for (file, yaw, pitch) in [(&mixed, 30.0, 20.0), (&suzanne, -60.0, 35.0)] {
+    for (file, yaw, pitch) in [(&mixed, 30.0, 20.0), (&fox, -60.0, 35.0)] {
         let (reference, ours) = (dir.join("render.png"), dir.join("view.png"));
         let (yaw_arg, pitch_arg) = (format!("--yaw={yaw}"), format!("--pitch={pitch}"));
         run(&[

@@ -400,3 +400,32 @@ fn pack_accepts_ply_and_the_packed_file_has_the_same_counts() {
     let packed = info(&output, 4);
     assert_eq!([get(&packed, "triangles"), get(&packed, "vertices"), get(&packed, "edges")], [12, 8, 18]);
 }
+
+/// An untextured mesh opens in the neutral grey (every lit mesh pixel has R = G = B);
+/// `render --position-colors` shows the position field instead (coloured pixels).
+#[test]
+fn untextured_meshes_open_grey_and_position_colors_are_a_view() {
+    let dir = TempDir::new("neutral");
+    let stl = model("AssimpTestModels/sphereWithHole.stl");
+    let render = |name: &str, extra: &[&str]| {
+        let out = dir.join(name);
+        let output = Command::new(BIN)
+            .arg("render")
+            .arg(&stl)
+            .arg("-o")
+            .arg(&out)
+            .args(["--width", "160", "--height", "120"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", describe(&output));
+        image::open(&out).unwrap().to_rgb8()
+    };
+    let (grey, colored) = (render("grey.png", &[]), render("colored.png", &["--position-colors"]));
+    let background = *grey.get_pixel(0, 0);
+    let mesh: Vec<_> = grey.pixels().filter(|p| **p != background).collect();
+    assert!(mesh.len() > 160 * 120 / 10, "the sphere is visible");
+    assert!(mesh.iter().all(|p| p[0] == p[1] && p[1] == p[2]), "a non-grey pixel in the neutral render");
+    let tinted = colored.pixels().filter(|p| **p != background && (p[0] != p[1] || p[1] != p[2])).count();
+    assert!(tinted > mesh.len() / 2, "only {tinted} coloured pixels with --position-colors");
+}

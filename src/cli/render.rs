@@ -46,6 +46,10 @@ pub(super) struct RenderArgs {
     /// Draw the glTF UVs and base-colour texture (the baseline) instead of mesh colors.
     #[arg(long)]
     baseline_uv: bool,
+    /// Show a colour field of the position instead of the document's colours (a view of the
+    /// shape and its samples; the document is unchanged).
+    #[arg(long, conflicts_with = "baseline_uv")]
+    position_colors: bool,
 }
 
 /// `--filter` values.
@@ -109,7 +113,14 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
         for warning in &displayed.document.warnings {
             log::warn!(target: LOG_TARGET, "{}: {warning}", args.file.display());
         }
-        let mesh = gpu.upload(&displayed.packed)?;
+        let mesh = if args.position_colors {
+            let document = &displayed.document;
+            let store = meshpaint::io::document::position_colored(&document.store, &document.positions);
+            let view = meshpaint::io::document::Document { store, ..document.clone() };
+            gpu.upload(&view.pack(document.display_format())?)?
+        } else {
+            gpu.upload(&displayed.packed)?
+        };
         let image = gpu.render_image(DrawItem::MeshColors(&mesh), &settings(mesh.bounds), args.width, args.height)?;
         (image, mesh.face_count, mesh.atlas.samples)
     };

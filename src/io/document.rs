@@ -1,9 +1,9 @@
 //! A document: one mesh with its mesh colors, opened from glTF, OBJ, PLY, STL or a packed file.
 //!
 //! Opening chooses the loader by content (the packed magic, PLY's magic line), then by
-//! extension for OBJ and STL, else glTF. An imported mesh is welded, given a uniform resolution, and coloured: without a texture it gets
-//! a deterministic colour from position so the result is visibly non-uniform. A packed
-//! file is unpacked into the editable store.
+//! extension for OBJ and STL, else glTF. An imported mesh is welded, given a uniform
+//! resolution, and coloured: from its texture, material colour or vertex colours, else a
+//! neutral light grey to paint on. A packed file is unpacked into the editable store.
 //!
 //! [`open_for_display`] is the one way to open a document for display (the editor, `render`,
 //! `bench render`, the examples): open the [`Source`], refuse a mesh without triangles, pack
@@ -161,8 +161,9 @@ pub struct Document {
     pub warnings: Vec<String>,
 }
 
-/// A smooth, deterministic colour field over the bounding box, so texture-less meshes
-/// show visible variation: three sine waves of different frequency per channel.
+/// A smooth, deterministic colour field over the bounding box that shows the shape and the
+/// resolution of a mesh: three sine waves of different frequency per channel
+/// ([`position_colored`]; a view option, untextured meshes open in a neutral colour).
 pub fn position_color(position: [f32; 3], bounds_min: [f32; 3], bounds_size: [f32; 3]) -> Rgba {
     let t: [f32; 3] = std::array::from_fn(|a| {
         let size = if bounds_size[a] > 0.0 { bounds_size[a] } else { 1.0 };
@@ -186,6 +187,33 @@ pub fn bounds(positions: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
         return ([0.0; 3], [0.0; 3]);
     }
     (min, std::array::from_fn(|a| max[a] - min[a]))
+}
+
+/// The colour an untextured mesh opens in where its faces have no material (the glTF
+/// default material is white, which is too bright to paint on): a light grey, linear RGBA
+/// (8-bit sRGB 203).
+pub const NEUTRAL_BASE_COLOR: Rgba = [0.6, 0.6, 0.6, 1.0];
+
+/// Colours every sample of a mesh without textures or vertex colours: its owner face's
+/// material base colour factor, or [`NEUTRAL_BASE_COLOR`] for faces without a material.
+fn fill_neutral(store: &mut ColorStore, triangle_materials: &[Option<u32>], scene: &Scene) {
+    store.fill_with(|site| {
+        triangle_materials
+            .get(site.face as usize)
+            .copied()
+            .flatten()
+            .and_then(|m| scene.materials.get(m as usize))
+            .map_or(NEUTRAL_BASE_COLOR, |material| material.base_color_factor)
+    });
+}
+
+/// `store` with every sample coloured by [`position_color`] at its position on `positions`:
+/// a view of the geometry (`render --position-colors`), not a document's content.
+pub fn position_colored(store: &ColorStore, positions: &[[f32; 3]]) -> ColorStore {
+    let mut out = store.clone();
+    fill_with_position_colors(&mut out, positions);
+    out.take_dirty();
+    out
 }
 
 /// Colours every sample of `store` with [`position_color`] at its position on `positions`.
@@ -260,8 +288,9 @@ impl Document {
     /// ([`MeshFormat::detect`]) or glTF, meshes at uniform `gltf_resolution`.
     ///
     /// A mesh whose materials carry a base-colour texture or a non-white factor is
-    /// baked from them ([`crate::io::bake::bake_texture`]); otherwise it gets
-    /// [`position_color`]. Vertex colours (glTF COLOR_0, OBJ and PLY colours) are applied.
+    /// baked from them ([`crate::io::bake::bake_texture`]); otherwise each face gets its
+    /// material's base colour factor, or [`NEUTRAL_BASE_COLOR`] without a material. Vertex
+    /// colours (glTF COLOR_0, OBJ and PLY colours) are applied.
     pub fn open(path: &Path, gltf_resolution: Resolution) -> Result<Self, DocumentError> {
         let head = read_head(path)?;
         if packed_file::looks_like_packed(&head) {
@@ -306,7 +335,7 @@ impl Document {
         if has_base_color {
             crate::io::bake::bake_texture(&mut store, &welded, &scene);
         } else if welded.vertex_colors.is_empty() {
-            fill_with_position_colors(&mut store, &welded.positions_world);
+            fill_neutral(&mut store, &welded.triangle_materials, &scene);
         }
         if !welded.vertex_colors.is_empty() {
             apply_vertex_colors(&mut store, &welded.vertex_colors, has_base_color);
