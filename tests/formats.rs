@@ -429,3 +429,37 @@ fn untextured_meshes_open_grey_and_position_colors_are_a_view() {
     let tinted = colored.pixels().filter(|p| **p != background && (p[0] != p[1] || p[1] != p[2])).count();
     assert!(tinted > mesh.len() / 2, "only {tinted} coloured pixels with --position-colors");
 }
+
+/// An OBJ's `map_Kd` image becomes the base colour (times `Kd`); a map outside the OBJ's
+/// folder or missing is named in a warning and the mesh still opens in its `Kd`.
+#[test]
+fn obj_texture_maps_are_baked_and_unreadable_ones_reported() {
+    let dir = TempDir::new("obj-texture");
+    let texel = [200u8, 100, 50, 255];
+    image::RgbaImage::from_pixel(16, 16, image::Rgba(texel)).save(dir.join("skin.png")).unwrap();
+    let obj = "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+               usemtl skin\nf 1/1 2/2 3/3 4/4\n";
+    std::fs::write(dir.join("quad.obj"), obj).unwrap();
+    let r4 = Resolution::new(4).unwrap();
+    let decode = |c: u8| srgb_to_linear(f64::from(c) / 255.0);
+    for (mtl, expected, warned) in [
+        ("newmtl skin\nKd 1 1 1\nmap_Kd skin.png\n", [decode(200), decode(100), decode(50)], false),
+        ("newmtl skin\nKd 1 1 1\nmap_Kd .\\skin.png\n", [decode(200), decode(100), decode(50)], false),
+        ("newmtl skin\nKd 0.5 0.5 0.5\nmap_Kd ../skin.png\n", [decode(128); 3], true),
+        ("newmtl skin\nKd 0.5 0.5 0.5\nmap_Kd nothing.png\n", [decode(128); 3], true),
+    ] {
+        std::fs::write(dir.join("quad.mtl"), mtl).unwrap();
+        let document = Document::open(&dir.join("quad.obj"), r4).unwrap();
+        assert_eq!(
+            document.warnings.iter().any(|w| w.contains("not loaded")),
+            warned,
+            "{mtl}: {:?}",
+            document.warnings
+        );
+        document.store.for_each_site(|site| {
+            let got = document.store.get(site.sample).unwrap();
+            // Kd 0.5 is a display value: decoded like the texture's 128 within 0.2 %.
+            assert!((0..3).all(|k| (f64::from(got[k]) - expected[k]).abs() < 2e-3), "{mtl}: {got:?} vs {expected:?}");
+        });
+    }
+}

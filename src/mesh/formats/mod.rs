@@ -22,7 +22,7 @@ use std::path::Path;
 
 use glam::{Mat4, Vec3};
 
-use crate::mesh::scene::{Instance, Material, Scene, SourceMesh};
+use crate::mesh::scene::{Instance, Material, Scene, SourceMesh, Texture};
 
 mod obj;
 mod ply;
@@ -137,6 +137,8 @@ struct ReadMesh {
     /// The material of every triangle (an OBJ's MTL diffuse colour), if any.
     triangle_materials: Vec<Option<u32>>,
     materials: Vec<Material>,
+    /// Decoded base-colour textures the materials name.
+    textures: Vec<Texture>,
     warnings: Vec<String>,
 }
 
@@ -165,7 +167,7 @@ impl ReadMesh {
             meshes: vec![mesh],
             instances: vec![Instance { mesh: 0, world_from_local: Mat4::IDENTITY }],
             materials: self.materials,
-            textures: Vec::new(),
+            textures: self.textures,
             warnings: self.warnings,
         }
     }

@@ -2,22 +2,26 @@
 //! file's vertex list), polygons fanned by tobj (`(c0, c[i], c[i+1])`), points and lines
 //! skipped, `v x y z r g b` colours as display values, `vt` flipped to glTF's top-left
 //! origin (`v' = 1 − v`), and each MTL's diffuse colour `Kd` (display values) with its
-//! dissolve `d` as the base colour of the triangles that use it. Texture maps (`map_Kd`) are
-//! not read (one warning).
+//! dissolve `d` and its `map_Kd` image (PNG or JPEG, sRGB) as the base colour of the
+//! triangles that use it; a map that cannot be read is named in a warning.
 //!
 //! tobj is wrapped in `catch_unwind`: a short `Kd` line in an MTL makes tobj 4.0.5 panic.
-//! MTL files are read only when they are regular files of at most [`MAX_MTL_BYTES`] beside
-//! the OBJ (a relative name), so an OBJ cannot make the reader open devices or absolute paths.
+//! MTL and texture files are read only when they are regular files of bounded size inside the
+//! OBJ's folder (a relative name), so an OBJ cannot make the reader open devices or absolute
+//! paths.
 
 use std::io::BufReader;
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::path::{Component, Path};
+use std::path::{Component, Path, PathBuf};
 
 use super::{ReadMesh, count_of, srgb_to_linear};
-use crate::mesh::scene::Material;
+use crate::mesh::scene::{Material, Texture};
 
 /// Largest MTL file read.
 const MAX_MTL_BYTES: u64 = 16 << 20;
+/// Largest texture file read, and texture side decoded (as the glTF importer).
+const MAX_TEXTURE_BYTES: u64 = 256 << 20;
+const MAX_TEXTURE_SIDE: u32 = 16384;
 
 pub(super) fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<ReadMesh, String> {
     check_vertex_colors(bytes)?;
@@ -34,11 +38,24 @@ pub(super) fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<ReadMesh, St
     let mut mesh = ReadMesh::default();
     match materials {
         Ok(materials) => {
-            let textured = materials.iter().filter(|m| m.diffuse_texture.is_some()).count();
-            if textured > 0 {
-                mesh.warnings.push(format!("ignored: {} (map_Kd)", count_of(textured, "texture map", "texture maps")));
+            let mut missing = Vec::new();
+            for source in &materials {
+                let mut base = material(source);
+                if let Some(name) = &source.diffuse_texture {
+                    match load_texture(base_dir, name) {
+                        Ok(texture) => {
+                            base.base_color_texture = Some(mesh.textures.len() as u32);
+                            mesh.textures.push(texture);
+                        }
+                        Err(why) => missing.push(format!("{name} ({why})")),
+                    }
+                }
+                mesh.materials.push(base);
             }
-            mesh.materials = materials.iter().map(material).collect();
+            if !missing.is_empty() {
+                let what = count_of(missing.len(), "texture map", "texture maps");
+                mesh.warnings.push(format!("{what} not loaded: {}", missing.join(", ")));
+            }
         }
         Err(err) => mesh.warnings.push(format!("materials not loaded: {err}")),
     }
@@ -113,19 +130,37 @@ fn material(source: &tobj::Material) -> Material {
     Material { base_color_factor: [r, g, b, alpha], base_color_texture: None }
 }
 
-/// Reads an MTL named by `mtllib`: relative, beside the OBJ, a regular file, not too large.
+/// Reads an MTL named by `mtllib` ([`beside`]).
 fn load_mtl(base_dir: Option<&Path>, name: &Path) -> tobj::MTLLoadResult {
-    let Some(base_dir) = base_dir else {
-        return Err(tobj::LoadError::OpenFileFailed);
-    };
-    if name.components().any(|c| !matches!(c, Component::Normal(_) | Component::CurDir)) {
-        return Err(tobj::LoadError::OpenFileFailed);
-    }
-    let path = base_dir.join(name);
-    let metadata = std::fs::metadata(&path).map_err(|_| tobj::LoadError::OpenFileFailed)?;
-    if !metadata.is_file() || metadata.len() > MAX_MTL_BYTES {
-        return Err(tobj::LoadError::OpenFileFailed);
-    }
-    let bytes = std::fs::read(&path).map_err(|_| tobj::LoadError::ReadError)?;
+    let bytes = beside(base_dir, name, MAX_MTL_BYTES).map_err(|_| tobj::LoadError::OpenFileFailed)?;
     tobj::load_mtl_buf(&mut BufReader::new(bytes.as_slice()))
+}
+
+/// The bytes of a file an OBJ or MTL names: relative (`\` read as `/`, as Windows exporters
+/// write it), inside the OBJ's folder (no `..`), a regular file of at most `max_bytes`.
+fn beside(base_dir: Option<&Path>, name: &Path, max_bytes: u64) -> Result<Vec<u8>, String> {
+    let base_dir = base_dir.ok_or("no folder to look in")?;
+    let name = PathBuf::from(name.to_string_lossy().replace('\\', "/"));
+    if name.components().any(|c| !matches!(c, Component::Normal(_) | Component::CurDir)) {
+        return Err("not a relative path inside the folder".to_owned());
+    }
+    let path = base_dir.join(&name);
+    let metadata = std::fs::metadata(&path).map_err(|err| err.to_string())?;
+    if !metadata.is_file() || metadata.len() > max_bytes {
+        return Err(format!("not a regular file of at most {max_bytes} bytes"));
+    }
+    std::fs::read(&path).map_err(|err| err.to_string())
+}
+
+/// Decodes a `map_Kd` image (PNG or JPEG, at most [`MAX_TEXTURE_SIDE`] per side).
+fn load_texture(base_dir: Option<&Path>, name: &str) -> Result<Texture, String> {
+    let bytes = beside(base_dir, Path::new(name), MAX_TEXTURE_BYTES)?;
+    let mut reader =
+        image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(|err| err.to_string())?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
+    reader.limits(limits);
+    let rgba = reader.decode().map_err(|err| err.to_string())?.to_rgba8();
+    Ok(Texture { width: rgba.width(), height: rgba.height(), rgba8_srgb: rgba.into_raw() })
 }
