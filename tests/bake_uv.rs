@@ -84,6 +84,32 @@ fn a_linear_field_is_baked_exactly_and_padding_keeps_island_colours() {
     assert_eq!(inside as u64, bake.covered_texels, "every texel centre inside the square, and only those");
 }
 
+/// Two faces on the same UV triangle (mirrored islands) with different colours: every texel
+/// strictly inside is counted as overlapping and, the colours being far apart, conflicting.
+#[test]
+fn overlapping_uvs_are_counted() {
+    let triangles = [[0u32, 1, 2], [3, 4, 5]];
+    let mut store = ColorStore::uniform(Topology::build(6, &triangles).unwrap(), Resolution::new(2).unwrap(), [0.0; 4]);
+    store.fill_with(|site| if site.face == 0 { [1.0, 0.0, 0.0, 1.0] } else { [0.0, 0.0, 1.0, 1.0] });
+    let uv = [[0.1, 0.1], [0.9, 0.1], [0.1, 0.9]];
+    let size = 32u32;
+    let bake = bake_uv_texture(&store, &[uv, uv], size, 4).unwrap();
+    // Texel centres strictly inside u > 0.1, v > 0.1, u + v < 1.0 (none lies on an edge here).
+    let n = f64::from(size);
+    let inside = (0..size * size)
+        .filter(|t| {
+            let (u, v) = ((f64::from(t % size) + 0.5) / n, (f64::from(t / size) + 0.5) / n);
+            u > 0.1 && v > 0.1 && u + v < 1.0
+        })
+        .count() as u64;
+    assert!(inside > 100);
+    assert_eq!((bake.overlapping_texels, bake.conflicting_texels), (inside, inside));
+    // A mesh without overlaps has none.
+    let quad = [[[0.1f32, 0.1], [0.9, 0.1], [0.9, 0.9]], [[0.1, 0.1], [0.9, 0.9], [0.1, 0.9]]];
+    let bake = bake_uv_texture(&store, &quad, size, 4).unwrap();
+    assert_eq!((bake.overlapping_texels, bake.conflicting_texels), (0, 0));
+}
+
 /// PSNR in dB of `a` against `b` over the pixels where either is not the background.
 fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u64) {
     let background = *a.get_pixel(0, 0);
@@ -198,6 +224,8 @@ fn the_command_line_writes_glb_and_png_and_reports_faces_without_uvs() {
     let (a, b) = (image::open(&png).unwrap().to_rgba8(), image::open(&from_packed).unwrap().to_rgba8());
     let worst = a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
     assert!(worst <= 1, "the packed file's bake differs by {worst} (RGBA8 quantisation allows 1)");
+    // The Duck's two sides share their UVs: the command says so.
+    assert!(stderr.contains("texels lie in the UVs of two or more faces"), "{stderr}");
     // UVs of another mesh are refused.
     let (ok, stderr) =
         export(&[&s(&mpk), "--uvs", &s(&model("BoxTextured/BoxTextured.glb")), "-o", &s(&png), "--texture", "64"]);

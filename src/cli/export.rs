@@ -128,6 +128,16 @@ fn export_texture(args: &ExportArgs, size: u32) -> Result<()> {
             if bake.faces_without_uvs.len() > 10 { ", …" } else { "" }
         );
     }
+    if bake.overlapping_texels > 0 {
+        log::warn!(
+            target: LOG_TARGET,
+            "{}: {} texels lie in the UVs of two or more faces (overlapping or mirrored islands) and {} of them \
+             have clearly different colours there (> 32 steps): the texture keeps one face's colour, the others' are lost",
+            uv_file.display(),
+            bake.overlapping_texels,
+            bake.conflicting_texels
+        );
+    }
     let png = encode_png(&bake)?;
     let coverage = bake.covered_texels as f64 / (f64::from(size) * f64::from(size)) * 100.0;
     let bytes = if to_png {

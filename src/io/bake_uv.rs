@@ -15,6 +15,11 @@
 //! passes, each giving every empty texel next to a filled one (8-neighbourhood) the mean of its
 //! filled neighbours; whatever is still empty then takes the mean colour of the islands.
 //!
+//! **Overlapping UVs.** Mirrored or stacked islands (the Duck's two sides share one half of
+//! its texture) give one texel to several faces; it keeps the last face's colour. Texels
+//! strictly inside two faces' UV triangles are counted, and those whose colours differ by more
+//! than 32 steps (paint on one side only) reported, in [`UvBake::conflicting_texels`].
+//!
 //! **Faces without UVs.** A face whose three corner UVs are equal (which is what an import
 //! without texture coordinates gives: all zero) or span no area has no place in the texture;
 //! such faces are listed in [`UvBake::faces_without_uvs`], never silently dropped.
@@ -53,6 +58,12 @@ pub struct UvBake {
     pub covered_texels: u64,
     /// Faces with no UV area (see the module docs), ascending.
     pub faces_without_uvs: Vec<u32>,
+    /// Texels strictly inside the UV triangles of two or more faces (mirrored or stacked
+    /// islands): one texel cannot hold both faces' colours.
+    pub overlapping_texels: u64,
+    /// Of those, texels where the faces' colours differ by more than 32 steps in some 8-bit
+    /// channel: the texture keeps the last face's colour and loses the others'.
+    pub conflicting_texels: u64,
 }
 
 /// The default padding for a `size` texture: enough for MIP levels down to 1/32 of it.
@@ -80,25 +91,43 @@ pub fn bake_uv_texture(
     let mut rgba = vec![0u8; texels * 4];
     let mut covered = vec![false; texels];
     let mut faces_without_uvs = Vec::new();
+    let mut overlaps = Overlaps::default();
     for (face, uvs) in corner_uvs.iter().enumerate() {
-        if !rasterise_face(store, face as u32, uvs, size, &mut rgba, &mut covered) {
+        let target = Target { size, rgba: &mut rgba, covered: &mut covered, overlaps: &mut overlaps };
+        if !rasterise_face(store, face as u32, uvs, target) {
             faces_without_uvs.push(face as u32);
         }
     }
     let covered_texels = covered.iter().filter(|&&c| c).count() as u64;
     dilate(&mut rgba, &mut covered, size, padding);
-    Ok(UvBake { size, rgba8_srgb: rgba, covered_texels, faces_without_uvs })
+    Ok(UvBake {
+        size,
+        rgba8_srgb: rgba,
+        covered_texels,
+        faces_without_uvs,
+        overlapping_texels: overlaps.texels,
+        conflicting_texels: overlaps.conflicts,
+    })
+}
+
+/// Texels written twice (see [`UvBake::overlapping_texels`]).
+#[derive(Debug, Default)]
+struct Overlaps {
+    texels: u64,
+    conflicts: u64,
+}
+
+/// The texture being written.
+struct Target<'a> {
+    size: u32,
+    rgba: &'a mut [u8],
+    covered: &'a mut [bool],
+    overlaps: &'a mut Overlaps,
 }
 
 /// Writes the texels of `face`'s UV triangle; false when it has no area.
-fn rasterise_face(
-    store: &ColorStore,
-    face: u32,
-    uvs: &[[f32; 2]; 3],
-    size: u32,
-    rgba: &mut [u8],
-    covered: &mut [bool],
-) -> bool {
+fn rasterise_face(store: &ColorStore, face: u32, uvs: &[[f32; 2]; 3], target: Target<'_>) -> bool {
+    let Target { size, rgba, covered, overlaps } = target;
     let n = f64::from(size);
     // Corners in texel units (texel centres at k + ½).
     let p = uvs.map(|uv| [f64::from(uv[0]) * n, f64::from(uv[1]) * n]);
@@ -133,7 +162,16 @@ fn rasterise_face(
                 continue;
             };
             let texel = (y.rem_euclid(span) * span + x.rem_euclid(span)) as usize;
-            rgba[texel * 4..texel * 4 + 4].copy_from_slice(&encode_rgba8_srgb(color));
+            let encoded = encode_rgba8_srgb(color);
+            // Strictly inside this face and already written: another face's UVs overlap.
+            if covered[texel] && w0.min(w1).min(w2) > 1e-6 {
+                overlaps.texels += 1;
+                let old = &rgba[texel * 4..texel * 4 + 4];
+                if old.iter().zip(encoded).any(|(a, b)| a.abs_diff(b) > 32) {
+                    overlaps.conflicts += 1;
+                }
+            }
+            rgba[texel * 4..texel * 4 + 4].copy_from_slice(&encoded);
             covered[texel] = true;
         }
     }
