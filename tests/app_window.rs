@@ -1,5 +1,6 @@
 //! The real window under Xvfb: start `meshpaint Duck.glb`, drive it with xdotool (orbit,
-//! toggle the wireframe, export a .glb, open a broken file, quit) and check screenshots:
+//! toggle the wireframe, export a .glb, open a broken file, open OBJ / PLY / STL, quit) and
+//! check screenshots:
 //! the 3D view must match an offscreen render of the same camera within a tolerance, so a
 //! blank or misplaced view fails. Screenshots go to target/test-output/app_*.png; with
 //! `MESHPAINT_UPDATE_SCREENSHOTS=1` they are also copied over the committed
@@ -344,6 +345,28 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
         })
         .count();
     assert!(red > 50, "no error text in the status line ({red} red pixels)");
+
+    // 4b. OBJ, PLY and STL open through the same dialog and show; a broken PLY keeps the last.
+    let broken_ply = dir.join("broken.ply");
+    std::fs::write(&broken_ply, b"ply\nformat ascii 1.0\nelement vertex 9\nproperty float x\nend_header\n1\n").unwrap();
+    for (file, needle) in [
+        ("assets/models/AssimpTestModels/cube_with_vertexcolors.obj", "Opened cube_with_vertexcolors.obj"),
+        ("assets/models/PlyExamples/greg_turk_example2_ok_ascii.ply", "Opened greg_turk_example2_ok_ascii.ply"),
+        ("assets/models/AssimpTestModels/sphereWithHole.stl", "Opened sphereWithHole.stl"),
+        (broken_ply.to_str().unwrap(), "Could not open"),
+    ] {
+        let from = read_log(&log_path).len();
+        xdotool(&display, &["key", "ctrl+o"]);
+        pause(1.5);
+        xdotool(&display, &["key", "ctrl+a"]);
+        xdotool(&display, &["type", "--delay", "30", &crate_path(file).display().to_string()]);
+        xdotool(&display, &["key", "Return"]);
+        wait_for_log(&log_path, needle, from, Duration::from_secs(60), app!());
+        pause(2.0);
+        let shot = screenshot(&display, &dir.join("mesh_format.png"));
+        // A longer document name can widen the side panel: the view's latest rectangle.
+        check_view_not_blank(&crop(&shot, view_rect(&read_log(&log_path))), needle);
+    }
 
     // 5. Ctrl+Q quits cleanly.
     xdotool(&display, &["key", "ctrl+q"]);

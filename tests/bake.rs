@@ -396,7 +396,8 @@ fn textured_models_bake_to_their_textures_average() {
     }
 }
 
-/// `Document::open` bakes textured files and keeps position colours for plain ones.
+/// `Document::open` bakes textured files, gives factor-only materials their colour and plain
+/// meshes the neutral grey.
 #[test]
 fn document_open_bakes_textured_models() {
     let document = Document::open(&model("Duck/Duck.glb"), r(4)).unwrap();
@@ -417,13 +418,19 @@ fn document_open_bakes_textured_models() {
         assert_eq!(document.store.get(site.sample), Some(factor), "{site:?}");
     });
 
-    // Suzanne has no material: the position colour field stays.
+    // Suzanne has no material: every sample is the neutral light grey (8-bit sRGB 203).
     let path = model("Suzanne/monkey.glb");
     let document = Document::open(&path, r(2)).unwrap();
+    document.store.for_each_site(|site| {
+        let got = document.store.get(site.sample).unwrap();
+        assert_eq!(meshpaint::colors::format::encode_rgba8_srgb(got), [203, 203, 203, 255], "{site:?}");
+    });
+    // The position colour field is a view of it, computed from the positions alone.
+    let view = meshpaint::io::document::position_colored(&document.store, &document.positions);
     let (min, size) = meshpaint::io::document::bounds(&document.positions);
     for v in 0..document.positions.len() as u32 {
         let expected = meshpaint::io::document::position_color(document.positions[v as usize], min, size);
-        let got = document.store.vertex_color(v).unwrap();
+        let got = view.vertex_color(v).unwrap();
         assert!((0..4).all(|c| (got[c] - expected[c]).abs() < 1e-6), "vertex {v}: {got:?} vs {expected:?}");
     }
 }

@@ -44,7 +44,7 @@ impl DialogPurpose {
     /// File-name extensions listed (lower case; every file is listed with "all files").
     pub fn extensions(self) -> &'static [&'static str] {
         match self {
-            DialogPurpose::Open => &["glb", "gltf", "mpk"],
+            DialogPurpose::Open => &["glb", "gltf", "obj", "ply", "stl", "mpk"],
             DialogPurpose::SaveAs | DialogPurpose::ExportPacked => &["mpk"],
             DialogPurpose::ExportGltf => &["glb"],
         }

@@ -169,7 +169,7 @@ pub(super) fn packed_format(format: Option<ColorFormat>, source: SourceKind) -> 
     match (format, source) {
         (Some(format), _) => format,
         (None, SourceKind::Packed(format)) => format,
-        (None, SourceKind::Gltf) => ColorFormat::default(),
+        (None, SourceKind::Gltf | SourceKind::Mesh(_)) => ColorFormat::default(),
     }
 }
 

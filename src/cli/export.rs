@@ -1,29 +1,69 @@
-//! `meshpaint export`: a tessellated vertex-colour .glb, or a packed file.
+//! `meshpaint export`: a tessellated vertex-colour .glb, a packed file, or (`--texture`)
+//! the colours baked into the model's own UV texture, as a textured .glb or a plain PNG.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 
 use meshpaint::colors::format::ColorFormat;
+use meshpaint::io::bake_uv::{bake_uv_texture, default_padding};
+use meshpaint::io::document::{Document, SourceKind, import_scene};
+use meshpaint::io::export_fit::{FitOptions, write_fitted_glb};
+use meshpaint::io::export_gltf::ColorEncoding;
+use meshpaint::io::export_textured::{TexturedMesh, encode_png, textured_glb};
+use meshpaint::mesh::weld::weld_scene;
 
-use super::args::{OutputArgs, ResolutionArg, Written, budget, open, parse_format};
+use super::args::{LOG_TARGET, OutputArgs, ResolutionArg, Written, budget, open, parse_format};
 
 /// Arguments of `meshpaint export`.
 #[derive(Debug, clap::Args)]
 pub(super) struct ExportArgs {
-    /// A .glb / .gltf file or a packed file.
+    /// A .glb / .gltf, .obj, .ply, .stl or packed file.
     file: PathBuf,
     #[command(flatten)]
     resolution: ResolutionArg,
     /// Colour format of a packed output: rgba8 (sRGB, default), rgba16f or rgba32f.
     #[arg(long, value_parser = parse_format)]
     format: Option<ColorFormat>,
+    /// Bake the colours into the model's UV texture, SIZE × SIZE texels: -o OUT.glb writes
+    /// the mesh with its original UVs and this texture, -o OUT.png the texture alone.
+    #[arg(long, value_name = "SIZE")]
+    texture: Option<u32>,
+    /// With --texture: the file whose UVs to use (default: FILE; needed for packed input,
+    /// which has no UVs). Its welded mesh must be FILE's.
+    #[arg(long, value_name = "SOURCE", requires = "texture")]
+    uvs: Option<PathBuf>,
+    /// .glb: tessellate every face at R >> LEVEL (at least 1); the error is reported.
+    #[arg(long, value_name = "LEVEL", conflicts_with_all = ["max_vertices", "texture"])]
+    level: Option<u32>,
+    /// .glb: the finest level whose tessellation has at most N vertices.
+    #[arg(long, value_name = "N", conflicts_with = "texture")]
+    max_vertices: Option<u64>,
+    /// .glb COLOR_0: auto (normalized u8 or u16 when no colour changes, else float; the
+    /// default with --level / --max-vertices), float, u16 or u8.
+    #[arg(long, value_enum, conflicts_with = "texture")]
+    colors: Option<ColorsArg>,
     #[command(flatten)]
     output: OutputArgs,
 }
 
+/// `--colors` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum ColorsArg {
+    Auto,
+    Float,
+    U16,
+    U8,
+}
+
 pub(super) fn run(args: ExportArgs) -> Result<()> {
-    let ExportArgs { file: path, resolution, format, output } = args;
+    if let Some(size) = args.texture {
+        return export_texture(&args, size);
+    }
+    if args.level.is_some() || args.max_vertices.is_some() || args.colors.is_some() {
+        return export_fitted(&args);
+    }
+    let ExportArgs { file: path, resolution, format, output, .. } = args;
     if output.is_glb()? && format.is_some() {
         anyhow::bail!("--format applies to packed output only (.glb colours are always float, linear)");
     }
@@ -53,5 +93,131 @@ pub(super) fn run(args: ExportArgs) -> Result<()> {
             packed_format.name()
         ),
     }
+    Ok(())
+}
+
+/// `--texture SIZE`: bake into the UVs of FILE (or `--uvs`), write a textured .glb or a PNG.
+fn export_texture(args: &ExportArgs, size: u32) -> Result<()> {
+    let (path, out) = (&args.file, &args.output.output);
+    let extension = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let to_png = match extension.as_deref() {
+        Some("png") => true,
+        Some("glb") => false,
+        _ => anyhow::bail!("{}: with --texture the output is a .glb or a .png", out.display()),
+    };
+    anyhow::ensure!(args.format.is_none(), "--format applies to packed output only");
+    let document = open(path, args.resolution, &budget(None))?;
+    let uv_file = match (&args.uvs, document.source) {
+        (Some(source), _) => source.as_path(),
+        (None, SourceKind::Packed(_)) => anyhow::bail!(
+            "{}: a packed file keeps no UVs; name the model it was made from with --uvs SOURCE",
+            path.display()
+        ),
+        (None, _) => path.as_path(),
+    };
+    let (scene, _) = import_scene(uv_file)?;
+    let welded = weld_scene(&scene);
+    check_same_mesh(&document, &welded.positions_world, &welded.triangles, path, uv_file)?;
+    let bake = bake_uv_texture(&document.store, &welded.corner_uvs, size, default_padding(size))
+        .with_context(|| format!("baking {}", path.display()))?;
+    let faces = welded.triangles.len();
+    if !bake.faces_without_uvs.is_empty() {
+        let first: Vec<String> = bake.faces_without_uvs.iter().take(10).map(u32::to_string).collect();
+        log::warn!(
+            target: LOG_TARGET,
+            "{}: {} of {faces} faces have no UVs (no area in texture space) and are not in the texture; faces {}{}",
+            uv_file.display(),
+            bake.faces_without_uvs.len(),
+            first.join(", "),
+            if bake.faces_without_uvs.len() > 10 { ", …" } else { "" }
+        );
+    }
+    if bake.overlapping_texels > 0 {
+        log::warn!(
+            target: LOG_TARGET,
+            "{}: {} texels lie in the UVs of two or more faces (overlapping or mirrored islands) and {} of them \
+             have clearly different colours there (> 32 steps): the texture keeps one face's colour, the others' are lost",
+            uv_file.display(),
+            bake.overlapping_texels,
+            bake.conflicting_texels
+        );
+    }
+    let png = encode_png(&bake)?;
+    let coverage = bake.covered_texels as f64 / (f64::from(size) * f64::from(size)) * 100.0;
+    let bytes = if to_png {
+        png
+    } else {
+        let mesh = TexturedMesh {
+            positions: &welded.positions_world,
+            triangles: &welded.triangles,
+            corner_uvs: &welded.corner_uvs,
+            corner_normals: &welded.corner_normals_world,
+        };
+        textured_glb(&mesh, &png)?.bytes
+    };
+    meshpaint::atomic_write::write_atomically(out, &bytes)
+        .map_err(|error| anyhow::anyhow!("{}: cannot {}: {}", error.path.display(), error.action, error.source))?;
+    eprintln!(
+        "{} → {}: {size}×{size} texture, {coverage:.1}% of the texels in UV islands, {} of {faces} faces without UVs, {} B",
+        path.display(),
+        out.display(),
+        bake.faces_without_uvs.len(),
+        bytes.len()
+    );
+    Ok(())
+}
+
+/// `--level`, `--max-vertices`, `--colors`: the tessellated .glb fitted to the content.
+fn export_fitted(args: &ExportArgs) -> Result<()> {
+    let (path, out) = (&args.file, &args.output.output);
+    anyhow::ensure!(args.output.is_glb()?, "--level, --max-vertices and --colors apply to .glb output");
+    anyhow::ensure!(args.format.is_none(), "--format applies to packed output only");
+    let document = open(path, args.resolution, &budget(None))?;
+    let encoding = match args.colors.unwrap_or(ColorsArg::Auto) {
+        ColorsArg::Auto => None,
+        ColorsArg::Float => Some(ColorEncoding::Float),
+        ColorsArg::U16 => Some(ColorEncoding::Unorm16),
+        ColorsArg::U8 => Some(ColorEncoding::Unorm8),
+    };
+    let options = FitOptions { level: args.level.unwrap_or(0), max_vertices: args.max_vertices, encoding };
+    let summary = write_fitted_glb(out, &document.positions, &document.store, document.display_format(), options)
+        .with_context(|| format!("exporting {}", path.display()))?;
+    let (colors, as_float) = summary.color_bytes;
+    eprintln!(
+        "{} → {}: level {}, {} vertices, {} triangles, COLOR_0 {:?} ({colors} B instead of {as_float} B as float), \
+         error against the full-resolution colours: max {} / RMS {:.2} 8-bit steps, {} B",
+        path.display(),
+        out.display(),
+        summary.level,
+        summary.vertices,
+        summary.triangles,
+        summary.encoding,
+        summary.error_steps.0,
+        summary.error_steps.1,
+        summary.bytes
+    );
+    Ok(())
+}
+
+/// Refuses UVs from a mesh other than the document's (another file, or another version of it).
+fn check_same_mesh(
+    document: &Document,
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    path: &Path,
+    uv_file: &Path,
+) -> Result<()> {
+    let bits = |p: &[[f32; 3]]| p.iter().map(|v| v.map(f32::to_bits)).collect::<Vec<_>>();
+    let same = document.store.topology().face_vertices == triangles && bits(&document.positions) == bits(positions);
+    anyhow::ensure!(
+        same,
+        "{}: its mesh ({} vertices, {} faces) is not the mesh of {} ({} vertices, {} faces), so its UVs do not apply",
+        uv_file.display(),
+        positions.len(),
+        triangles.len(),
+        path.display(),
+        document.positions.len(),
+        document.store.topology().face_count()
+    );
     Ok(())
 }

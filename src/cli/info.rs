@@ -9,7 +9,7 @@ use meshpaint::colors::format::ColorFormat;
 use meshpaint::colors::layout::Resolution;
 use meshpaint::colors::stats::MeshStats;
 use meshpaint::io::adaptive::ResolutionRule;
-use meshpaint::io::document::{SourceKind, import_limits};
+use meshpaint::io::document::SourceKind;
 use meshpaint::mesh::orientation::Orientation;
 use meshpaint::mesh::topology::Topology;
 use meshpaint::packing::file as packed_file;
@@ -19,7 +19,7 @@ use super::args::{LOG_TARGET, ResolutionArg, open};
 /// Arguments of `meshpaint info`.
 #[derive(Debug, clap::Args)]
 pub(super) struct InfoArgs {
-    /// A .glb / .gltf file or a packed file.
+    /// A .glb / .gltf, .obj, .ply, .stl or packed file.
     file: PathBuf,
     #[command(flatten)]
     resolution: ResolutionArg,
@@ -86,13 +86,14 @@ fn budget_report(
     map
 }
 
-/// A glTF file: counts need the welded topology only, not the samples, so this stays
-/// cheap at any R (the triangles after instancing are checked while the file is read).
+/// A mesh file (glTF, OBJ, PLY, STL): counts need the welded topology only, not the
+/// samples, so this stays cheap at any R (a glTF file's triangles after instancing are
+/// checked while it is read).
 fn gltf_info(path: &Path, resolution_arg: ResolutionArg, json: bool) -> Result<()> {
     let resolution = resolution_arg.get()?;
     let rule = resolution_arg.rule();
     let budget = Budget::from_environment();
-    let scene = meshpaint::mesh::import::import_gltf_within(path, &import_limits(&budget))?;
+    let (scene, _) = meshpaint::io::document::import_scene_within(path, &budget)?;
     for warning in &scene.warnings {
         log::warn!(target: LOG_TARGET, "{}: {warning}", path.display());
     }

@@ -25,7 +25,7 @@ use clap::{Parser, Subcommand};
 pub struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// A .glb / .gltf or packed file to open in the editor (default: the built-in Duck).
+    /// A .glb / .gltf, .obj, .ply, .stl or packed file to open in the editor (default: the built-in Duck).
     file: Option<PathBuf>,
 }
 

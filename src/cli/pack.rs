@@ -12,7 +12,7 @@ use super::args::{ResolutionArg, budget, open, packed_format, parse_format};
 /// Arguments of `meshpaint pack`.
 #[derive(Debug, clap::Args)]
 pub(super) struct PackArgs {
-    /// A .glb / .gltf file, or a packed file (unpacked and packed again).
+    /// A .glb / .gltf, .obj, .ply or .stl file, or a packed file (unpacked and packed again).
     file: PathBuf,
     #[command(flatten)]
     resolution: ResolutionArg,

@@ -13,7 +13,7 @@ use super::args::{CameraArgs, OutputArgs, ResolutionArg, budget, open, packed_fo
 /// Arguments of `meshpaint paint`.
 #[derive(Debug, clap::Args)]
 pub(super) struct PaintArgs {
-    /// A .glb / .gltf file or a packed file.
+    /// A .glb / .gltf, .obj, .ply, .stl or packed file.
     file: PathBuf,
     /// Cursor positions in pixels of the WIDTH × HEIGHT view: "x0,y0 x1,y1 …".
     #[arg(long, allow_hyphen_values = true)]

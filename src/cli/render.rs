@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 
 use meshpaint::camera::default_camera;
 use meshpaint::colors::budget::Budget;
-use meshpaint::io::document::{Source, import_limits, open_for_display_within};
+use meshpaint::io::document::{Source, open_for_display_within};
 use meshpaint::render::{DrawItem, FilterMode, Gpu, Overlays, RenderSettings, Shading};
 
 use super::args::{CameraArgs, LOG_TARGET, ResolutionArg};
@@ -14,7 +14,7 @@ use super::args::{CameraArgs, LOG_TARGET, ResolutionArg};
 /// Arguments of `meshpaint render`.
 #[derive(Debug, clap::Args)]
 pub(super) struct RenderArgs {
-    /// A .glb / .gltf file or a packed file.
+    /// A .glb / .gltf, .obj, .ply, .stl or packed file.
     file: PathBuf,
     /// Output PNG.
     #[arg(long, short = 'o')]
@@ -47,6 +47,10 @@ pub(super) struct RenderArgs {
     /// Draw the glTF UVs and base-colour texture (the baseline) instead of mesh colors.
     #[arg(long)]
     baseline_uv: bool,
+    /// Show a colour field of the position instead of the document's colours (a view of the
+    /// shape and its samples; the document is unchanged).
+    #[arg(long, conflicts_with = "baseline_uv")]
+    position_colors: bool,
 }
 
 /// `--filter` values.
@@ -96,7 +100,7 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
     let gpu = Gpu::new_headless()?;
     let budget = Budget::from_environment().with_gpu(gpu.budget_limits());
     let (image, triangles, samples) = if args.baseline_uv {
-        let scene = meshpaint::mesh::import::import_gltf_within(&args.file, &import_limits(&budget))?;
+        let (scene, _) = meshpaint::io::document::import_scene_within(&args.file, &budget)?;
         let mesh = gpu.upload_baseline(&scene)?.with_context(|| {
             format!(
                 "{}: --baseline-uv needs a glTF file with a base-colour texture, and no material has one",
@@ -111,7 +115,14 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
         for warning in &displayed.document.warnings {
             log::warn!(target: LOG_TARGET, "{}: {warning}", args.file.display());
         }
-        let mesh = gpu.upload(&displayed.packed)?;
+        let mesh = if args.position_colors {
+            let document = &displayed.document;
+            let store = meshpaint::io::document::position_colored(&document.store, &document.positions);
+            let view = meshpaint::io::document::Document { store, ..document.clone() };
+            gpu.upload(&view.pack(document.display_format())?)?
+        } else {
+            gpu.upload(&displayed.packed)?
+        };
         let image = gpu.render_image(DrawItem::MeshColors(&mesh), &settings(mesh.bounds), args.width, args.height)?;
         (image, mesh.face_count, mesh.atlas.samples)
     };

@@ -1,9 +1,9 @@
-//! A document: one mesh with its mesh colors, opened from glTF or a packed file.
+//! A document: one mesh with its mesh colors, opened from glTF, OBJ, PLY, STL or a packed file.
 //!
-//! Opening chooses the loader by content (the packed magic), not by extension. A glTF
-//! mesh is welded, given a uniform resolution, and coloured: without a texture it gets
-//! a deterministic colour from position so the result is visibly non-uniform. A packed
-//! file is unpacked into the editable store.
+//! Opening chooses the loader by content (the packed magic, PLY's magic line), then by
+//! extension for OBJ and STL, else glTF. An imported mesh is welded, given a uniform
+//! resolution, and coloured: from its texture, material colour or vertex colours, else a
+//! neutral light grey to paint on. A packed file is unpacked into the editable store.
 //!
 //! [`open_for_display`] is the one way to open a document for display (the editor, `render`,
 //! `bench render`, the examples): open the [`Source`], refuse a mesh without triangles, pack
@@ -19,6 +19,7 @@ use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::Resolution;
 use crate::colors::store::{ColorStore, StoreError};
 use crate::io::adaptive::ResolutionRule;
+use crate::mesh::formats::{FormatError, MeshFormat, import_mesh_file};
 use crate::mesh::import::{ImportError, ImportLimits, import_gltf_slice_within, import_gltf_within};
 use crate::mesh::scene::Scene;
 use crate::mesh::topology::{Topology, TopologyError};
@@ -41,6 +42,9 @@ pub enum DocumentError {
     /// The glTF importer refused the file.
     #[error(transparent)]
     Import(#[from] ImportError),
+    /// The OBJ / PLY / STL importer refused the file.
+    #[error(transparent)]
+    Format(#[from] FormatError),
     /// The packed-file reader or writer refused the file.
     #[error(transparent)]
     PackedFile(#[from] PackedFileError),
@@ -89,7 +93,7 @@ pub enum DocumentError {
 pub enum Source {
     /// The Duck embedded in the binary ([`BUILT_IN_GLB`]).
     BuiltIn,
-    /// A .glb / .gltf or packed file.
+    /// A .glb / .gltf, .obj, .ply, .stl or packed file.
     File(PathBuf),
 }
 
@@ -165,6 +169,8 @@ pub fn open_for_display_within(
 pub enum SourceKind {
     /// A .glb / .gltf file.
     Gltf,
+    /// An OBJ, PLY or STL file.
+    Mesh(MeshFormat),
     /// A packed file, in this colour format.
     Packed(ColorFormat),
 }
@@ -184,8 +190,9 @@ pub struct Document {
     pub warnings: Vec<String>,
 }
 
-/// A smooth, deterministic colour field over the bounding box, so texture-less meshes
-/// show visible variation: three sine waves of different frequency per channel.
+/// A smooth, deterministic colour field over the bounding box that shows the shape and the
+/// resolution of a mesh: three sine waves of different frequency per channel
+/// ([`position_colored`]; a view option, untextured meshes open in a neutral colour).
 pub fn position_color(position: [f32; 3], bounds_min: [f32; 3], bounds_size: [f32; 3]) -> Rgba {
     let t: [f32; 3] = std::array::from_fn(|a| {
         let size = if bounds_size[a] > 0.0 { bounds_size[a] } else { 1.0 };
@@ -209,6 +216,33 @@ pub fn bounds(positions: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
         return ([0.0; 3], [0.0; 3]);
     }
     (min, std::array::from_fn(|a| max[a] - min[a]))
+}
+
+/// The colour an untextured mesh opens in where its faces have no material (the glTF
+/// default material is white, which is too bright to paint on): a light grey, linear RGBA
+/// (8-bit sRGB 203).
+pub const NEUTRAL_BASE_COLOR: Rgba = [0.6, 0.6, 0.6, 1.0];
+
+/// Colours every sample of a mesh without textures or vertex colours: its owner face's
+/// material base colour factor, or [`NEUTRAL_BASE_COLOR`] for faces without a material.
+fn fill_neutral(store: &mut ColorStore, triangle_materials: &[Option<u32>], scene: &Scene) {
+    store.fill_with(|site| {
+        triangle_materials
+            .get(site.face as usize)
+            .copied()
+            .flatten()
+            .and_then(|m| scene.materials.get(m as usize))
+            .map_or(NEUTRAL_BASE_COLOR, |material| material.base_color_factor)
+    });
+}
+
+/// `store` with every sample coloured by [`position_color`] at its position on `positions`:
+/// a view of the geometry (`render --position-colors`), not a document's content.
+pub fn position_colored(store: &ColorStore, positions: &[[f32; 3]]) -> ColorStore {
+    let mut out = store.clone();
+    fill_with_position_colors(&mut out, positions);
+    out.take_dirty();
+    out
 }
 
 /// Colours every sample of `store` with [`position_color`] at its position on `positions`.
@@ -266,40 +300,66 @@ pub fn import_limits(budget: &Budget) -> ImportLimits {
     }
 }
 
+/// The first bytes of `path` (fewer when the file is shorter).
+fn read_head(path: &Path) -> Result<Vec<u8>, DocumentError> {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(16);
+    let file = std::fs::File::open(path).map_err(|source| DocumentError::Io { path: path.to_owned(), source })?;
+    file.take(16).read_to_end(&mut head).map_err(|source| DocumentError::Io { path: path.to_owned(), source })?;
+    Ok(head)
+}
+
+/// Imports a mesh file that is not packed: OBJ / PLY / STL ([`MeshFormat::detect`]) or
+/// glTF. The one import path of `Document::open`, `info` and `render --baseline-uv`.
+pub fn import_scene(path: &Path) -> Result<(Scene, SourceKind), DocumentError> {
+    import_scene_within(path, &Budget::from_environment())
+}
+
+/// [`import_scene`] within `budget` (a glTF file's triangles after instancing, nodes and
+/// texels are checked while it is read).
+pub fn import_scene_within(path: &Path, budget: &Budget) -> Result<(Scene, SourceKind), DocumentError> {
+    let head = read_head(path)?;
+    import_scene_after(path, &head, budget)
+}
+
+fn import_scene_after(path: &Path, head: &[u8], budget: &Budget) -> Result<(Scene, SourceKind), DocumentError> {
+    match MeshFormat::detect(path, head) {
+        Some(format) => Ok((import_mesh_file(path, format)?, SourceKind::Mesh(format))),
+        None => Ok((import_gltf_within(path, &import_limits(budget))?, SourceKind::Gltf)),
+    }
+}
+
 impl Document {
-    /// Opens `path`: a packed file (by magic) or glTF at uniform `gltf_resolution`, within
+    /// Opens `path`: a packed file (by magic), an OBJ / PLY / STL file
+    /// ([`MeshFormat::detect`]) or glTF, meshes at uniform `gltf_resolution`, within
     /// [`Budget::from_environment`].
     ///
-    /// A glTF mesh whose materials carry a base-colour texture or a non-white factor is
-    /// baked from them ([`crate::io::bake::bake_texture`]); otherwise it gets
-    /// [`position_color`].
+    /// A mesh whose materials carry a base-colour texture or a non-white factor is
+    /// baked from them ([`crate::io::bake::bake_texture`]); otherwise each face gets its
+    /// material's base colour factor, or [`NEUTRAL_BASE_COLOR`] without a material. Vertex
+    /// colours (glTF COLOR_0, OBJ and PLY colours) are applied.
     pub fn open(path: &Path, gltf_resolution: Resolution) -> Result<Self, DocumentError> {
         Self::open_within(path, gltf_resolution, &Budget::from_environment())
     }
 
-    /// [`Document::open`] within `budget`, a glTF mesh at the per-face resolutions of `rule`
+    /// [`Document::open`] within `budget`, a mesh at the per-face resolutions of `rule`
     /// (a [`Resolution`] is uniform; [`crate::io::adaptive`]): a glTF file's triangles (after
     /// instancing), nodes and textures are checked while it is read, its samples before the
     /// store is allocated; a packed file's samples before it is unpacked.
     pub fn open_within(path: &Path, rule: impl Into<ResolutionRule>, budget: &Budget) -> Result<Self, DocumentError> {
         let rule = rule.into();
-        let mut head = [0u8; 8];
-        let is_packed = {
-            use std::io::Read;
-            let mut file =
-                std::fs::File::open(path).map_err(|source| DocumentError::Io { path: path.to_owned(), source })?;
-            let read = file.read(&mut head).unwrap_or(0);
-            packed_file::looks_like_packed(&head[..read])
-        };
-        if is_packed {
+        let head = read_head(path)?;
+        if packed_file::looks_like_packed(&head) {
             let packed = packed_file::read_file(path)?;
             return Self::from_packed_within(&packed, budget).map_err(|source| match source {
                 PackError::Budget(source) => DocumentError::Budget { path: path.to_owned(), source },
                 source => DocumentError::Pack { path: path.to_owned(), source },
             });
         }
-        let scene = import_gltf_within(path, &import_limits(budget))?;
-        Self::from_scene_within(scene, rule, path, budget)
+        let (scene, kind) = import_scene_after(path, &head, budget)?;
+        let mut document = Self::from_scene_within(scene, rule, path, budget)?;
+        document.source = kind;
+        Ok(document)
     }
 
     /// Opens `source`: the built-in scene or a file, as [`Document::open`] does.
@@ -327,7 +387,7 @@ impl Document {
     pub fn display_format(&self) -> ColorFormat {
         match self.source {
             SourceKind::Packed(format) => format,
-            SourceKind::Gltf => ColorFormat::default(),
+            SourceKind::Gltf | SourceKind::Mesh(_) => ColorFormat::default(),
         }
     }
 
@@ -376,7 +436,7 @@ impl Document {
         if has_base_color {
             crate::io::adaptive::bake_and_verify(&mut store, &welded, &scene, rule);
         } else if welded.vertex_colors.is_empty() {
-            fill_with_position_colors(&mut store, &welded.positions_world);
+            fill_neutral(&mut store, &welded.triangle_materials, &scene);
         }
         if !welded.vertex_colors.is_empty() {
             apply_vertex_colors(&mut store, &welded.vertex_colors, has_base_color);

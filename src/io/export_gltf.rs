@@ -22,7 +22,9 @@
 //!   `((R − i − j)/R)·c0 + (i/R)·c1 + (j/R)·c2`, computed in `f64` and rounded to `f32`;
 //! - `COLOR_0` (float VEC4): the sample colour, linear RGBA as glTF defines COLOR_0, the
 //!   store's `f32` values unchanged except that components outside `[0, 1]` (which glTF
-//!   forbids; the store's exact-inverse reduction can overshoot) are clamped to it;
+//!   forbids; the store's exact-inverse reduction can overshoot) are clamped to it
+//!   ([`tessellation_to_glb_encoded`] also writes normalized u16 or u8, see
+//!   [`crate::io::export_fit`]);
 //! - indices (unsigned short when every index fits, else unsigned int): for each face in
 //!   face order, for `i` in `0..R`, for `j` in `0..R − i`, the sub-triangle
 //!   `(i, j), (i+1, j), (i, j+1)` (or its fan, sides in the order (i,j)→(i+1,j)→(i,j+1)→(i,j),
@@ -465,6 +467,59 @@ pub fn export_tessellated_glb(positions: &[[f32; 3]], store: &ColorStore) -> Res
 /// Encodes a tessellation as a binary glTF. The tessellation is consumed so that its
 /// memory is released before the file's bytes are assembled.
 pub fn tessellation_to_glb(tessellation: Tessellation) -> Result<Vec<u8>, ExportError> {
+    tessellation_to_glb_encoded(tessellation, ColorEncoding::Float)
+}
+
+/// How `COLOR_0` is stored: float, or normalized unsigned shorts or bytes (glTF allows all
+/// three for VEC4 colours; the values are linear in every case).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum ColorEncoding {
+    /// 4 × f32, 16 bytes per vertex.
+    #[default]
+    Float,
+    /// 4 × normalized u16, 8 bytes per vertex.
+    Unorm16,
+    /// 4 × normalized u8, 4 bytes per vertex.
+    Unorm8,
+}
+
+impl ColorEncoding {
+    /// Bytes per vertex colour.
+    pub fn bytes(self) -> usize {
+        match self {
+            ColorEncoding::Float => 16,
+            ColorEncoding::Unorm16 => 8,
+            ColorEncoding::Unorm8 => 4,
+        }
+    }
+
+    /// The colour (clamped to `[0, 1]`) after storing it this way and reading it back.
+    pub fn round_trip(self, color: [f32; 4]) -> [f32; 4] {
+        let unit = |c: f32| if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
+        match self {
+            ColorEncoding::Float => color.map(unit),
+            ColorEncoding::Unorm16 => color.map(|c| f32::from((unit(c) * 65535.0).round() as u16) / 65535.0),
+            ColorEncoding::Unorm8 => color.map(|c| f32::from((unit(c) * 255.0).round() as u8) / 255.0),
+        }
+    }
+
+    fn write(self, color: [f32; 4], out: &mut Vec<u8>) {
+        let unit = |c: f32| if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
+        for c in color {
+            match self {
+                ColorEncoding::Float => out.extend_from_slice(&c.to_le_bytes()),
+                ColorEncoding::Unorm16 => out.extend_from_slice(&((unit(c) * 65535.0).round() as u16).to_le_bytes()),
+                ColorEncoding::Unorm8 => out.push((unit(c) * 255.0).round() as u8),
+            }
+        }
+    }
+}
+
+/// [`tessellation_to_glb`] with `COLOR_0` stored as `encoding`.
+pub fn tessellation_to_glb_encoded(
+    tessellation: Tessellation,
+    encoding: ColorEncoding,
+) -> Result<Vec<u8>, ExportError> {
     let vertices = tessellation.positions.len();
     let triangles = tessellation.triangles.len();
     check_limits(vertices as u64, triangles as u64)?;
@@ -495,8 +550,8 @@ pub fn tessellation_to_glb(tessellation: Tessellation) -> Result<Vec<u8>, Export
         bin.extend_from_slice(&value.to_le_bytes());
     }
     let colors_offset = bin.len();
-    for value in tessellation.colors.iter().flatten() {
-        bin.extend_from_slice(&value.to_le_bytes());
+    for &color in &tessellation.colors {
+        encoding.write(color, &mut bin);
     }
     let indices_offset = bin.len();
     for &index in tessellation.triangles.iter().flatten() {
@@ -522,6 +577,7 @@ pub fn tessellation_to_glb(tessellation: Tessellation) -> Result<Vec<u8>, Export
         u16_indices,
         min,
         max,
+        encoding,
     });
     let json_string = json::serialize::to_string(&root).map_err(|err| ExportError::Encode(err.to_string()))?;
     let total = 12 + 8 + json_string.len().next_multiple_of(4) + 8 + bin.len();
@@ -551,6 +607,7 @@ struct GltfLayout {
     u16_indices: bool,
     min: [f32; 3],
     max: [f32; 3],
+    encoding: ColorEncoding,
 }
 
 /// The glTF JSON describing the binary chunk laid out as `layout` says.
@@ -607,7 +664,15 @@ fn gltf_root(layout: GltfLayout) -> json::Root {
         Type::Vec3,
         Some((layout.min, layout.max)),
     ));
-    let colors = root.push(accessor(colors_view, layout.vertices, ComponentType::F32, Type::Vec4, None));
+    let (color_component, normalized) = match layout.encoding {
+        ColorEncoding::Float => (ComponentType::F32, false),
+        ColorEncoding::Unorm16 => (ComponentType::U16, true),
+        ColorEncoding::Unorm8 => (ComponentType::U8, true),
+    };
+    let colors = root.push(json::Accessor {
+        normalized,
+        ..accessor(colors_view, layout.vertices, color_component, Type::Vec4, None)
+    });
     let index_type = if layout.u16_indices { ComponentType::U16 } else { ComponentType::U32 };
     let indices = root.push(accessor(indices_view, 3 * layout.triangles, index_type, Type::Scalar, None));
 

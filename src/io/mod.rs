@@ -1,11 +1,14 @@
-//! Documents on disk: open glTF or packed files into a store, export glTF, bake
-//! textures into mesh colors (at a per-face resolution chosen by the content, `adaptive`),
-//! autosave and recovery.
+//! Documents on disk: open glTF, OBJ, PLY, STL or packed files into a store, export glTF
+//! (tessellated or textured), bake textures into mesh colors (at a per-face resolution chosen by the content, `adaptive`)
+//! and back, autosave and recovery.
 
 pub mod adaptive;
 pub mod autosave;
 pub mod bake;
+pub mod bake_uv;
 pub mod document;
+pub mod export_fit;
 pub mod export_gltf;
+pub mod export_textured;
 
 pub use document::{Document, SourceKind};

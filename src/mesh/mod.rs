@@ -3,6 +3,7 @@
 //!
 //! `file ─ import ─▶ Scene ─ weld ─▶ WeldedMesh ─ topology ─▶ Topology`
 
+pub mod formats;
 pub mod import;
 pub mod orientation;
 pub mod scene;

@@ -1,0 +1,239 @@
+//! Baking mesh colors into the model's UV texture (`export --texture`).
+//!
+//! Truths: a linear colour field, which the mesh-colors linear filter reproduces exactly, must
+//! come out in every covered texel as the closed form at the texel centre's UV; padding must
+//! leave no texel of an unrelated colour; the textured model rendered through the UV baseline
+//! (`render --baseline-uv`'s pipeline) must match the mesh-colors render of the document it was
+//! baked from (PSNR over the mesh pixels, printed per model and view); the Khronos validator must
+//! accept the .glb; a mesh without UVs is reported face by face.
+
+use std::path::Path;
+use std::process::Command;
+
+mod common;
+use common::{TempDir, crate_path, model};
+
+use meshpaint::camera::default_camera;
+use meshpaint::colors::format::encode_rgba8_srgb;
+use meshpaint::colors::layout::Resolution;
+use meshpaint::colors::store::ColorStore;
+use meshpaint::io::bake_uv::{bake_uv_texture, default_padding};
+use meshpaint::io::document::Document;
+use meshpaint::io::export_textured::{TexturedMesh, encode_png, textured_glb};
+use meshpaint::mesh::import::import_gltf;
+use meshpaint::mesh::topology::Topology;
+use meshpaint::mesh::weld::weld_scene;
+use meshpaint::render::{DrawItem, Gpu, RenderSettings};
+
+/// A linear colour in UV space: r = u, g = v, b = 1 − u (all in [0, 1] on the unit square).
+fn field(u: f64, v: f64) -> [f64; 3] {
+    [u, v, 1.0 - u]
+}
+
+#[test]
+fn a_linear_field_is_baked_exactly_and_padding_keeps_island_colours() {
+    // Two triangles covering the UV square [0.1, 0.9]², positions = UVs (z = 0), R = 4.
+    let (lo, hi) = (0.1f32, 0.9f32);
+    let positions = [[lo, lo, 0.0], [hi, lo, 0.0], [hi, hi, 0.0], [lo, hi, 0.0]];
+    let triangles = vec![[0u32, 1, 2], [0, 2, 3]];
+    let topology = Topology::build(4, &triangles).unwrap();
+    let mut store = ColorStore::uniform(topology, Resolution::new(4).unwrap(), [0.0; 4]);
+    let corners = triangles.clone();
+    store.fill_with(|site| {
+        let face = corners[site.face as usize];
+        let p = |a: usize| {
+            (0..3).map(|k| f64::from(site.barycentric[k]) * f64::from(positions[face[k] as usize][a])).sum::<f64>()
+        };
+        let [r, g, b] = field(p(0), p(1));
+        [r as f32, g as f32, b as f32, 1.0]
+    });
+    let uvs: Vec<[[f32; 2]; 3]> =
+        triangles.iter().map(|t| t.map(|v| [positions[v as usize][0], positions[v as usize][1]])).collect();
+    let size = 64u32;
+    let bake = bake_uv_texture(&store, &uvs, size, 8).unwrap();
+    assert!(bake.faces_without_uvs.is_empty());
+    let n = f64::from(size);
+    let texel = |x: u32, y: u32| {
+        let at = 4 * (y * size + x) as usize;
+        [bake.rgba8_srgb[at], bake.rgba8_srgb[at + 1], bake.rgba8_srgb[at + 2]]
+    };
+    let mut inside = 0;
+    for y in 0..size {
+        for x in 0..size {
+            let (u, v) = ((f64::from(x) + 0.5) / n, (f64::from(y) + 0.5) / n);
+            let got = texel(x, y);
+            if u > f64::from(lo) && u < f64::from(hi) && v > f64::from(lo) && v < f64::from(hi) {
+                inside += 1;
+                let [r, g, b] = field(u, v);
+                let expected = encode_rgba8_srgb([r as f32, g as f32, b as f32, 1.0]);
+                for k in 0..3 {
+                    assert!(got[k].abs_diff(expected[k]) <= 1, "texel ({x}, {y}): {got:?} vs {expected:?}");
+                }
+            } else {
+                // Padding: within the field's range clamped to the island (a neighbour's
+                // average), never an unrelated colour.
+                let clamp = |t: f64| t.clamp(f64::from(lo), f64::from(hi));
+                let [r, g, b] = field(clamp(u), clamp(v));
+                let near = encode_rgba8_srgb([r as f32, g as f32, b as f32, 1.0]);
+                for k in 0..3 {
+                    assert!(got[k].abs_diff(near[k]) <= 40, "padding texel ({x}, {y}): {got:?} far from {near:?}");
+                }
+            }
+        }
+    }
+    assert_eq!(inside as u64, bake.covered_texels, "every texel centre inside the square, and only those");
+}
+
+/// Two faces on the same UV triangle (mirrored islands) with different colours: every texel
+/// strictly inside is counted as overlapping and, the colours being far apart, conflicting.
+#[test]
+fn overlapping_uvs_are_counted() {
+    let triangles = [[0u32, 1, 2], [3, 4, 5]];
+    let mut store = ColorStore::uniform(Topology::build(6, &triangles).unwrap(), Resolution::new(2).unwrap(), [0.0; 4]);
+    store.fill_with(|site| if site.face == 0 { [1.0, 0.0, 0.0, 1.0] } else { [0.0, 0.0, 1.0, 1.0] });
+    let uv = [[0.1, 0.1], [0.9, 0.1], [0.1, 0.9]];
+    let size = 32u32;
+    let bake = bake_uv_texture(&store, &[uv, uv], size, 4).unwrap();
+    // Texel centres strictly inside u > 0.1, v > 0.1, u + v < 1.0 (none lies on an edge here).
+    let n = f64::from(size);
+    let inside = (0..size * size)
+        .filter(|t| {
+            let (u, v) = ((f64::from(t % size) + 0.5) / n, (f64::from(t / size) + 0.5) / n);
+            u > 0.1 && v > 0.1 && u + v < 1.0
+        })
+        .count() as u64;
+    assert!(inside > 100);
+    assert_eq!((bake.overlapping_texels, bake.conflicting_texels), (inside, inside));
+    // A mesh without overlaps has none.
+    let quad = [[[0.1f32, 0.1], [0.9, 0.1], [0.9, 0.9]], [[0.1, 0.1], [0.9, 0.9], [0.1, 0.9]]];
+    let bake = bake_uv_texture(&store, &quad, size, 4).unwrap();
+    assert_eq!((bake.overlapping_texels, bake.conflicting_texels), (0, 0));
+}
+
+/// PSNR in dB of `a` against `b` over the pixels where either is not the background.
+fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u64) {
+    let background = *a.get_pixel(0, 0);
+    let (mut sum, mut count) = (0.0f64, 0u64);
+    for (p, q) in a.pixels().zip(b.pixels()) {
+        if *p == background && *q == background {
+            continue;
+        }
+        for k in 0..3 {
+            let d = f64::from(p[k]) - f64::from(q[k]);
+            sum += d * d;
+        }
+        count += 1;
+    }
+    let mse = sum / (3.0 * count.max(1) as f64);
+    (10.0 * (255.0f64 * 255.0 / mse.max(1e-12)).log10(), count)
+}
+
+/// The PSNR table of the issue: every shared textured model, baked at its source texture's size.
+#[test]
+fn baked_textures_render_like_the_mesh_colors() {
+    let gpu = Gpu::new_headless().unwrap();
+    let dir = TempDir::new("psnr");
+    let r8 = Resolution::new(8).unwrap();
+    let mut worst = f64::INFINITY;
+    eprintln!("| model | texture | R | view (yaw, pitch) | mesh pixels | PSNR (dB) |\n|---|---|---|---|---|---|");
+    for file in ["BoxTextured/BoxTextured.glb", "Duck/Duck.glb", "Fox/Fox.glb"] {
+        let path = model(file);
+        let scene = import_gltf(&path).unwrap();
+        let size = scene.textures[0].width.max(scene.textures[0].height);
+        let welded = weld_scene(&scene);
+        let document = Document::open(&path, r8).unwrap();
+        let bake = bake_uv_texture(&document.store, &welded.corner_uvs, size, default_padding(size)).unwrap();
+        assert!(bake.faces_without_uvs.is_empty(), "{file}");
+        let mesh = TexturedMesh {
+            positions: &welded.positions_world,
+            triangles: &welded.triangles,
+            corner_uvs: &welded.corner_uvs,
+            corner_normals: &welded.corner_normals_world,
+        };
+        let glb = textured_glb(&mesh, &encode_png(&bake).unwrap()).unwrap();
+        let out = dir.join(&format!("{}.glb", file.replace('/', "_")));
+        std::fs::write(&out, &glb.bytes).unwrap();
+        let report = validate(&out);
+        assert_eq!(
+            (report["numErrors"].as_u64(), report["numWarnings"].as_u64()),
+            (Some(0), Some(0)),
+            "{file}: {report}"
+        );
+        let baked_scene = import_gltf(&out).unwrap();
+        let baseline = gpu.upload_baseline(&baked_scene).unwrap().expect("the export has a base-colour texture");
+        let colors = gpu.upload(&document.pack(document.display_format()).unwrap()).unwrap();
+        for (yaw, pitch) in [(30.0, 20.0), (210.0, -15.0), (120.0, 60.0)] {
+            let settings = RenderSettings::new(default_camera(colors.bounds, yaw, pitch, None));
+            let a = gpu.render_image(DrawItem::MeshColors(&colors), &settings, 512, 512).unwrap();
+            let b = gpu.render_image(DrawItem::Baseline(&baseline), &settings, 512, 512).unwrap();
+            let (db, pixels) = psnr(&a, &b);
+            eprintln!("| {file} | {size}² | 8 | ({yaw}, {pitch}) | {pixels} | {db:.1} |");
+            worst = worst.min(db);
+            if (yaw, pitch) == (30.0, 20.0) {
+                let name = file.split('/').next().unwrap();
+                a.save(common::output_dir().join(format!("bake_uv_{name}_mesh_colors.png"))).unwrap();
+                b.save(common::output_dir().join(format!("bake_uv_{name}_baked.png"))).unwrap();
+            }
+        }
+    }
+    assert!(worst >= 35.0, "worst PSNR {worst:.1} dB < 35 dB");
+}
+
+/// The Khronos glTF-Validator's summary of `path` (tools/validate-gltf; installed with `npm ci`
+/// when missing, as tests/export_gltf.rs does).
+fn validate(path: &Path) -> serde_json::Value {
+    let dir = crate_path("tools/validate-gltf");
+    if !dir.join("node_modules/gltf-validator/package.json").is_file() {
+        let status = Command::new("npm").arg("ci").arg("--prefix").arg(&dir).status().expect("npm is needed");
+        assert!(status.success(), "npm ci --prefix tools/validate-gltf failed");
+    }
+    let output = Command::new("node").arg(dir.join("validate.mjs")).arg(path).output().expect("node is needed");
+    serde_json::from_slice(&output.stdout).unwrap_or_else(|e| panic!("{}: no validator JSON: {e}", path.display()))
+}
+
+/// Runs `meshpaint export ARGS`; returns (success, stderr).
+fn export(args: &[&str]) -> (bool, String) {
+    let output = Command::new(env!("CARGO_BIN_EXE_meshpaint")).arg("export").args(args).output().unwrap();
+    (output.status.success(), String::from_utf8_lossy(&output.stderr).into_owned())
+}
+
+#[test]
+fn the_command_line_writes_glb_and_png_and_reports_faces_without_uvs() {
+    let dir = TempDir::new("cli");
+    let duck = model("Duck/Duck.glb");
+    let (glb, png, mpk) = (dir.join("duck.glb"), dir.join("duck.png"), dir.join("duck.mpk"));
+    let s = |p: &Path| p.to_str().unwrap().to_owned();
+    let (ok, stderr) = export(&[&s(&duck), "-o", &s(&glb), "--texture", "256"]);
+    assert!(ok, "{stderr}");
+    let scene = import_gltf(&glb).unwrap();
+    assert_eq!(scene.textures.len(), 1);
+    assert_eq!((scene.textures[0].width, scene.textures[0].height), (256, 256));
+    assert_eq!(scene.instanced_triangle_count(), 4212);
+    let (ok, stderr) = export(&[&s(&duck), "-o", &s(&png), "--texture", "128"]);
+    assert!(ok, "{stderr}");
+    assert_eq!(image::open(&png).unwrap().to_rgba8().dimensions(), (128, 128));
+
+    // A packed file needs --uvs; with the source's UVs it bakes the same texture.
+    let run = Command::new(env!("CARGO_BIN_EXE_meshpaint")).args(["pack", &s(&duck), "-o", &s(&mpk)]).output().unwrap();
+    assert!(run.status.success());
+    let (ok, stderr) = export(&[&s(&mpk), "-o", &s(&png), "--texture", "128"]);
+    assert!(!ok && stderr.contains("--uvs"), "{stderr}");
+    let from_packed = dir.join("from_packed.png");
+    let (ok, stderr) = export(&[&s(&mpk), "--uvs", &s(&duck), "-o", &s(&from_packed), "--texture", "128"]);
+    assert!(ok, "{stderr}");
+    let (a, b) = (image::open(&png).unwrap().to_rgba8(), image::open(&from_packed).unwrap().to_rgba8());
+    let worst = a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+    assert!(worst <= 1, "the packed file's bake differs by {worst} (RGBA8 quantisation allows 1)");
+    // The Duck's two sides share their UVs: the command says so.
+    assert!(stderr.contains("texels lie in the UVs of two or more faces"), "{stderr}");
+    // UVs of another mesh are refused.
+    let (ok, stderr) =
+        export(&[&s(&mpk), "--uvs", &s(&model("BoxTextured/BoxTextured.glb")), "-o", &s(&png), "--texture", "64"]);
+    assert!(!ok && stderr.contains("is not the mesh of"), "{stderr}");
+
+    // An STL has no UVs: every face is reported.
+    let stl = crate_path("assets/models/AssimpTestModels/sphereWithHole.stl");
+    let (ok, stderr) = export(&[&s(&stl), "-o", &s(&png), "--texture", "64"]);
+    assert!(ok, "{stderr}");
+    assert!(stderr.contains("285 of 285 faces have no UVs"), "{stderr}");
+}
