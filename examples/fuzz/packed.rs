@@ -75,7 +75,7 @@ pub fn seeds(models: &Path) -> Vec<Vec<u8>> {
         add(&document, ColorFormat::Rgba32F);
         add(&document, ColorFormat::Rgba8Srgb);
     }
-    if let Some(bytes) = packed_file::to_bytes(&PackedMesh::default()).ok() {
+    if let Ok(bytes) = packed_file::to_bytes(&PackedMesh::default()) {
         out.push(bytes);
     }
     out
