@@ -81,6 +81,8 @@ fn xdotool(display: &str, args: &[&str]) -> String {
     String::from_utf8_lossy(&output.stdout).into_owned()
 }
 
+/// Pacing between input events (never to wait for the app: that is [`wait_for_log`] and
+/// [`wait_for_screen`]).
 fn pause(seconds: f64) {
     std::thread::sleep(Duration::from_secs_f64(seconds));
 }
@@ -118,6 +120,93 @@ fn wait_for_log(path: &Path, needle: &str, from: usize, timeout: Duration, app: 
             panic!("the app exited ({status}) while waiting for “{needle}”:\n{log}");
         }
         assert!(started.elapsed() < timeout, "no “{needle}” in the log after {timeout:?}:\n{log}");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+/// Starts the editor on `file` in `dir` (its stderr log at `log_path`) with `env` added.
+fn start_app(display: &str, dir: &Path, log_path: &Path, file: &Path, env: &[(&str, &str)]) -> Child {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_meshpaint"));
+    command
+        .arg(file)
+        .env("DISPLAY", display)
+        .env("RUST_LOG", "meshpaint=info")
+        .env("XDG_RUNTIME_DIR", dir)
+        .env("XDG_STATE_HOME", dir)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(log_path).unwrap());
+    for (key, value) in env {
+        command.env(key, value);
+    }
+    command.spawn().expect("cannot start meshpaint")
+}
+
+/// The editor's window, focused.
+fn focus_window(display: &str) {
+    let window = xdotool(display, &["search", "--sync", "--name", "meshpaint"]);
+    let window = window.lines().next().expect("no meshpaint window").trim().to_owned();
+    xdotool(display, &["windowfocus", "--sync", &window]);
+}
+
+/// Screenshots (to `path`) until two in a row agree inside `rect` — the app has finished
+/// drawing — and `accept` holds for the whole screenshot; returns it. Waits for state, not for
+/// a fixed time: fails after `timeout` or at once if the app exits.
+fn wait_for_screen(
+    display: &str,
+    path: &Path,
+    rect: (u32, u32, u32, u32),
+    what: &str,
+    accept: &dyn Fn(&RgbImage) -> bool,
+    app: &mut Child,
+) -> RgbImage {
+    let timeout = Duration::from_secs(60);
+    let started = Instant::now();
+    let mut previous: Option<RgbImage> = None;
+    loop {
+        let shot = screenshot(display, path);
+        let view = crop(&shot, rect);
+        if previous.as_ref().is_some_and(|p| *p == view) && accept(&shot) {
+            return shot;
+        }
+        if let Ok(Some(status)) = app.try_wait() {
+            panic!("the app exited ({status}) while waiting for {what}");
+        }
+        assert!(started.elapsed() < timeout, "no {what} on screen after {timeout:?} (see {})", path.display());
+        previous = Some(view);
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}
+
+/// The 3D view shows a mesh: background at the corners, not at the centre.
+fn view_drawn(shot: &RgbImage, rect: (u32, u32, u32, u32)) -> bool {
+    let view = crop(shot, rect);
+    let (w, h) = view.dimensions();
+    is_background(view.get_pixel(4, 4)) && !is_background(view.get_pixel(w / 2, h / 2))
+}
+
+/// Opens a file dialog with `keys`, waits until its path field has the keyboard focus (the
+/// app logs it), replaces the field's text with `path` and confirms with Enter.
+fn type_into_dialog(display: &str, log_path: &Path, keys: &str, path: &Path, app: &mut Child) {
+    let from = read_log(log_path).len();
+    xdotool(display, &["key", keys]);
+    wait_for_log(log_path, "the path field has the keyboard focus", from, Duration::from_secs(30), app);
+    // Key events reach the app in order: no pause is needed between them.
+    xdotool(display, &["key", "ctrl+a"]);
+    xdotool(display, &["type", "--delay", "30", &path.display().to_string()]);
+    xdotool(display, &["key", "Return"]);
+}
+
+/// Waits until the app exits after Ctrl+Q; returns its status.
+fn quit(display: &str, app: &mut Child) -> std::process::ExitStatus {
+    xdotool(display, &["key", "ctrl+q"]);
+    let started = Instant::now();
+    loop {
+        if let Some(status) = app.try_wait().unwrap() {
+            return status;
+        }
+        assert!(started.elapsed() < Duration::from_secs(20), "the app did not quit on Ctrl+Q");
         std::thread::sleep(Duration::from_millis(100));
     }
 }
@@ -240,18 +329,7 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     let display = start_xvfb(&mut processes);
 
     let asset = crate_path("assets/models/Duck/Duck.glb");
-    let app = Command::new(env!("CARGO_BIN_EXE_meshpaint"))
-        .arg(&asset)
-        .env("DISPLAY", &display)
-        .env("RUST_LOG", "meshpaint=info")
-        .env("XDG_RUNTIME_DIR", &dir)
-        .current_dir(&dir)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(std::fs::File::create(&log_path).unwrap())
-        .spawn()
-        .expect("cannot start meshpaint");
-    processes.children.push(app);
+    processes.children.push(start_app(&display, &dir, &log_path, &asset, &[]));
     // The app is the last child.
     macro_rules! app {
         () => {
@@ -259,19 +337,18 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
         };
     }
 
-    let log = wait_for_log(&log_path, "Opened Duck.glb", 0, Duration::from_secs(120), app!());
-    let window = xdotool(&display, &["search", "--sync", "--name", "meshpaint"]);
-    let window = window.lines().next().expect("no meshpaint window").trim().to_owned();
-    xdotool(&display, &["windowfocus", "--sync", &window]);
-    pause(3.0);
-    let rect = view_rect(&read_log(&log_path));
+    wait_for_log(&log_path, "Opened Duck.glb", 0, Duration::from_secs(120), app!());
+    focus_window(&display);
+    let log = wait_for_log(&log_path, "3D view at ", 0, Duration::from_secs(60), app!());
+    let rect = view_rect(&log);
     assert!(rect.2 > 400 && rect.3 > 300, "3D view too small: {rect:?}\n{log}");
 
     // 1. The default view: not blank, and the same image as an offscreen render.
     // Screenshots go to target/test-output (never over the committed screenshots/, unless
     // MESHPAINT_UPDATE_SCREENSHOTS=1 asks for it once the checks on them passed).
     let shots = output_dir();
-    let first = screenshot(&display, &shots.join("app_duck.png"));
+    let first =
+        wait_for_screen(&display, &shots.join("app_duck.png"), rect, "the Duck", &|s| view_drawn(s, rect), app!());
     let view = crop(&first, rect);
     check_view_not_blank(&view, "default view");
     let reference = reference_view(&asset, (rect.2, rect.3));
@@ -285,19 +362,20 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
 
     // 2. Orbit with the middle button, toggle the wireframe with W.
     let (cx, cy) = (rect.0 + rect.2 / 2, rect.1 + rect.3 / 2);
-    xdotool(&display, &["mousemove", &cx.to_string(), &cy.to_string()]);
-    pause(0.3);
+    xdotool(&display, &["mousemove", "--sync", &cx.to_string(), &cy.to_string()]);
     xdotool(&display, &["mousedown", "2"]);
-    pause(0.3);
+    // Pacing, not waiting: each step is a separate motion event for the orbit. What the test
+    // waits for is the screen below.
     for step in 1..=4 {
-        xdotool(&display, &["mousemove", &(cx + 40 * step).to_string(), &(cy + 12 * step).to_string()]);
         pause(0.3);
+        xdotool(&display, &["mousemove", "--sync", &(cx + 40 * step).to_string(), &(cy + 12 * step).to_string()]);
     }
     xdotool(&display, &["mouseup", "2"]);
-    pause(0.5);
     xdotool(&display, &["key", "w"]);
-    pause(3.0);
-    let second = screenshot(&display, &shots.join("app_duck_orbit_wireframe.png"));
+    let before = dark_share(&view);
+    let wired = |shot: &RgbImage| dark_share(&crop(shot, rect)) > before + 0.05;
+    let second =
+        wait_for_screen(&display, &shots.join("app_duck_orbit_wireframe.png"), rect, "the wireframe", &wired, app!());
     let orbited = crop(&second, rect);
     check_view_not_blank(&orbited, "orbited view");
     let (moved, _) = compare(&orbited, &view);
@@ -309,13 +387,7 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     // 3. Export glTF through the dialog (Ctrl+E, type the path, Enter).
     let exported = dir.join("exported duck.glb");
     let from = read_log(&log_path).len();
-    xdotool(&display, &["key", "ctrl+e"]);
-    pause(1.5);
-    xdotool(&display, &["key", "ctrl+a"]);
-    pause(0.3);
-    xdotool(&display, &["type", "--delay", "30", &exported.display().to_string()]);
-    pause(0.5);
-    xdotool(&display, &["key", "Return"]);
+    type_into_dialog(&display, &log_path, "ctrl+e", &exported, app!());
     wait_for_log(&log_path, "Exported", from, Duration::from_secs(120), app!());
     let bytes = std::fs::read(&exported).expect("no exported file");
     assert_eq!(&bytes[..4], b"glTF");
@@ -326,25 +398,21 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     // 4. Open a broken file (Ctrl+O): the error shows, the Duck stays, the app runs on.
     let broken = crate_path("tests/fixtures/invalid/gltf-validator/glb/invalid_magic.glb");
     let from = read_log(&log_path).len();
-    xdotool(&display, &["key", "ctrl+o"]);
-    pause(1.5);
-    xdotool(&display, &["type", "--delay", "30", &broken.display().to_string()]);
-    pause(0.5);
-    xdotool(&display, &["key", "Return"]);
+    type_into_dialog(&display, &log_path, "ctrl+o", &broken, app!());
     wait_for_log(&log_path, "Could not open", from, Duration::from_secs(60), app!());
-    pause(2.0);
-    assert!(app!().try_wait().unwrap().is_none(), "the app exited after a bad file");
-    let third = screenshot(&display, &dir.join("after_error.png"));
-    check_view_not_blank(&crop(&third, rect), "view after the bad file");
     // The status line (bottom rows) shows the error in the error colour (red).
-    let red = (0..third.width())
-        .flat_map(|x| (third.height() - 22..third.height()).map(move |y| (x, y)))
-        .filter(|&(x, y)| {
-            let p = third.get_pixel(x, y);
-            p[0] > 150 && p[1] < 110 && p[2] < 110
-        })
-        .count();
-    assert!(red > 50, "no error text in the status line ({red} red pixels)");
+    let red = |shot: &RgbImage| {
+        (0..shot.width())
+            .flat_map(|x| (shot.height() - 22..shot.height()).map(move |y| (x, y)))
+            .filter(|&(x, y)| {
+                let p = shot.get_pixel(x, y);
+                p[0] > 150 && p[1] < 110 && p[2] < 110
+            })
+            .count()
+    };
+    let third = wait_for_screen(&display, &dir.join("after_error.png"), rect, "the error", &|s| red(s) > 50, app!());
+    assert!(app!().try_wait().unwrap().is_none(), "the app exited after a bad file");
+    check_view_not_blank(&crop(&third, rect), "view after the bad file");
 
     // 4b. OBJ, PLY and STL open through the same dialog and show; a broken PLY keeps the last.
     let broken_ply = dir.join("broken.ply");
@@ -369,15 +437,7 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
     }
 
     // 5. Ctrl+Q quits cleanly.
-    xdotool(&display, &["key", "ctrl+q"]);
-    let started = Instant::now();
-    let status = loop {
-        if let Some(status) = app!().try_wait().unwrap() {
-            break status;
-        }
-        assert!(started.elapsed() < Duration::from_secs(20), "the app did not quit on Ctrl+Q");
-        std::thread::sleep(Duration::from_millis(100));
-    };
+    let status = quit(&display, app!());
     processes.children.pop();
     let log = read_log(&log_path);
     assert!(status.success(), "exit status {status}:\n{log}");
@@ -433,124 +493,66 @@ fn samples_with_positions(
     out
 }
 
-#[test]
-fn paint_mode_stroke_lands_under_the_cursor_and_is_saved() {
-    let _serial = WINDOW_TESTS.lock().unwrap_or_else(|e| e.into_inner());
-    for tool in ["Xvfb", "xdotool", "import"] {
-        require_tool(tool);
-    }
-    let dir = std::env::temp_dir().join(format!("meshpaint_app_paint_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let log_path = dir.join("app.log");
-    let mut processes = Processes { children: Vec::new() };
-    let display = start_xvfb(&mut processes);
-    let asset = crate_path("assets/models/Duck/Duck.glb");
-    let app = Command::new(env!("CARGO_BIN_EXE_meshpaint"))
-        .arg(&asset)
-        .env("DISPLAY", &display)
-        .env("RUST_LOG", "meshpaint=info")
-        .env("XDG_RUNTIME_DIR", &dir)
-        .env("XDG_STATE_HOME", &dir)
-        .current_dir(&dir)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(std::fs::File::create(&log_path).unwrap())
-        .spawn()
-        .expect("cannot start meshpaint");
-    processes.children.push(app);
-    macro_rules! app {
-        () => {
-            processes.children.last_mut().unwrap()
-        };
-    }
-    wait_for_log(&log_path, "Opened Duck.glb", 0, Duration::from_secs(120), app!());
-    let window = xdotool(&display, &["search", "--sync", "--name", "meshpaint"]);
-    let window = window.lines().next().expect("no meshpaint window").trim().to_owned();
-    xdotool(&display, &["windowfocus", "--sync", &window]);
-    pause(3.0);
-    let rect = view_rect(&read_log(&log_path));
+/// A horizontal stroke `(x0, x1, y)` in screen pixels.
+type Stroke = (u32, u32, u32);
+
+/// Enters paint mode (Tab) with the cursor on the view and paints a horizontal stroke across
+/// the middle of the Duck (the default brush: red, 30 px); waits until it shows. Returns it.
+fn paint_a_stroke(display: &str, log_path: &Path, rect: (u32, u32, u32, u32), app: &mut Child) -> Stroke {
     let (cx, cy) = (rect.0 + rect.2 / 2, rect.1 + rect.3 / 2);
+    xdotool(display, &["mousemove", "--sync", &cx.to_string(), &cy.to_string()]);
+    let from = read_log(log_path).len();
+    xdotool(display, &["key", "Tab"]);
+    wait_for_log(log_path, "Paint mode", from, Duration::from_secs(30), app);
+    let shots = output_dir();
+    wait_for_screen(display, &shots.join("app_paint_mode.png"), rect, "paint mode", &|s| view_drawn(s, rect), app);
 
-    // Tab enters paint mode.
-    xdotool(&display, &["mousemove", &cx.to_string(), &cy.to_string()]);
-    pause(0.3);
-    let from = read_log(&log_path).len();
-    xdotool(&display, &["key", "Tab"]);
-    wait_for_log(&log_path, "Paint mode", from, Duration::from_secs(30), app!());
-    pause(1.0);
-
-    // A horizontal stroke across the middle of the Duck (the default brush: red, 30 px).
     let (x0, x1, y) = (cx - 120, cx + 120, cy + 20);
-    xdotool(&display, &["mousemove", &x0.to_string(), &y.to_string()]);
-    pause(0.3);
-    let from = read_log(&log_path).len();
-    xdotool(&display, &["mousedown", "1"]);
-    pause(0.3);
+    xdotool(display, &["mousemove", "--sync", &x0.to_string(), &y.to_string()]);
+    let from = read_log(log_path).len();
+    xdotool(display, &["mousedown", "1"]);
+    // Pacing, not waiting: each step is a separate motion event for the brush.
     for step in 1..=6 {
         let x = x0 + (x1 - x0) * step / 6;
-        xdotool(&display, &["mousemove", &x.to_string(), &y.to_string()]);
         pause(0.3);
+        xdotool(display, &["mousemove", "--sync", &x.to_string(), &y.to_string()]);
     }
-    xdotool(&display, &["mouseup", "1"]);
-    wait_for_log(&log_path, "paint stroke", from, Duration::from_secs(30), app!());
-    pause(1.5);
-    let shot_path = output_dir().join("app_paint.png");
-    let shot = screenshot(&display, &shot_path);
-    let view = crop(&shot, rect);
-    let red = view
-        .enumerate_pixels()
-        .filter(|&(px, py, p)| {
-            let (vx, vy) = (f64::from(px + rect.0), f64::from(py + rect.1));
-            distance_to_segment((vx, vy), (f64::from(x0), f64::from(y)), (f64::from(x1), f64::from(y))) < 30.0
-                && p[0] > 150
-                && p[1] < 80
-                && p[2] < 80
-        })
-        .count();
-    assert!(red > 2000, "no red stroke in the paint-mode screenshot ({red} red pixels near the stroke)");
-    update_screenshot(&shot_path, "app_paint.png");
-
-    // Tab leaves (repack), Ctrl+S saves through the dialog.
-    let from = read_log(&log_path).len();
-    xdotool(&display, &["key", "Tab"]);
-    wait_for_log(&log_path, "Repacked", from, Duration::from_secs(60), app!());
-    let saved = dir.join("painted duck.mpk");
-    let from = read_log(&log_path).len();
-    xdotool(&display, &["key", "ctrl+s"]);
-    pause(1.5);
-    xdotool(&display, &["key", "ctrl+a"]);
-    pause(0.3);
-    xdotool(&display, &["type", "--delay", "30", &saved.display().to_string()]);
-    pause(0.5);
-    xdotool(&display, &["key", "Return"]);
-    wait_for_log(&log_path, "Saved", from, Duration::from_secs(120), app!());
-    xdotool(&display, &["key", "ctrl+q"]);
-    let started = Instant::now();
-    while app!().try_wait().unwrap().is_none() {
-        assert!(started.elapsed() < Duration::from_secs(20), "the app did not quit on Ctrl+Q");
-        std::thread::sleep(Duration::from_millis(100));
-    }
-    processes.children.pop();
-    let log = read_log(&log_path);
-    assert!(!log.contains("panicked"), "{log}");
-
-    // The saved colours differ from the original only under the stroke.
-    let r8 = meshpaint::colors::layout::Resolution::new(8).unwrap();
-    let painted = meshpaint::io::document::Document::open(&saved, r8).expect("the saved file does not open");
-    let format = match painted.source {
-        meshpaint::io::document::SourceKind::Packed(format) => format,
-        other => panic!("the saved file is not packed: {other:?}"),
+    xdotool(display, &["mouseup", "1"]);
+    wait_for_log(log_path, "paint stroke", from, Duration::from_secs(30), app);
+    let shot_path = shots.join("app_paint.png");
+    let red_near_stroke = |shot: &RgbImage| {
+        crop(shot, rect)
+            .enumerate_pixels()
+            .filter(|&(px, py, p)| {
+                let (vx, vy) = (f64::from(px + rect.0), f64::from(py + rect.1));
+                distance_to_segment((vx, vy), (f64::from(x0), f64::from(y)), (f64::from(x1), f64::from(y))) < 30.0
+                    && p[0] > 150
+                    && p[1] < 80
+                    && p[2] < 80
+            })
+            .count()
+            > 2000
     };
-    let original = meshpaint::io::document::Document::open(&asset, r8).unwrap();
-    // Quantise the original exactly as the save did.
-    let original = meshpaint::io::document::Document::from_packed(&original.pack(format).unwrap()).unwrap();
-    let before = samples_with_positions(&original);
-    let after = samples_with_positions(&painted);
-    assert_eq!(before.len(), after.len(), "the sample count changed");
+    wait_for_screen(display, &shot_path, rect, "a red stroke (over 2000 red pixels near it)", &red_near_stroke, app);
+    (x0, x1, y)
+}
 
+/// The samples of `painted` differ from those of `original` only under `stroke` (within the
+/// brush radius, seen from the camera the editor computes for the view `rect`), towards red,
+/// and at least 1000 of them.
+fn assert_only_the_stroke_changed(
+    original: &meshpaint::io::document::Document,
+    painted: &meshpaint::io::document::Document,
+    asset: &Path,
+    rect: (u32, u32, u32, u32),
+    (x0, x1, y): Stroke,
+) {
+    let before = samples_with_positions(original);
+    let after = samples_with_positions(painted);
+    assert_eq!(before.len(), after.len(), "the sample count changed");
     // The app's camera: the same editor state the app computed at this view size.
     let mut editor = Editor::new(None, Arc::new(|| {}));
-    editor.open(Source::File(asset.clone()));
+    editor.open(Source::File(asset.to_owned()));
     assert!(editor.wait_for_job(Duration::from_secs(60)));
     editor.viewport.rect = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(rect.2 as f32, rect.3 as f32));
     editor.viewport.pixels_per_point = 1.0;
@@ -579,6 +581,179 @@ fn paint_mode_stroke_lands_under_the_cursor_and_is_saved() {
     }
     eprintln!("{changed} samples changed, farthest {worst:.1} px from the stroke");
     assert!(changed >= 1000, "only {changed} samples changed");
+}
+
+/// `document` after a save in `format` (as the editor's save quantises it).
+fn quantised(
+    document: &meshpaint::io::document::Document,
+    format: meshpaint::colors::format::ColorFormat,
+) -> meshpaint::io::document::Document {
+    meshpaint::io::document::Document::from_packed(&document.pack(format).unwrap()).unwrap()
+}
+
+#[test]
+fn paint_mode_stroke_lands_under_the_cursor_and_is_saved() {
+    let _serial = WINDOW_TESTS.lock().unwrap_or_else(|e| e.into_inner());
+    for tool in ["Xvfb", "xdotool", "import"] {
+        require_tool(tool);
+    }
+    let dir = std::env::temp_dir().join(format!("meshpaint_app_paint_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log_path = dir.join("app.log");
+    let mut processes = Processes { children: Vec::new() };
+    let display = start_xvfb(&mut processes);
+    let asset = crate_path("assets/models/Duck/Duck.glb");
+    processes.children.push(start_app(&display, &dir, &log_path, &asset, &[]));
+    macro_rules! app {
+        () => {
+            processes.children.last_mut().unwrap()
+        };
+    }
+    wait_for_log(&log_path, "Opened Duck.glb", 0, Duration::from_secs(120), app!());
+    focus_window(&display);
+    let rect = view_rect(&wait_for_log(&log_path, "3D view at ", 0, Duration::from_secs(60), app!()));
+    let stroke = paint_a_stroke(&display, &log_path, rect, app!());
+    update_screenshot(&output_dir().join("app_paint.png"), "app_paint.png");
+
+    // Tab leaves (repack), Ctrl+S saves through the dialog.
+    let from = read_log(&log_path).len();
+    xdotool(&display, &["key", "Tab"]);
+    wait_for_log(&log_path, "Repacked", from, Duration::from_secs(60), app!());
+    let saved = dir.join("painted duck.mpk");
+    let from = read_log(&log_path).len();
+    type_into_dialog(&display, &log_path, "ctrl+s", &saved, app!());
+    wait_for_log(&log_path, "Saved", from, Duration::from_secs(120), app!());
+    quit(&display, app!());
+    processes.children.pop();
+    let log = read_log(&log_path);
+    assert!(!log.contains("panicked"), "{log}");
+
+    // The saved colours differ from the original only under the stroke.
+    let r8 = meshpaint::colors::layout::Resolution::new(8).unwrap();
+    let painted = meshpaint::io::document::Document::open(&saved, r8).expect("the saved file does not open");
+    let format = match painted.source {
+        meshpaint::io::document::SourceKind::Packed(format) => format,
+        other => panic!("the saved file is not packed: {other:?}"),
+    };
+    // Quantise the original exactly as the save did.
+    let original = quantised(&meshpaint::io::document::Document::open(&asset, r8).unwrap(), format);
+    assert_only_the_stroke_changed(&original, &painted, &asset, rect, stroke);
     drop(processes);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every sample's colour, in `for_each_site` order.
+fn colors(document: &meshpaint::io::document::Document) -> Vec<[f32; 4]> {
+    let mut out = Vec::new();
+    document.store.for_each_site(|site| out.push(document.store.get(site.sample).unwrap()));
+    out
+}
+
+#[test]
+fn a_killed_editor_offers_its_autosave_and_restores_what_was_painted() {
+    let _serial = WINDOW_TESTS.lock().unwrap_or_else(|e| e.into_inner());
+    for tool in ["Xvfb", "xdotool", "import"] {
+        require_tool(tool);
+    }
+    let dir = std::env::temp_dir().join(format!("meshpaint_app_recovery_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut processes = Processes { children: Vec::new() };
+    let display = start_xvfb(&mut processes);
+    let asset = crate_path("assets/models/Duck/Duck.glb");
+    // Autosave every second (the default is 60 s).
+    let env = [("MESHPAINT_AUTOSAVE_SECONDS", "1")];
+    let first_log = dir.join("first.log");
+    processes.children.push(start_app(&display, &dir, &first_log, &asset, &env));
+    macro_rules! app {
+        () => {
+            processes.children.last_mut().unwrap()
+        };
+    }
+    wait_for_log(&first_log, "Opened Duck.glb", 0, Duration::from_secs(120), app!());
+    focus_window(&display);
+    let rect = view_rect(&wait_for_log(&first_log, "3D view at ", 0, Duration::from_secs(60), app!()));
+    let stroke = paint_a_stroke(&display, &first_log, rect, app!());
+
+    // The first autosave after the stroke (it may already be there), then kill -9.
+    let from = read_log(&first_log).find("paint stroke").unwrap();
+    let log = wait_for_log(&first_log, "Autosaved ", from, Duration::from_secs(60), app!());
+    let line = log[from..].lines().find(|l| l.contains("Autosaved ")).unwrap();
+    let recovery = line[line.find("Autosaved ").unwrap() + "Autosaved ".len()..].split(" (").next().unwrap();
+    let recovery = std::path::PathBuf::from(recovery);
+    let autosaved = std::fs::read(&recovery).expect("no recovery file");
+    sigkill(app!());
+    processes.children.pop();
+
+    // What the autosave holds: the painted Duck (an independent check of the stroke).
+    let r8 = meshpaint::colors::layout::Resolution::new(8).unwrap();
+    let autosave =
+        meshpaint::io::document::Document::from_packed(&meshpaint::packing::file::from_bytes(&autosaved).unwrap())
+            .unwrap();
+    let original = meshpaint::io::document::Document::open(&asset, r8).unwrap();
+    assert_only_the_stroke_changed(&original, &autosave, &asset, rect, stroke);
+
+    // Restart: the recovery offer appears; Restore.
+    let second_log = dir.join("second.log");
+    processes.children.push(start_app(&display, &dir, &second_log, &asset, &env));
+    wait_for_log(&second_log, "Opened Duck.glb", 0, Duration::from_secs(120), app!());
+    focus_window(&display);
+    let offered = "Restore button at ";
+    let mut restored = false;
+    for _attempt in 0..5 {
+        let log = wait_for_log(&second_log, offered, 0, Duration::from_secs(60), app!());
+        let line = log.lines().rev().find(|l| l.contains(offered)).unwrap();
+        let at = &line[line.find(offered).unwrap() + offered.len()..];
+        let mut numbers = at.split(|c: char| !c.is_ascii_digit()).filter(|n| !n.is_empty());
+        let (x, y) = (numbers.next().unwrap(), numbers.next().unwrap());
+        let from = read_log(&second_log).len();
+        xdotool(&display, &["mousemove", "--sync", x, y, "click", "1"]);
+        // The restored document opens (state), or the click came before the button was
+        // there: look again at where it is now.
+        let started = Instant::now();
+        while started.elapsed() < Duration::from_secs(10) {
+            if read_log(&second_log).get(from..).is_some_and(|tail| tail.contains("Opened ")) {
+                restored = true;
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        if restored {
+            break;
+        }
+    }
+    assert!(restored, "Restore did not open the recovery file:\n{}", read_log(&second_log));
+
+    // Save the restored document; the recovery file goes away with the save.
+    let saved = dir.join("recovered.mpk");
+    let from = read_log(&second_log).len();
+    type_into_dialog(&display, &second_log, "ctrl+s", &saved, app!());
+    wait_for_log(&second_log, "Saved", from, Duration::from_secs(120), app!());
+    let status = quit(&display, app!());
+    processes.children.pop();
+    let log = read_log(&second_log);
+    assert!(status.success() && !log.contains("panicked"), "{status}:\n{log}");
+    assert!(!recovery.exists(), "the recovery file {} outlived the save", recovery.display());
+
+    // The saved file holds exactly the autosaved samples (quantised as the save does).
+    let recovered = meshpaint::io::document::Document::open(&saved, r8).unwrap();
+    let format = match recovered.source {
+        meshpaint::io::document::SourceKind::Packed(format) => format,
+        other => panic!("the saved file is not packed: {other:?}"),
+    };
+    let expected = colors(&quantised(&autosave, format));
+    let found = colors(&recovered);
+    assert_eq!(expected.len(), found.len());
+    let differ = expected.iter().zip(&found).filter(|(a, b)| a != b).count();
+    assert_eq!(differ, 0, "{differ} of {} recovered samples differ from the autosave", found.len());
+    drop(processes);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// SIGKILL (std's `Child::kill`), then reap.
+fn sigkill(app: &mut Child) {
+    app.kill().unwrap();
+    let status = app.wait().unwrap();
+    use std::os::unix::process::ExitStatusExt;
+    assert_eq!(status.signal(), Some(9), "the app was not killed by SIGKILL: {status}");
 }

@@ -50,18 +50,41 @@ pub struct AutosaveState {
     /// When the last autosave finished.
     pub last_saved: Option<Instant>,
     pub(crate) restoring: Option<Restoring>,
+    /// Where the recovery offer's Restore button was last logged (physical px).
+    pub(crate) logged_restore_button: Option<[i32; 2]>,
+}
+
+/// The environment variable that sets the autosave interval in whole seconds (at least 1),
+/// e.g. `MESHPAINT_AUTOSAVE_SECONDS=1` in the window tests; otherwise 60 s.
+pub const INTERVAL_ENV: &str = "MESHPAINT_AUTOSAVE_SECONDS";
+
+/// The interval [`INTERVAL_ENV`] asks for, else the default (a bad value is logged).
+fn interval_from_env() -> u32 {
+    let default = autosave::DEFAULT_INTERVAL.as_secs() as u32;
+    let Some(value) = std::env::var_os(INTERVAL_ENV) else {
+        return default;
+    };
+    match value.to_str().and_then(|v| v.trim().parse::<u32>().ok()).filter(|&s| s >= 1) {
+        Some(seconds) => seconds,
+        None => {
+            log::warn!("{INTERVAL_ENV}={value:?} is not a number of seconds >= 1; autosaving every {default} s");
+            default
+        }
+    }
 }
 
 impl Default for AutosaveState {
     fn default() -> Self {
+        let interval_seconds = interval_from_env();
         AutosaveState {
             enabled: true,
-            interval_seconds: autosave::DEFAULT_INTERVAL.as_secs() as u32,
-            autosaver: Autosaver::new(autosave::DEFAULT_INTERVAL, 0),
+            interval_seconds,
+            autosaver: Autosaver::new(Duration::from_secs(u64::from(interval_seconds)), 0),
             recovery_path: None,
             offer: None,
             last_saved: None,
             restoring: None,
+            logged_restore_button: None,
         }
     }
 }

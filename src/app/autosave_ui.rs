@@ -47,7 +47,11 @@ impl Editor {
             ui.checkbox(&mut self.autosave.enabled, "Autosave every");
             ui.add_enabled(
                 self.autosave.enabled,
-                egui::DragValue::new(&mut self.autosave.interval_seconds).range(5..=3600).suffix(" s"),
+                // Not clamped while shown: MESHPAINT_AUTOSAVE_SECONDS may ask for less than 5 s.
+                egui::DragValue::new(&mut self.autosave.interval_seconds)
+                    .range(5..=3600)
+                    .clamp_existing_to_range(false)
+                    .suffix(" s"),
             );
         });
         if let Some(at) = self.autosave.last_saved {
@@ -61,6 +65,7 @@ impl Editor {
             return;
         };
         let mut choice = None;
+        let mut restore_at = None;
         egui::Window::new("Recover unsaved work?")
             .collapsible(false)
             .resizable(false)
@@ -69,14 +74,25 @@ impl Editor {
             .show(ctx, |ui| {
                 ui.label(format!("A recovery file from an earlier session exists:\n{}", offer.path.display()));
                 ui.horizontal(|ui| {
-                    if ui.button("Restore").clicked() {
+                    let restore = ui.button("Restore");
+                    if restore.clicked() {
                         choice = Some(true);
                     }
+                    restore_at = Some(restore.rect.center());
                     if ui.button("Discard").clicked() {
                         choice = Some(false);
                     }
                 });
             });
+        // A log line the window tests wait for (and click at).
+        if let Some(at) = restore_at {
+            let ppp = ctx.pixels_per_point();
+            let px = [(at.x * ppp).round() as i32, (at.y * ppp).round() as i32];
+            if self.autosave.logged_restore_button != Some(px) {
+                log::info!("Recovery offered for {}: Restore button at {},{} px", offer.path.display(), px[0], px[1]);
+                self.autosave.logged_restore_button = Some(px);
+            }
+        }
         match choice {
             Some(true) => {
                 let Some(open) = &self.document else {

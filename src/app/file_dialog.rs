@@ -91,6 +91,7 @@ pub struct FileDialog {
     listing_error: Option<String>,
     confirm_replace: Option<PathBuf>,
     focus_pending: bool,
+    focus_logged: bool,
 }
 
 impl FileDialog {
@@ -106,6 +107,7 @@ impl FileDialog {
             listing_error: None,
             confirm_replace: None,
             focus_pending: true,
+            focus_logged: false,
         };
         dialog.refresh();
         dialog
@@ -250,6 +252,10 @@ impl FileDialog {
             if self.focus_pending {
                 field.request_focus();
                 self.focus_pending = false;
+            } else if field.has_focus() && !self.focus_logged {
+                // The window tests wait for this line before typing a path.
+                log::info!("File dialog \"{}\": the path field has the keyboard focus", self.purpose.title());
+                self.focus_logged = true;
             }
             if field.changed() {
                 self.confirm_replace = None;

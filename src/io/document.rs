@@ -56,6 +56,17 @@ pub enum DocumentError {
         /// The cause.
         source: TopologyError,
     },
+    /// A vertex lands at an infinite or NaN world position once its node transforms apply
+    /// (finite file values whose product overflows `f32`).
+    #[error("{path}: vertex {vertex} has a non-finite world position {position:?} after its node transforms")]
+    NonFiniteWorldPosition {
+        /// The file.
+        path: PathBuf,
+        /// The welded vertex.
+        vertex: u64,
+        /// Its world position.
+        position: [f32; 3],
+    },
     /// The mesh has no triangles to show or paint.
     #[error("{path}: the file holds no triangles to paint")]
     NoTriangles {
@@ -410,6 +421,11 @@ impl Document {
         let budget_error = |source| DocumentError::Budget { path: name.to_owned(), source };
         budget.check_triangles("the scene", scene.instanced_triangle_count() as u64).map_err(budget_error)?;
         let welded = weld_scene(&scene);
+        if let Some((vertex, position)) =
+            (0u64..).zip(&welded.positions_world).find(|(_, p)| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(DocumentError::NonFiniteWorldPosition { path: name.to_owned(), vertex, position: *position });
+        }
         let topology = Topology::build(welded.positions_world.len() as u32, &welded.triangles)
             .map_err(|source| DocumentError::Topology { path: name.to_owned(), source })?;
         let resolutions = match rule {

@@ -33,7 +33,7 @@ const UPLOAD_BAND_BYTES: u64 = 64 << 20;
 const MESH_DATA_WIDTH: u32 = 1 << 12;
 
 /// Bytes per data-texture entry (one RGBA32 texel).
-const DATA_TEXEL_BYTES: u64 = 16;
+pub(super) const DATA_TEXEL_BYTES: u64 = 16;
 
 /// Writes `data` (whole texels of `bytes_per_texel`) into `texture`, whose rows are `width`
 /// texels, starting at texel index `first` (texel `(first % width, first / width)`): partial
@@ -105,7 +105,8 @@ fn data_texture(
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        // COPY_SRC: tests read the GPU copy back (super::readback).
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     });
     write_texel_rows(ctx, &texture, MESH_DATA_WIDTH, texel_bytes, 0, bytes);
@@ -270,7 +271,8 @@ impl GpuMesh {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: atlas_texture_format(packed.format),
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            // COPY_SRC: tests read the GPU copy back (super::readback).
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
         let view = |texture: &wgpu::Texture| texture.create_view(&wgpu::TextureViewDescriptor::default());
@@ -351,6 +353,14 @@ impl GpuMesh {
         let bytes = bytemuck::cast_slice::<FaceRecord, u8>(records);
         write_texel_rows(ctx, &self.face_records, MESH_DATA_WIDTH, DATA_TEXEL_BYTES, u64::from(first_face), bytes);
         Ok(())
+    }
+
+    pub(super) fn atlas_texture(&self) -> &wgpu::Texture {
+        &self.atlas_texture
+    }
+
+    pub(super) fn face_record_texture(&self) -> &wgpu::Texture {
+        &self.face_records
     }
 
     /// GPU memory of the mesh's data textures and atlas, in bytes.

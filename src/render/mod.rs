@@ -38,6 +38,7 @@ mod baseline;
 mod context;
 mod gpu;
 mod mesh_gpu;
+mod readback;
 mod renderer;
 mod uniforms;
 

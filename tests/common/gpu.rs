@@ -16,6 +16,11 @@ impl Gpu {
     /// A new context and renderer, or why there is none.
     pub fn try_new() -> Result<Gpu, String> {
         let ctx = GpuContext::new_headless().map_err(|error| error.to_string())?;
+        // A wgpu error outside the renderer's error scopes fails the test (the editor only
+        // logs it): tests must not pass with a broken upload.
+        ctx.device.on_uncaptured_error(std::sync::Arc::new(|error: wgpu::Error| {
+            panic!("uncaptured wgpu error (outside the renderer's error scopes): {error}")
+        }));
         let renderer = Renderer::new(&ctx, OFFSCREEN_FORMAT).map_err(|error| error.to_string())?;
         Ok(Gpu { ctx, renderer })
     }
