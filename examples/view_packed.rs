@@ -81,8 +81,9 @@ pub fn read_packed(path: &Path) -> Result<Packed> {
 
 /// meshpaint's default orbit camera (src/camera.rs): a sphere around the axis-aligned bounds,
 /// framed at a 40° vertical field of view with a 10 % margin, near/far around the sphere.
-/// Returns `(render origin, clip_from_world relative to it, unit vector towards the light)`.
-pub fn camera(positions: &[[f32; 3]], yaw: f64, pitch: f64, width: u32, height: u32) -> (DVec3, DMat4, DVec3) {
+/// Returns `(render origin, clip_from_world relative to it, unit vector towards the light,
+/// eye relative to the origin)`.
+pub fn camera(positions: &[[f32; 3]], yaw: f64, pitch: f64, width: u32, height: u32) -> (DVec3, DMat4, DVec3, DVec3) {
     let points = positions.iter().map(|p| DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])));
     let (min, max) = points.clone().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
     let center = if positions.is_empty() { DVec3::ZERO } else { (min + max) * 0.5 };
@@ -104,10 +105,45 @@ pub fn camera(positions: &[[f32; 3]], yaw: f64, pitch: f64, width: u32, height: 
     let right = DVec3::Y.cross(towards_eye).normalize_or(DVec3::X);
     let up = towards_eye.cross(right).normalize_or(DVec3::Y);
     let light = (towards_eye + 0.6 * up - 0.4 * right).normalize_or(towards_eye);
-    (center, projection * view, light)
+    (center, projection * view, light, eye - center)
 }
 
-/// `struct FrameUniforms` of shaders/frame.wgsl (160 bytes).
+/// The trilinear level of detail's per-vertex inputs (docs/FORMAT.md, "Use it in your
+/// renderer"): each vertex's sample density, the largest `R_f / sqrt(2 A_f)` over the faces
+/// around it (faces of zero area skipped), and its unit area-weighted normal as f16 bits.
+fn vertex_lod(positions: &[[f32; 3]], indices: &[u32], face_records: &[u32]) -> (Vec<f32>, Vec<[u16; 4]>) {
+    let mut density = vec![0.0f64; positions.len()];
+    let mut normal = vec![DVec3::ZERO; positions.len()];
+    let p = |v: u32| {
+        positions.get(v as usize).map_or(DVec3::ZERO, |p| DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])))
+    };
+    for (face, c) in indices.chunks_exact(3).enumerate() {
+        let cross = (p(c[1]) - p(c[0])).cross(p(c[2]) - p(c[0]));
+        let twice_area = cross.length();
+        let log2_r = face_records.get(face * 4).map_or(0, |word| word >> 28);
+        if !(twice_area.is_finite() && twice_area > 0.0) || log2_r > 12 {
+            continue;
+        }
+        let face_density = f64::from(1u32 << log2_r) / twice_area.sqrt();
+        for &v in c {
+            if let (Some(d), Some(n)) = (density.get_mut(v as usize), normal.get_mut(v as usize)) {
+                *d = d.max(face_density);
+                *n += cross;
+            }
+        }
+    }
+    let normals = normal
+        .iter()
+        .map(|n| {
+            let unit = if n.length() > 0.0 && n.length().is_finite() { *n / n.length() } else { DVec3::ZERO };
+            let bits = unit.to_array().map(|x| half::f16::from_f64(x).to_bits());
+            [bits[0], bits[1], bits[2], 0]
+        })
+        .collect();
+    (density.iter().map(|&d| if d.is_finite() { d as f32 } else { f32::MAX }).collect(), normals)
+}
+
+/// `struct FrameUniforms` of shaders/frame.wgsl (176 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct FrameUniforms {
@@ -115,6 +151,7 @@ struct FrameUniforms {
     light: [f32; 4],
     wire_color: [f32; 4],
     tint: [f32; 4],
+    lod_eye: [f32; 4],
     filter_kind: u32,
     level_mode: u32,
     level: u32,
@@ -187,16 +224,19 @@ pub fn view_packed(input: &Path, output: &Path, size: (u32, u32), yaw: f64, pitc
     let packed = read_packed(input)?;
     let (width, height) = size;
     let (device, queue, adapter) = device()?;
-    let (origin, clip_from_world, light) = camera(&packed.positions, yaw, pitch, width, height);
+    let (origin, clip_from_world, light, eye) = camera(&packed.positions, yaw, pitch, width, height);
+    let (density, normals) = vertex_lod(&packed.positions, &packed.indices, &packed.face_records);
 
-    // Bindings 1..4: positions relative to the render origin (subtracted in f64), vertex ids,
-    // face records (one RGBA32 texel each) and the colour atlas (one texel per sample).
+    // Bindings 1..5: positions relative to the render origin (subtracted in f64) with each
+    // vertex's sample density in w, vertex ids, face records (one RGBA32 texel each), the
+    // colour atlas (one texel per sample) and the vertex normals (Rgba16Float).
     let relative: Vec<[f32; 4]> = packed
         .positions
         .iter()
-        .map(|p| {
+        .zip(&density)
+        .map(|(p, &density)| {
             let p = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - origin;
-            [p.x as f32, p.y as f32, p.z as f32, 0.0]
+            [p.x as f32, p.y as f32, p.z as f32, density]
         })
         .collect();
     let corners: Vec<[u32; 4]> = packed.indices.chunks_exact(3).map(|c| [c[0], c[1], c[2], 0]).collect();
@@ -213,12 +253,20 @@ pub fn view_packed(input: &Path, output: &Path, size: (u32, u32), yaw: f64, pitc
         data(wgpu::TextureFormat::Rgba32Uint, bytemuck::cast_slice(&corners)),
         data(wgpu::TextureFormat::Rgba32Uint, bytemuck::cast_slice(&packed.face_records)),
         texture(&device, &queue, atlas_format, atlas_width, sample_bytes, &packed.colors),
+        texture(&device, &queue, wgpu::TextureFormat::Rgba16Float, DATA_WIDTH, 8, bytemuck::cast_slice(&normals)),
     ];
     let uniforms = FrameUniforms {
         clip_from_world: clip_from_world.as_mat4().to_cols_array_2d(),
         light: [light.x as f32, light.y as f32, light.z as f32, 0.25],
         wire_color: [0.0, 0.0, 0.0, 0.85],
         tint: [1.0; 4],
+        // Eye relative to the origin; the world size of a pixel at unit depth (40° fov).
+        lod_eye: [
+            eye.x as f32,
+            eye.y as f32,
+            eye.z as f32,
+            (2.0 * 20.0f64.to_radians().tan() / f64::from(height.max(1))) as f32,
+        ],
         filter_kind: 1, // linear
         level_mode: 1,  // automatic level (trilinear)
         level: 0,
@@ -233,7 +281,7 @@ pub fn view_packed(input: &Path, output: &Path, size: (u32, u32), yaw: f64, pitc
     };
     let uniform_buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: None,
-        size: 160,
+        size: std::mem::size_of::<FrameUniforms>() as u64,
         usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
