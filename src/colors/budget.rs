@@ -575,11 +575,16 @@ pub fn parse_bytes(text: &str) -> Option<u64> {
 
 /// `n` with thin thousands separators (`1 234 567`).
 pub fn thousands(n: u64) -> String {
+    thousands_with(n, ' ')
+}
+
+/// `n` with `separator` between groups of three digits (the editor uses `,`).
+pub fn thousands_with(n: u64, separator: char) -> String {
     let digits = n.to_string();
     let mut out = String::with_capacity(digits.len() + digits.len() / 3);
     for (k, c) in digits.chars().enumerate() {
         if k > 0 && (digits.len() - k).is_multiple_of(3) {
-            out.push(' ');
+            out.push(separator);
         }
         out.push(c);
     }
