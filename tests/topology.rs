@@ -1,6 +1,8 @@
 //! Welding and topology against brute force and closed-form counts, including the
 //! numerical and topological extremes.
 
+mod common;
+
 use std::collections::{BTreeMap, BTreeSet};
 
 use glam::{Mat4, Vec3};
@@ -276,4 +278,51 @@ fn stats_at_resolution_extremes() {
         })
         .sum();
     assert_eq!(max.samples_with_mips, with_mips);
+}
+
+/// Area of a welded mesh, summed in f64.
+fn welded_area(mesh: &WeldedMesh) -> f64 {
+    mesh.triangles
+        .iter()
+        .map(|t| {
+            let p = t.map(|i| Vec3::from_array(mesh.positions_world[i as usize]).as_dvec3());
+            0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()
+        })
+        .sum()
+}
+
+#[test]
+fn midpoint_subdivision_has_the_closed_form_counts_and_the_same_surface() {
+    use meshpaint::colors::budget::{Budget, MemorySource};
+    use meshpaint::mesh::subdivide::subdivide_scene;
+    let (scene, _) = meshpaint::io::document::import_scene(&common::model("Duck/glTF-Binary/Duck.glb")).unwrap();
+    let before = weld_scene(&scene);
+    let t0 = Topology::build(before.positions_world.len() as u32, &before.triangles).unwrap();
+    let budget = Budget::with_memory(8 << 30, MemorySource::Environment);
+    for levels in 1..=2u32 {
+        let after = weld_scene(&subdivide_scene(&scene, levels, &budget).unwrap());
+        let t1 = Topology::build(after.positions_world.len() as u32, &after.triangles).unwrap();
+        t1.validate().unwrap();
+        // Closed forms of `levels` 1→4 splits: F' = 4^n F, E' = 2^n E + 3 (4^n − 1)/3 · F … checked
+        // one level at a time below, by brute force over the edges.
+        let (mut v, mut e, mut f) = (t0.vertex_count as u64, t0.edge_count() as u64, t0.face_count() as u64);
+        let mut boundary = t0.boundary_edge_count() as u64;
+        for _ in 0..levels {
+            (v, e, f) = (v + e, 2 * e + 3 * f, 4 * f);
+            boundary *= 2;
+        }
+        assert_eq!(after.triangles.len() as u64, f);
+        assert_eq!(after.positions_world.len() as u64, v, "one new vertex per edge");
+        assert_eq!(brute_force_edges(&after.triangles).len() as u64, e);
+        assert_eq!(t1.boundary_edge_count() as u64, boundary);
+        assert_eq!(t1.nonmanifold_edge_count(), t0.nonmanifold_edge_count());
+        let (a0, a1) = (welded_area(&before), welded_area(&after));
+        assert!((a1 - a0).abs() <= 1e-5 * a0, "area {a0} → {a1}");
+    }
+    // The budget is checked on the count before anything is built.
+    let tiny = Budget::with_memory(600 * 4 * scene.instanced_triangle_count() as u64, MemorySource::Environment);
+    assert!(subdivide_scene(&scene, 1, &tiny).is_ok());
+    let refusal = subdivide_scene(&scene, 2, &tiny).unwrap_err().to_string();
+    assert!(refusal.contains("subdivided") && refusal.contains("triangles"), "{refusal}");
+    assert!(subdivide_scene(&scene, 40, &budget).is_err(), "4^40 triangles overflow to a refusal");
 }
