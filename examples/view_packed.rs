@@ -270,7 +270,7 @@ pub fn view_packed(input: &Path, output: &Path, size: (u32, u32), yaw: f64, pitc
         filter_kind: 1, // linear
         level_mode: 1,  // automatic level (trilinear)
         level: 0,
-        flags: 1, // FLAG_LIT
+        flags: 1 | 8, // FLAG_LIT | FLAG_SMOOTH: smooth shading from the vertex normals (binding 5)
         atlas_width,
         sample_count: u32::try_from(packed.sample_count).unwrap_or(u32::MAX).max(1),
         vertex_levels: packed.vertex_levels.max(1),

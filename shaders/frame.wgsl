@@ -50,6 +50,8 @@ struct FrameUniforms {
 const FLAG_LIT: u32 = 1u;
 const FLAG_WIREFRAME: u32 = 2u;
 const FLAG_HEATMAP: u32 = 4u;
+// With FLAG_LIT: smooth shading (vertex normals) instead of the face normal.
+const FLAG_SMOOTH: u32 = 8u;
 
 // The wireframe overlay: `wire_color` blended over `rgb` within about `wire_width` pixels of
 // a triangle edge. `bary` are the interpolated barycentrics, `bary_width` their fwidth

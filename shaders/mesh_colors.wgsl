@@ -107,7 +107,15 @@ struct VertexOut {
     // LEVEL_MODE 1: (view depth, μ) of the level of detail (src/packing/lod.rs), interpolated
     // perspective-correctly, so lod = log2(depth) + μ is one function over the mesh.
     @location(4) lod: vec2<f32>,
+    // FLAG_SMOOTH: dot(corner normal, light direction), interpolated (Gouraud).
+    @location(5) light_dot: f32,
 }
+
+// Smooth shading's crease: a corner takes its vertex's area-weighted normal when that is
+// within 45° of the face normal, else the face normal (a cube's corners, 54.7° away, stay
+// sharp; the faces of a sphere blend). Keep in sync with `SMOOTH_CREASE_COSINE` in
+// src/mesh/normals.rs (tests/shaders.rs compares them).
+const SMOOTH_CREASE_COSINE: f32 = 0.70710677;
 
 fn data_texel(k: u32) -> vec2<u32> {
     return vec2<u32>(k & ((1u << MESH_DATA_WIDTH_LOG2) - 1u), k >> MESH_DATA_WIDTH_LOG2);
@@ -306,6 +314,16 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
     }
     // The fragment stage flips the sign for back faces: dot(−n, l) = −dot(n, l) exactly.
     out.shade = vec4<f32>(heat_color(f.log2_f), dot(normal, u.light.xyz));
+    out.light_dot = out.shade.w;
+    if (u.flags & FLAG_SMOOTH) != 0u {
+        // The vertex normal is stored in f16; it is renormalised here. A face wound against
+        // its neighbours (mixed winding) sees it more than 45° away and stays flat.
+        let vn = textureLoad(normals, data_texel(v), 0).xyz;
+        let vn_len = length(vn);
+        if vn_len > 0.0 && dot(vn, normal) >= SMOOTH_CREASE_COSINE * vn_len {
+            out.light_dot = dot(vn / vn_len, u.light.xyz);
+        }
+    }
     out.face0 = packed[0];
     out.face1 = packed[1];
     return out;
@@ -514,7 +532,8 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     }
     if (u.flags & FLAG_LIT) != 0u {
         let ambient = u.light.w;
-        let diffuse = max(select(-in.shade.w, in.shade.w, front_facing), 0.0);
+        let d = select(in.shade.w, in.light_dot, (u.flags & FLAG_SMOOTH) != 0u);
+        let diffuse = max(select(-d, d, front_facing), 0.0);
         rgb = rgb * (ambient + (1.0 - ambient) * diffuse);
     }
     if (u.flags & FLAG_WIREFRAME) != 0u {

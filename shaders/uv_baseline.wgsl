@@ -20,6 +20,7 @@ struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) uv: vec2<f32>,
     @location(2) normal: vec3<f32>,
+    @location(3) corner_normal: vec3<f32>,
 }
 
 struct VertexOut {
@@ -27,6 +28,8 @@ struct VertexOut {
     @location(0) uv: vec2<f32>,
     @location(1) bary: vec3<f32>,
     @location(2) @interpolate(flat) normal: vec3<f32>,
+    // FLAG_SMOOTH: the file's corner normals, interpolated.
+    @location(3) smooth_normal: vec3<f32>,
 }
 
 @vertex
@@ -37,6 +40,7 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.uv = in.uv;
     out.bary = vec3<f32>(f32(corner == 0u), f32(corner == 1u), f32(corner == 2u));
     out.normal = in.normal;
+    out.smooth_normal = in.corner_normal;
     return out;
 }
 
@@ -49,7 +53,11 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     var rgb = texel.rgb * u.tint.rgb;
     let alpha = texel.a * u.tint.a;
     if (u.flags & FLAG_LIT) != 0u {
-        let n = select(-in.normal, in.normal, front_facing);
+        var n = select(-in.normal, in.normal, front_facing);
+        if (u.flags & FLAG_SMOOTH) != 0u {
+            let s = normalize(in.smooth_normal);
+            n = select(-s, s, front_facing);
+        }
         let ambient = u.light.w;
         let diffuse = max(dot(n, u.light.xyz), 0.0);
         rgb = rgb * (ambient + (1.0 - ambient) * diffuse);

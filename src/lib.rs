@@ -16,7 +16,7 @@
 //! | [`colors`] | the mesh-colors core: [`colors::layout`] (sample counts, classification, MIP offsets, filtering), [`colors::format`] (linear RGBA, sRGB, RGBA8 / 16F / 32F), [`colors::store`] (the map-based store with per-face R and dirty tracking), [`colors::resample`] (exact 2× refine / reduce), [`colors::stats`] (the sample budget `info` prints), [`colors::budget`] (the limits every operation that creates samples checks first: counts, memory, packed format, GPU) |
 //! | [`packing`] | [`packing::linear`] (16-byte face records, colour buffer with MIP chains), [`packing::packer`] (store ⇄ linear, eq. 2.5/2.6), [`packing::paint_layout`] (paint-mode blocks with slack, dirty ranges), [`packing::sampler`] (the CPU reference sampler, the truth the GPU is tested against), [`packing::file`] (the packed file format) |
 //! | [`paint`] | [`paint::picking`] (obvhs BVH, watertight rays), [`paint::brush`] (colour / blur / resolution brushes, tools, replay), [`paint::undo`] (per stroke, memory cap) |
-//! | [`io`] | [`io::document`] (open glTF or packed files into a store; pack for export), [`io::export_gltf`], [`io::bake`] (texture → mesh colors), [`io::autosave`] |
+//! | [`io`] | [`io::document`] (open glTF or packed files into a store; pack for export), [`io::export_gltf`], [`io::bake`] (texture → mesh colors), [`io::autosave`], [`io::subdivide`] (1→4 midpoint split of a scene, budget first) |
 //! | [`atomic_write`] | the one way files are written: temporary file, `sync_all`, rename, directory sync |
 //! | [`camera`] | the orbit camera: matrices, framing, pixel rays (shared by render, picking, replay) |
 //! | [`render`] | **GPU**: wgpu context, packed buffers on the GPU, sampling pipelines, readback |

@@ -51,9 +51,12 @@ fn view_panel_changes_the_render_settings() {
     harness.get_by_label("Unlit").click();
     harness.run_steps(2);
     assert_eq!(harness.state().render_settings().shading, Shading::Unlit);
-    harness.get_by_label("Lit").click();
+    harness.get_by_label("Flat").click();
     harness.run_steps(2);
     assert_eq!(harness.state().view.shading, Shading::Lit);
+    harness.get_by_label("Smooth").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().render_settings().shading, Shading::Smooth);
 }
 
 #[test]
@@ -559,6 +562,9 @@ fn optimize_button_lowers_resolutions_losslessly_and_undoes() {
     let before = store(harness.state());
     harness.get_by_label("Optimize").click();
     harness.run_steps(2);
+    // Optimize plans on a worker thread; its result is applied when the job is noticed.
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "Optimize timed out");
+    harness.run_steps(2);
     let after = store(harness.state());
     let status = format!("{:?}", harness.state().status);
     assert!(after.sample_count() * 2 < before.sample_count(), "{status}");
@@ -653,4 +659,133 @@ fn the_resolution_brush_stops_at_the_budget_with_one_message() {
     let store = &editor.document.as_ref().unwrap().document.store;
     let counts = meshpaint::colors::budget::SampleCounts::of_store(store);
     assert!(counts.estimated_bytes(meshpaint::colors::format::ColorFormat::Rgba8Srgb) <= 11_136_784 + 100_000);
+}
+
+/// Opens `path` with the editor's current import settings and waits for it.
+fn open_and_wait(editor: &mut Editor, path: &Path) {
+    editor.open(Source::File(path.to_owned()));
+    assert!(editor.wait_for_job(JOB_TIMEOUT), "opening {} timed out", path.display());
+    assert!(editor.document.is_some(), "{} did not open: {:?}", path.display(), editor.status);
+}
+
+/// The open dialog's resolution choice reaches the document: "Automatic" keeps R on the
+/// textured Duck and starts an untextured STL at R = 1 with resolution following the brush;
+/// "Error ≤ E" gives the Duck exactly the per-face resolutions of the library's rule.
+#[test]
+fn the_open_dialog_offers_uniform_match_texture_and_error_bound_resolutions() {
+    use meshpaint::app::import_settings::ImportMode;
+    use meshpaint::colors::budget::Budget;
+    use meshpaint::io::adaptive::ResolutionRule;
+    use meshpaint::io::document::Document;
+    let duck = crate_path("assets/models/Duck/Duck.glb");
+    let stl = crate_path("assets/models/AssimpTestModels/sphereWithHole.stl");
+    let mut harness = harness(new_editor());
+    harness.run_steps(2);
+    harness.state_mut().open_dialog(meshpaint::app::file_dialog::DialogPurpose::Open);
+    harness.run_steps(2);
+    // The dialog shows the choice; picking a mode there is what the editor opens with.
+    harness.get_by_label("Mesh resolution:").click();
+    harness.run_steps(2);
+    harness.get_by_label("Error ≤ E").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().import.mode, ImportMode::ErrorBound, "the dialog's choice is the editor's");
+    harness.state_mut().dialog = None;
+
+    let resolutions = |editor: &Editor| editor.document.as_ref().unwrap().document.store.face_resolutions().to_vec();
+    let editor = harness.state_mut();
+    editor.import.error_bound = 0.02;
+    open_and_wait(editor, &duck);
+    let rule = ResolutionRule::ErrorBound { bound: 0.02, max: editor.import.max_resolution };
+    let expected = Document::open_within(&duck, rule, &Budget::from_environment()).unwrap();
+    assert_eq!(resolutions(editor), expected.store.face_resolutions(), "the rule's resolutions, face by face");
+    assert!(resolutions(editor).iter().any(|r| r.get() != resolutions(editor)[0].get()), "not uniform");
+
+    editor.import.mode = ImportMode::Automatic;
+    open_and_wait(editor, &duck);
+    assert!(resolutions(editor).iter().all(|r| r.get() == 8), "the textured Duck keeps R = 8");
+    assert_eq!(editor.brush.follow_resolution, None, "textured: resolution does not follow the brush");
+    open_and_wait(editor, &stl);
+    assert!(resolutions(editor).iter().all(|r| r.get() == 1), "untextured: the lowest R");
+    assert!(editor.brush.follow_resolution.is_some(), "untextured: resolution follows the brush");
+
+    editor.import.mode = ImportMode::Uniform;
+    editor.import.resolution = meshpaint::colors::layout::Resolution::new(4).unwrap();
+    open_and_wait(editor, &stl);
+    assert!(resolutions(editor).iter().all(|r| r.get() == 4), "uniform R is uniform, textured or not");
+
+    editor.import.mode = ImportMode::MatchTexture;
+    open_and_wait(editor, &duck);
+    let rule = ResolutionRule::TexelDensity { max: editor.import.max_resolution };
+    let expected = Document::open_within(&duck, rule, &Budget::from_environment()).unwrap();
+    assert_eq!(resolutions(editor), expected.store.face_resolutions());
+}
+
+/// An editor with a headless GPU (lavapipe) and the built-in Duck.
+fn editor_with_gpu_and_duck() -> Editor {
+    let gpu = meshpaint::render::Gpu::new_headless().expect("GPU tests need an adapter (lavapipe)");
+    let mut editor = Editor::new(Some(Arc::new(gpu)), Arc::new(|| {}));
+    editor.open(Source::BuiltIn);
+    assert!(editor.wait_for_job(JOB_TIMEOUT), "opening the Duck timed out");
+    assert!(editor.document.is_some(), "the Duck did not open: {:?}", editor.status);
+    editor
+}
+
+/// "Show: Source texture" draws the UV-textured source and reports the PSNR of this view
+/// (the Duck at R = 8 looks like its texture: tests/gpu_render.rs measures a mean below 1
+/// step at R = 16); "Position colours" draws a colour field, never the document's colours.
+#[test]
+fn the_view_compares_mesh_colors_with_the_source_texture_and_shows_the_psnr() {
+    use meshpaint::render::DrawItem;
+    let mut harness = harness(editor_with_gpu_and_duck());
+    harness.run_steps(2);
+    assert!(matches!(harness.state().shown_item(), Some(DrawItem::MeshColors(_))));
+    harness.get_by_label("Show:").click();
+    harness.run_steps(2);
+    harness.get_by_label("Source texture").click();
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "building the source texture timed out");
+    harness.run_steps(3);
+    assert!(matches!(harness.state().shown_item(), Some(DrawItem::Baseline(_))), "{:?}", harness.state().status);
+    let psnr = match &harness.state().source_psnr {
+        Some((_, Ok(db))) => *db,
+        other => panic!("no PSNR measured: {other:?}"),
+    };
+    assert!(psnr > 25.0 && psnr.is_finite(), "Duck R = 8 vs its texture: {psnr} dB");
+    harness.get_by_label_contains("PSNR");
+    let colors_before = harness.state().document.as_ref().unwrap().document.store.clone();
+    harness.get_by_label("Show:").click();
+    harness.run_steps(2);
+    harness.get_by_label("Position colours").click();
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "building the position colours timed out");
+    harness.run_steps(2);
+    let editor = harness.state();
+    let open = editor.document.as_ref().unwrap();
+    match (editor.shown_item(), open.gpu_mesh.as_ref()) {
+        (Some(DrawItem::MeshColors(shown)), Some(own)) => assert!(!std::ptr::eq(shown, own), "a separate mesh"),
+        _ => panic!("position colours are not shown"),
+    }
+    let colors_after = &open.document.store;
+    assert_eq!(colors_after.sample_count(), colors_before.sample_count());
+    assert!(
+        (0..colors_after.topology().face_count())
+            .all(|f| colors_after.interior_samples(f) == colors_before.interior_samples(f)),
+        "a view option never changes the document's colours"
+    );
+}
+
+/// A file without a texture cannot be compared: the view says why and keeps the mesh colors.
+#[test]
+fn comparing_an_untextured_mesh_says_why_and_shows_the_mesh_colors() {
+    use meshpaint::render::DrawItem;
+    let mut editor = editor_with_gpu_and_duck();
+    open_and_wait(&mut editor, &crate_path("assets/models/AssimpTestModels/sphereWithHole.stl"));
+    let mut harness = harness(editor);
+    harness.run_steps(2);
+    harness.state_mut().view.shown = meshpaint::app::state::Shown::SourceTexture;
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.run_steps(2);
+    assert!(matches!(harness.state().shown_item(), Some(DrawItem::MeshColors(_))));
+    assert!(harness.get_all_by_label_contains("no base-colour texture").count() >= 1);
 }

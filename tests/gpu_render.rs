@@ -679,7 +679,7 @@ fn mesh_colors_and_the_uv_baseline_look_alike() {
     let mut settings =
         RenderSettings::new(default_camera(BoundingSphere::of_points(&document.positions), 30.0, 20.0, None));
     settings.background = [0.0; 4];
-    for shading in [Shading::Unlit, Shading::Lit] {
+    for shading in [Shading::Unlit, Shading::Lit, Shading::Smooth] {
         settings.shading = shading;
         let ours = gpu.renderer.render_image(&gpu.ctx, DrawItem::MeshColors(&mesh), &settings, SIZE, SIZE).unwrap();
         let theirs = gpu.renderer.render_image(&gpu.ctx, DrawItem::Baseline(&baseline), &settings, SIZE, SIZE).unwrap();

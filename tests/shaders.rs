@@ -131,6 +131,24 @@ fn the_wgsl_flag_bits_match_the_rust_constants() {
     assert_eq!(value("FLAG_LIT"), FrameUniforms::FLAG_LIT);
     assert_eq!(value("FLAG_WIREFRAME"), FrameUniforms::FLAG_WIREFRAME);
     assert_eq!(value("FLAG_HEATMAP"), FrameUniforms::FLAG_HEATMAP);
+    assert_eq!(value("FLAG_SMOOTH"), FrameUniforms::FLAG_SMOOTH);
     let flags: Vec<&str> = module.constants.iter().filter_map(|(_, c)| c.name.as_deref()).collect();
-    assert_eq!(flags.iter().filter(|name| name.starts_with("FLAG_")).count(), 3, "{flags:?}");
+    assert_eq!(flags.iter().filter(|name| name.starts_with("FLAG_")).count(), 4, "{flags:?}");
+}
+
+#[test]
+fn the_smooth_shading_crease_matches_the_rust_constant() {
+    let (module, _) = validate("mesh_colors.wgsl", MESH_COLORS_WGSL);
+    let (_, constant) = module
+        .constants
+        .iter()
+        .find(|(_, constant)| constant.name.as_deref() == Some("SMOOTH_CREASE_COSINE"))
+        .expect("no const SMOOTH_CREASE_COSINE in shaders/mesh_colors.wgsl");
+    match module.global_expressions[constant.init] {
+        naga::Expression::Literal(naga::Literal::F32(value)) => {
+            assert_eq!(value, meshpaint::mesh::normals::SMOOTH_CREASE_COSINE);
+            assert!((value - 45f32.to_radians().cos()).abs() < 1e-6, "the crease is 45°");
+        }
+        ref other => panic!("SMOOTH_CREASE_COSINE is not an f32 literal: {other:?}"),
+    }
 }

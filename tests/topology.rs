@@ -294,8 +294,8 @@ fn welded_area(mesh: &WeldedMesh) -> f64 {
 #[test]
 fn midpoint_subdivision_has_the_closed_form_counts_and_the_same_surface() {
     use meshpaint::colors::budget::{Budget, MemorySource};
-    use meshpaint::mesh::subdivide::subdivide_scene;
-    let (scene, _) = meshpaint::io::document::import_scene(&common::model("Duck/glTF-Binary/Duck.glb")).unwrap();
+    use meshpaint::io::subdivide::subdivide_scene;
+    let (scene, _) = meshpaint::io::document::import_scene(&common::model("Duck/Duck.glb")).unwrap();
     let before = weld_scene(&scene);
     let t0 = Topology::build(before.positions_world.len() as u32, &before.triangles).unwrap();
     let budget = Budget::with_memory(8 << 30, MemorySource::Environment);

@@ -187,7 +187,17 @@ fn a_stroke_on_an_inside_out_mesh_changes_the_samples_it_changes_on_the_outward_
 
 /// The lit render of `mesh` (a grey icosphere, any winding) from a fixed camera.
 fn lit_render(mesh: &Mesh) -> image::RgbaImage {
-    use meshpaint::render::{DrawItem, GpuMesh, MeshUploadOptions, RenderSettings, Shading};
+    shaded_render(mesh, meshpaint::render::Shading::Lit)
+}
+
+/// The camera of [`shaded_render`].
+fn render_camera(mesh: &Mesh) -> OrbitCamera {
+    OrbitCamera::framing(BoundingSphere::of_points(&mesh.0), 30.0, 20.0)
+}
+
+/// `mesh` in uniform grey 0.6 (linear) with `shading`, 128 × 128, from [`render_camera`].
+fn shaded_render(mesh: &Mesh, shading: meshpaint::render::Shading) -> image::RgbaImage {
+    use meshpaint::render::{DrawItem, GpuMesh, MeshUploadOptions, RenderSettings};
     let gpu = common::gpu::shared();
     let (positions, triangles) = mesh;
     let store = ColorStore::uniform(topology(mesh), Resolution::new(2).unwrap(), [0.6, 0.6, 0.6, 1.0]);
@@ -195,9 +205,8 @@ fn lit_render(mesh: &Mesh) -> image::RgbaImage {
         meshpaint::packing::packer::pack(&store, positions, meshpaint::colors::format::ColorFormat::Rgba32F).unwrap();
     let uploaded = GpuMesh::upload(&gpu.ctx, &gpu.renderer, &packed, &MeshUploadOptions::default()).unwrap();
     let _ = triangles;
-    let camera = OrbitCamera::framing(BoundingSphere::of_points(positions), 30.0, 20.0);
-    let mut settings = RenderSettings::new(camera);
-    settings.shading = Shading::Lit;
+    let mut settings = RenderSettings::new(render_camera(mesh));
+    settings.shading = shading;
     settings.background = [0.0; 4];
     gpu.renderer.render_image(&gpu.ctx, DrawItem::MeshColors(&uploaded), &settings, 128, 128).unwrap()
 }
@@ -221,6 +230,71 @@ fn the_lit_view_shades_an_inside_out_mesh_like_the_outward_one() {
             .filter(|(a, b)| a.0.iter().zip(b.0.iter()).any(|(x, y)| x.abs_diff(*y) > 2))
             .count();
         assert!(differing <= 16, "{what}: {differing} pixels differ by more than 2 steps");
+    }
+}
+
+/// Smooth shading, pixel by pixel, against the lighting computed on the CPU: a ray through
+/// each pixel centre finds the face and its barycentrics (perspective-correct, as the GPU
+/// interpolates), each corner takes its vertex normal within 45° of the face normal
+/// (`mesh::normals`), and `grey × (ambient + (1 − ambient) · max(±Σ wₖ n̂ₖ · l, 0))` is
+/// encoded to sRGB. Flat shading differs from it by many steps, so the test can fail.
+#[test]
+fn smooth_shading_matches_the_interpolated_corner_lighting_for_any_winding() {
+    use meshpaint::colors::format::linear_to_srgb;
+    use meshpaint::mesh::normals::{smooth_corner_normal, vertex_normals};
+    use meshpaint::render::{RenderSettings, Shading};
+    let sphere = icosphere(2);
+    for (what, mesh) in [("outward", sphere.clone()), ("inside out", rewound(&sphere, |_| true))] {
+        let (positions, triangles) = &mesh;
+        let camera = render_camera(&mesh);
+        let settings = RenderSettings::new(camera);
+        let light = settings.light_direction();
+        let ambient = f64::from(settings.ambient);
+        let normals = vertex_normals(positions, triangles);
+        let bvh = MeshBvh::build(positions, triangles, BvhPreset::FastBuild);
+        let expected_at = |x: u32, y: u32| -> Option<u8> {
+            let (origin, direction) = camera.ray_through_pixel(f64::from(x) + 0.5, f64::from(y) + 0.5, 128, 128);
+            let hit = bvh.cast(origin, direction, f64::INFINITY)?;
+            let corners = triangles[hit.face as usize];
+            let p = corners.map(|v| DVec3::from_array(positions[v as usize].map(f64::from)));
+            let face_normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize().as_vec3().to_array();
+            let mut d = 0.0;
+            for k in 0..3 {
+                let vertex = normals[corners[k] as usize].map(|x| x as f32);
+                let n = DVec3::from_array(smooth_corner_normal(vertex, face_normal).map(f64::from));
+                d += f64::from(hit.barycentric[k]) * n.dot(light);
+            }
+            let d = if hit.front_facing { d } else { -d };
+            let linear = 0.6 * (ambient + (1.0 - ambient) * d.max(0.0));
+            Some((linear_to_srgb(linear as f32) * 255.0).round() as u8)
+        };
+        for (shading, must_match) in [(Shading::Smooth, true), (Shading::Lit, false)] {
+            let image = shaded_render(&mesh, shading);
+            let (mut compared, mut off) = (0usize, 0usize);
+            let mut worst = 0u8;
+            for (x, y, pixel) in image.enumerate_pixels() {
+                // Silhouette pixels are partly covered: only pixels whose neighbours all hit.
+                let inside = [(0i32, 0i32), (-1, 0), (1, 0), (0, -1), (0, 1)].iter().all(|&(dx, dy)| {
+                    let (nx, ny) = (x as i32 + dx, y as i32 + dy);
+                    (0..128).contains(&nx) && (0..128).contains(&ny) && image.get_pixel(nx as u32, ny as u32)[3] > 0
+                });
+                let Some(expected) = expected_at(x, y).filter(|_| inside) else { continue };
+                compared += 1;
+                let difference = pixel[0].abs_diff(expected);
+                worst = worst.max(difference);
+                off += usize::from(difference > 2);
+            }
+            eprintln!("{what} {shading:?}: {off} of {compared} px differ by more than 2 steps (worst {worst})");
+            assert!(compared > 4000, "{what}: the sphere covers the image ({compared} px)");
+            if must_match {
+                assert!(
+                    off * 200 <= compared,
+                    "{what}: {off} of {compared} px differ by more than 2 steps (worst {worst})"
+                );
+            } else {
+                assert!(off * 10 > compared, "{what}: flat shading should differ from smooth ({off} of {compared} px)");
+            }
+        }
     }
 }
 

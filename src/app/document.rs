@@ -14,12 +14,13 @@ use anyhow::{Context, Result};
 use crate::camera::BoundingSphere;
 use crate::colors::budget::Budget;
 use crate::colors::format::ColorFormat;
-use crate::colors::layout::Resolution;
+use crate::io::adaptive::ResolutionRule;
 use crate::io::document::{Displayed, Document, Source, SourceKind, open_for_display_within};
 use crate::paint::picking::{BvhPreset, MeshBvh};
-use crate::render::{Gpu, GpuMesh};
+use crate::render::{BaselineMesh, Gpu, GpuMesh};
 
 use super::jobs::JobContext;
+use super::state::Shown;
 use super::text::{human_bytes, thousands};
 
 /// A document open in the editor.
@@ -51,6 +52,68 @@ pub struct OpenDocument {
     pub packed_bytes: u64,
     /// How long the last repack (store → linear buffers) took.
     pub last_repack: Duration,
+    /// The other views of the document, built the first time they are shown.
+    pub alternates: AlternateViews,
+}
+
+/// The views of a document besides its mesh colors ([`super::state::Shown`]), each built on
+/// the GPU by a job the first time it is shown; `Err` says why it cannot be shown.
+#[derive(Debug, Default)]
+pub struct AlternateViews {
+    /// The source file drawn with its UVs and base-colour texture.
+    pub source_texture: Option<Result<BaselineMesh, String>>,
+    /// The position colour field (the mesh at its own resolutions).
+    pub position_colors: Option<Result<GpuMesh, String>>,
+}
+
+/// One alternate view, built by [`build_alternate`].
+#[derive(Debug)]
+pub enum AlternateView {
+    /// [`AlternateViews::source_texture`].
+    SourceTexture(Box<Result<BaselineMesh, String>>),
+    /// [`AlternateViews::position_colors`].
+    PositionColors(Box<Result<GpuMesh, String>>),
+}
+
+/// Builds the view `shown` of `document`, opened from `source`, on `gpu` (`None` for
+/// [`Shown::MeshColors`], which the document always has).
+pub fn build_alternate(
+    shown: Shown,
+    source: &Source,
+    document: &Document,
+    budget: &Budget,
+    gpu: &Gpu,
+    job: &JobContext,
+) -> Option<AlternateView> {
+    let name = source.name();
+    match shown {
+        Shown::MeshColors => None,
+        Shown::SourceTexture => {
+            job.progress(0.1, "reading the source file");
+            let built = match crate::io::document::import_source_scene(source, budget) {
+                Ok(Some(scene)) => {
+                    job.progress(0.5, "uploading the UV-textured mesh");
+                    match gpu.upload_baseline(&scene) {
+                        Ok(Some(mesh)) => Ok(mesh),
+                        Ok(None) => Err(format!("{name} has no base-colour texture to compare with")),
+                        Err(error) => Err(format!("{name}: {error}")),
+                    }
+                }
+                Ok(None) => Err(format!("{name} is a packed file: it keeps no source texture")),
+                Err(error) => Err(error.to_string()),
+            };
+            Some(AlternateView::SourceTexture(Box::new(built)))
+        }
+        Shown::PositionColors => {
+            job.progress(0.1, "colouring by position");
+            let store = crate::io::document::position_colored(&document.store, &document.positions);
+            job.progress(0.4, "packing");
+            let built = crate::packing::packer::pack(&store, &document.positions, document.display_format())
+                .map_err(|error| format!("{name}: {error}"))
+                .and_then(|packed| gpu.upload(&packed).map_err(|error| format!("{name}: {error}")));
+            Some(AlternateView::PositionColors(Box::new(built)))
+        }
+    }
 }
 
 impl OpenDocument {
@@ -60,17 +123,17 @@ impl OpenDocument {
     }
 }
 
-/// Opens `source` for display ([`open_for_display_within`] `budget`: glTF at `resolution`, or
-/// packed), uploads it when `gpu` is given and builds the picking BVH.
+/// Opens `source` for display ([`open_for_display_within`] `budget`: a mesh at the face
+/// resolutions of `rule`, or packed), uploads it when `gpu` is given and builds the picking BVH.
 pub fn load(
     source: &Source,
-    resolution: Resolution,
+    rule: ResolutionRule,
     budget: &Budget,
     gpu: Option<&Gpu>,
     job: &JobContext,
 ) -> Result<OpenDocument> {
     let Displayed { document, packed, pack_time } =
-        open_for_display_within(source, resolution, budget, &mut |fraction, stage| job.progress(fraction, stage))?;
+        open_for_display_within(source, rule, budget, &mut |fraction, stage| job.progress(fraction, stage))?;
     let name = source.name();
     let gpu_mesh = match gpu {
         Some(gpu) => {
@@ -102,6 +165,7 @@ pub fn load(
         },
         title: source.title(),
         last_repack: pack_time,
+        alternates: AlternateViews::default(),
     })
 }
 

@@ -16,21 +16,19 @@ use glam::DVec3;
 use crate::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera};
 use crate::colors::format::ColorFormat;
 use crate::colors::layout::Resolution;
-use crate::render::{FilterMode, RenderSettings};
+use crate::render::{DrawItem, FilterMode, RenderSettings};
 
 use crate::io::document::Source;
 use crate::render::Gpu;
 
 use super::autosave::{AutosaveState, Autosaved};
-use super::document::{self, OpenDocument, Written};
+use super::document::{self, AlternateView, OpenDocument, Written};
 use super::file_dialog::{DialogOutcome, DialogPurpose, FileDialog};
+use super::import_settings::ImportSettings;
 use super::jobs::{Finished, JobKind, Jobs, Waker, WriteKind};
 use super::paint_session::{PaintSession, Repacked};
-use super::state::{FrameStats, Mode, Severity, Status, ViewSettings, ViewportInfo};
+use super::state::{FrameStats, Mode, Severity, Shown, Status, ViewSettings, ViewportInfo};
 use super::text::{error_text, thousands};
-
-/// Uniform resolution given to glTF files when they are opened, unless changed in the UI.
-pub const DEFAULT_IMPORT_RESOLUTION: u64 = 8;
 
 /// What a job produced.
 #[derive(Debug)]
@@ -43,6 +41,24 @@ pub enum JobOutput {
     Repacked(Box<Repacked>),
     /// A recovery file was written.
     Autosaved(Autosaved),
+    /// Optimize found its changes (applied if the document did not change meanwhile).
+    Optimized(Box<Optimized>),
+    /// An alternate view was built for the document opened from this path (`None`: built-in).
+    View(Option<PathBuf>, Box<AlternateView>),
+}
+
+/// The view a PSNR was measured in: render settings, 3D view size in pixels, scene generation.
+pub type PsnrKey = (RenderSettings, [u32; 2], u64);
+
+/// What an Optimize job found.
+#[derive(Debug)]
+pub struct Optimized {
+    /// The changes, planned on the store as it was at `generation`.
+    pub plan: crate::paint::optimize::OptimizePlan,
+    /// [`Editor::edit_generation`] when the job started.
+    pub generation: u64,
+    /// The error bound used.
+    pub bound: f32,
 }
 
 /// The editor.
@@ -65,8 +81,8 @@ pub struct Editor {
     pub dialog: Option<FileDialog>,
     /// Whether the shortcut help window is shown.
     pub show_help: bool,
-    /// Resolution given to glTF files opened next.
-    pub import_resolution: Resolution,
+    /// How meshes opened next get their face resolutions (the open dialog's choice).
+    pub import: ImportSettings,
     /// The 3D view's area (set by [`Editor::ui`]).
     pub viewport: ViewportInfo,
     /// The egui texture showing the 3D view (registered by the window shell).
@@ -100,6 +116,9 @@ pub struct Editor {
     pub resolution_for_all: Resolution,
     /// The error bound of "Optimize" (0 = lossless; colour units, 0..1).
     pub optimize_bound: f32,
+    /// The last PSNR of the mesh colors against the source texture, with the view it was
+    /// measured in (render settings, view size, scene generation).
+    pub source_psnr: Option<(PsnrKey, Result<f64, String>)>,
     /// A memory budget that replaces the machine's (tests set a small one; `None`:
     /// [`crate::colors::budget::Budget::from_environment`]).
     pub budget_override: Option<crate::colors::budget::Budget>,
@@ -137,7 +156,7 @@ impl Editor {
             jobs: Jobs::new(waker),
             dialog: None,
             show_help: false,
-            import_resolution: Resolution::new(DEFAULT_IMPORT_RESOLUTION).unwrap_or(Resolution::ONE),
+            import: ImportSettings::default(),
             viewport: ViewportInfo {
                 rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1.0, 1.0)),
                 pixels_per_point: 1.0,
@@ -157,6 +176,7 @@ impl Editor {
             edit_generation: 0,
             resolution_for_all: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
             optimize_bound: 0.0,
+            source_psnr: None,
             budget_override: None,
             autosave: AutosaveState::default(),
             fallback_error: None,
@@ -194,7 +214,7 @@ impl Editor {
     /// Opens `source` on a worker thread; the current document stays until the new one
     /// is ready, and stays for good if opening fails.
     pub fn open(&mut self, source: Source) {
-        let resolution = self.import_resolution;
+        let rule = self.import.rule();
         let budget = self.budget();
         let gpu = self.gpu.clone();
         let name = source.name();
@@ -206,7 +226,7 @@ impl Editor {
         let label = format!("Opening {name}");
         let kind = JobKind::Open { built_in: source == Source::BuiltIn };
         let started = self.jobs.start(kind, label.clone(), move |job| {
-            document::load(&source, resolution, &budget, gpu.as_deref(), job)
+            document::load(&source, rule, &budget, gpu.as_deref(), job)
                 .map(|document| JobOutput::Loaded(Box::new(document)))
                 .map_err(|error| error_text(&error))
         });
@@ -304,6 +324,10 @@ impl Editor {
                 self.gpu_paint_layout = false;
                 self.history.clear();
                 self.history.set_budget(Some((self.budget(), document.format)));
+                // Untextured documents start at the lowest R where nothing is painted, and
+                // resolution follows the brush there; textured ones keep the chosen R.
+                self.brush.follow_resolution =
+                    (!document.document.textured).then_some(crate::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
                 self.autosave.document_opened(&mut document, self.edit_generation);
                 self.document = Some(document);
                 self.scene_generation += 1;
@@ -346,6 +370,8 @@ impl Editor {
             }
             Finished::Done { value: JobOutput::Repacked(repacked), elapsed } => self.finish_repack(*repacked, elapsed),
             Finished::Done { value: JobOutput::Autosaved(autosaved), .. } => self.autosave.finished(&autosaved),
+            Finished::Done { value: JobOutput::Optimized(done), elapsed } => self.finish_optimize(*done, elapsed),
+            Finished::Done { value: JobOutput::View(path, view), .. } => self.finish_view(path, *view),
             Finished::Failed(message) if kind == JobKind::Autosave => {
                 self.autosave.failed();
                 self.set_status(Severity::Warning, format!("Autosave failed: {message}"));
@@ -370,6 +396,29 @@ impl Editor {
                 self.set_status(Severity::Error, format!("{what}: {message}{kept}"));
             }
         }
+    }
+
+    /// Keeps a built alternate view if the document is still the one it was built for.
+    fn finish_view(&mut self, path: Option<PathBuf>, view: AlternateView) {
+        let Some(open) = self.document.as_mut().filter(|open| open.path == path) else {
+            return;
+        };
+        let failed = match view {
+            AlternateView::SourceTexture(built) => {
+                let failed = built.as_ref().as_ref().err().cloned();
+                open.alternates.source_texture = Some(*built);
+                failed
+            }
+            AlternateView::PositionColors(built) => {
+                let failed = built.as_ref().as_ref().err().cloned();
+                open.alternates.position_colors = Some(*built);
+                failed
+            }
+        };
+        if let Some(message) = failed {
+            self.set_status(Severity::Warning, format!("Cannot show it: {message}"));
+        }
+        self.scene_generation += 1;
     }
 
     /// Applies a finished repack (if the document is still the one packed).
@@ -422,7 +471,11 @@ impl Editor {
             DialogPurpose::ExportGltf => format!("{stem}_meshcolors.glb"),
         };
         let format = self.document.as_ref().map_or_else(ColorFormat::default, |d| d.format);
-        self.dialog = Some(FileDialog::new(purpose, self.last_directory.clone(), file_name, format));
+        let mut dialog = FileDialog::new(purpose, self.last_directory.clone(), file_name, format);
+        if purpose == DialogPurpose::Open {
+            dialog.import = Some(self.import);
+        }
+        self.dialog = Some(dialog);
     }
 
     /// Handles the dialog's decision.
@@ -431,7 +484,11 @@ impl Editor {
             return;
         };
         let purpose = dialog.purpose;
-        match dialog.file_dialog_ui(ctx) {
+        let outcome = dialog.file_dialog_ui(ctx);
+        if let Some(import) = dialog.import {
+            self.import = import;
+        }
+        match outcome {
             DialogOutcome::Pending => {}
             DialogOutcome::Cancelled => self.dialog = None,
             DialogOutcome::Chosen(path, format) => {
@@ -499,6 +556,73 @@ impl Editor {
         let (origin, direction) = self.camera.ray_through_pixel(x, y, w, h);
         let hit = open.bvh.cast(origin, direction, f64::INFINITY)?;
         Some(DVec3::from_array(hit.position_world))
+    }
+
+    /// Starts the job that builds what [`ViewSettings::shown`] needs, when it is missing and
+    /// no other job runs (called by the view panel each frame it is shown).
+    pub fn ensure_shown_view(&mut self) {
+        let shown = self.view.shown;
+        let (Some(open), Some(gpu)) = (&self.document, &self.gpu) else {
+            return;
+        };
+        let missing = match shown {
+            Shown::MeshColors => false,
+            Shown::SourceTexture => open.alternates.source_texture.is_none(),
+            Shown::PositionColors => open.alternates.position_colors.is_none(),
+        };
+        if !missing || self.jobs.is_busy() {
+            return;
+        }
+        let source = open.path.clone().map_or(Source::BuiltIn, Source::File);
+        let path = open.path.clone();
+        let document = Arc::clone(&open.document);
+        let (gpu, budget) = (Arc::clone(gpu), self.budget());
+        let started = self.jobs.start(JobKind::View, format!("Preparing {}", shown.name()), move |job| {
+            let view = document::build_alternate(shown, &source, &document, &budget, &gpu, job)
+                .ok_or_else(|| "nothing to build".to_owned())?;
+            Ok(JobOutput::View(path, Box::new(view)))
+        });
+        if let Err(message) = started {
+            self.set_status(Severity::Error, message);
+        }
+    }
+
+    /// What the 3D view draws: the alternate view chosen in [`ViewSettings::shown`] once it is
+    /// built, else the mesh colors.
+    pub fn shown_item(&self) -> Option<DrawItem<'_>> {
+        let open = self.document.as_ref()?;
+        let alternate = match self.view.shown {
+            Shown::MeshColors => None,
+            Shown::SourceTexture => match &open.alternates.source_texture {
+                Some(Ok(mesh)) => Some(DrawItem::Baseline(mesh)),
+                _ => None,
+            },
+            Shown::PositionColors => match &open.alternates.position_colors {
+                Some(Ok(mesh)) => Some(DrawItem::MeshColors(mesh)),
+                _ => None,
+            },
+        };
+        alternate.or_else(|| open.gpu_mesh.as_ref().map(DrawItem::MeshColors))
+    }
+
+    /// PSNR (dB, RGB of covered pixels) of the mesh colors against the source texture as the
+    /// 3D view shows them now, rendered offscreen at the view's aspect (at most 512 px on
+    /// the long side). `None` until the source texture is built.
+    pub fn measure_source_psnr(&self) -> Option<Result<f64, String>> {
+        let open = self.document.as_ref()?;
+        let (Some(gpu), Some(mesh), Some(Ok(baseline))) =
+            (&self.gpu, open.gpu_mesh.as_ref(), open.alternates.source_texture.as_ref())
+        else {
+            return None;
+        };
+        let [w, h] = self.viewport.size_px();
+        let scale = (512.0 / f64::from(w.max(h).max(1))).min(1.0);
+        let (w, h) = (((f64::from(w) * scale) as u32).max(16), ((f64::from(h) * scale) as u32).max(16));
+        let settings = self.render_settings();
+        let render = |item| gpu.render_image(item, &settings, w, h).map_err(|error| error.to_string());
+        Some(render(DrawItem::MeshColors(mesh)).and_then(|ours| {
+            render(DrawItem::Baseline(baseline)).map(|theirs| crate::bench::adaptive::psnr(&ours, &theirs))
+        }))
     }
 
     /// GPU memory in use: the mesh's buffers and atlas plus the view's render targets.

@@ -8,6 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::colors::format::ColorFormat;
 
+use super::import_settings::ImportSettings;
+
 /// What the dialog is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DialogPurpose {
@@ -87,6 +89,8 @@ pub struct FileDialog {
     pub format: ColorFormat,
     /// List every file, not only the purpose's extensions.
     pub show_all: bool,
+    /// The mesh resolution choice, shown when opening (the editor copies it in and back).
+    pub import: Option<ImportSettings>,
     entries: Vec<Entry>,
     listing_error: Option<String>,
     confirm_replace: Option<PathBuf>,
@@ -103,6 +107,7 @@ impl FileDialog {
             file_name,
             format,
             show_all: false,
+            import: None,
             entries: Vec::new(),
             listing_error: None,
             confirm_replace: None,
@@ -213,7 +218,7 @@ impl FileDialog {
             ui.label(egui::RichText::new(self.directory.display().to_string()).monospace());
         });
         ui.separator();
-        let list_height = (ui.available_height() - 90.0).max(80.0);
+        let list_height = (ui.available_height() - if self.import.is_some() { 120.0 } else { 90.0 }).max(80.0);
         let mut navigate_to = None;
         egui::ScrollArea::vertical().max_height(list_height).auto_shrink([false, false]).show(ui, |ui| {
             if let Some(error) = &self.listing_error {
@@ -279,6 +284,9 @@ impl FileDialog {
                 self.refresh();
             }
         });
+        if let Some(import) = self.import.as_mut() {
+            import.ui(ui, "Mesh resolution:");
+        }
         if let Some(path) = &self.confirm_replace {
             ui.colored_label(
                 ui.visuals().warn_fg_color,

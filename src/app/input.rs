@@ -184,8 +184,8 @@ pub fn perform(editor: &mut Editor, action: Action) {
         Action::ToggleHeatmap => editor.view.overlays.heatmap = !editor.view.overlays.heatmap,
         Action::ToggleShading => {
             editor.view.shading = match editor.view.shading {
-                Shading::Lit => Shading::Unlit,
-                Shading::Unlit => Shading::Lit,
+                Shading::Lit | Shading::Smooth => Shading::Unlit,
+                Shading::Unlit => Shading::Smooth,
             }
         }
         Action::CycleFilter => {

@@ -24,6 +24,10 @@ pub enum JobKind {
     Write(WriteKind),
     /// Repacking the store after paint mode.
     Repack,
+    /// Planning Optimize (lower resolutions within a bound) on a snapshot of the store.
+    Optimize,
+    /// Building an alternate view (source texture, position colours) on the GPU.
+    View,
     /// Writing a recovery file.
     Autosave,
 }

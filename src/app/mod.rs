@@ -13,7 +13,7 @@
 //! | 3 | [`panels`], [`paint`], [`autosave_ui`] | the `*_ui` panels; paint-mode commands (strokes, live GPU upload, undo / redo, tool panel); autosave tick and recovery dialog |
 //! | 2 | [`editor`] | the editor: document, camera, view settings, mode, status, jobs (applied by [`jobs::JobKind`]) |
 //! | 1 | [`document`], [`autosave`], [`paint_session`] | the open document (store and GPU mesh side by side; open, save, export work); autosave state; paint-mode state |
-//! | 0 | [`state`], [`jobs`], [`text`], [`file_dialog`] | shared small types and [`Action`]s; one background job at a time with progress; number / error text; an egui file browser |
+//! | 0 | [`state`], [`jobs`], [`text`], [`file_dialog`], [`import_settings`] | shared small types and [`Action`]s; one background job at a time with progress; number / error text; an egui file browser; the open dialog's resolution choice |
 //!
 //! Paint mode is [`Mode::Paint`] (Tab, [`input::SHORTCUTS`]): its tools get the pointer in
 //! [`input::viewport_input`], edit the store through `Arc::make_mut` on
@@ -26,6 +26,7 @@ pub mod autosave_ui;
 pub mod document;
 pub mod editor;
 pub mod file_dialog;
+pub mod import_settings;
 pub mod input;
 pub mod jobs;
 pub mod paint;

@@ -8,7 +8,7 @@
 //! compact layout with MIP chains on a worker thread ([`Editor::leave_paint_mode`]).
 
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use crate::colors::layout::Resolution;
 use crate::colors::store::ColorStore;
@@ -20,7 +20,7 @@ use crate::paint::brush::{
 use crate::paint::optimize;
 use crate::paint::undo::UndoHistory;
 
-use super::editor::{Editor, JobOutput};
+use super::editor::{Editor, JobOutput, Optimized};
 use super::jobs::JobKind;
 use super::paint_session::{Gesture, GestureKind, PaintSession, Repacked, STRENGTH_GESTURE_POINTS};
 use super::state::{Mode, Severity};
@@ -387,10 +387,46 @@ impl Editor {
     }
 
     /// Lowers face resolutions while every shown colour stays within `optimize_bound`
-    /// (`paint::optimize`), as one undo step; reports the memory before and after.
+    /// (`paint::optimize`): plans the changes on a worker thread (the status line shows its
+    /// progress), then applies them as one undo step and reports the memory before and after.
     pub fn optimize_resolutions(&mut self) {
-        let bound = self.optimize_bound;
-        let result = self.with_paint(|_, store, _, history| optimize::optimize(store, history, bound));
+        if self.paint.is_none() {
+            self.set_status(Severity::Info, "Optimize works in paint mode (Tab).");
+            return;
+        }
+        if self.jobs.is_busy() {
+            self.set_status(Severity::Warning, "Busy: wait for the running job to finish before optimizing.");
+            return;
+        }
+        self.end_stroke();
+        let Some(open) = &self.document else {
+            return;
+        };
+        let document = Arc::clone(&open.document);
+        let (bound, generation) = (self.optimize_bound, self.edit_generation);
+        let started = self.jobs.start(JobKind::Optimize, "Optimizing", move |job| {
+            let plan =
+                optimize::plan(&document.store, bound, &|fraction| job.progress(fraction, "trying lower resolutions"))
+                    .map_err(|error| error.to_string())?;
+            Ok(JobOutput::Optimized(Box::new(Optimized { plan, generation, bound })))
+        });
+        match started {
+            Ok(()) => self.set_status(Severity::Info, format!("Optimizing (E = {bound})…")),
+            Err(message) => self.set_status(Severity::Error, message),
+        }
+    }
+
+    /// Applies a finished Optimize plan if the document is still the one planned on.
+    pub(crate) fn finish_optimize(&mut self, optimized: Optimized, elapsed: Duration) {
+        let Optimized { plan, generation, bound } = optimized;
+        if generation != self.edit_generation || self.paint.is_none() {
+            self.set_status(
+                Severity::Warning,
+                "The colours changed while Optimize ran (or paint mode ended); nothing was changed. Run it again.",
+            );
+            return;
+        }
+        let result = self.with_paint(|_, store, _, history| optimize::apply(store, history, &plan));
         match result {
             Some(Ok(report)) => {
                 if report.step.is_some() {
@@ -404,13 +440,14 @@ impl Editor {
                 self.set_status(
                     Severity::Info,
                     format!(
-                        "Optimize (E = {bound}): {} faces lowered, samples {} to {} ({} to {}), largest change {:.2e}",
+                        "Optimize (E = {bound}): {} faces lowered, samples {} to {} ({} to {}), largest change {:.2e} ({:.2} s)",
                         thousands(report.faces_lowered.into()),
                         thousands(report.samples_before),
                         thousands(report.samples_after),
                         bytes(report.samples_before),
                         bytes(report.samples_after),
-                        report.max_error
+                        report.max_error,
+                        elapsed.as_secs_f64()
                     ),
                 );
             }
@@ -712,7 +749,7 @@ fn brush_settings_ui(ui: &mut egui::Ui, brush: &mut BrushSettings, bounds_radius
     let mut follow = brush.follow_resolution.is_some();
     ui.checkbox(&mut follow, "Resolution follows the brush")
         .on_hover_text("Raise the faces under each dab to the R that resolves the brush (spacing at most a quarter of the radius, R up to 64)");
-    brush.follow_resolution = follow.then(|| Resolution::from_log2(6).unwrap_or(Resolution::MAX));
+    brush.follow_resolution = follow.then_some(crate::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
 }
 
 /// A labelled combo box of resolutions 1 … 64.

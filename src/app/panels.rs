@@ -1,12 +1,11 @@
 //! The editor's panels: menu bar, side panel (file, view, scene), status line, help
 //! window and the 3D view's area. [`Editor::ui`] lays out one frame.
 
-use crate::colors::layout::Resolution;
 use crate::render::{FilterMode, RenderSettings, Shading};
 
-use super::editor::Editor;
+use super::editor::{Editor, PsnrKey};
 use super::input::{self, POINTER_HELP, SHORTCUTS, shortcut_text};
-use super::state::{Action, Severity};
+use super::state::{Action, Severity, Shown};
 use super::text::{human_bytes, thousands};
 
 /// Width of the side panel, points.
@@ -129,22 +128,78 @@ impl Editor {
                 input::perform(self, Action::ExportPacked);
             }
         });
+        self.import.ui(ui, "Open meshes at:");
+        self.autosave_settings_ui(ui);
+    }
+
+    /// What the view shows (mesh colors, or for comparison the source texture or position
+    /// colours), what the current choice costs, and what it loses against the source.
+    fn shown_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
-            let label = ui.label("glTF import R:");
-            egui::ComboBox::from_id_salt("import resolution")
-                .selected_text(self.import_resolution.get().to_string())
+            let label = ui.label("Show:");
+            egui::ComboBox::from_id_salt("shown")
+                .selected_text(self.view.shown.name())
                 .show_ui(ui, |ui| {
-                    for log2 in 0..=6 {
-                        if let Ok(r) = Resolution::from_log2(log2) {
-                            ui.selectable_value(&mut self.import_resolution, r, r.get().to_string());
-                        }
+                    for shown in Shown::ALL {
+                        ui.selectable_value(&mut self.view.shown, shown, shown.name());
                     }
                 })
                 .response
                 .labelled_by(label.id)
-                .on_hover_text("Uniform face resolution given to .glb / .gltf files opened next");
+                .on_hover_text(
+                    "Compare the mesh colors with the source file's UV texture, or show a position colour field",
+                );
         });
-        self.autosave_settings_ui(ui);
+        if self.view.shown != Shown::MeshColors {
+            self.ensure_shown_view();
+        }
+        let Some(open) = &self.document else {
+            return;
+        };
+        // The cost of the current choice: what the GPU holds and how long a frame takes.
+        ui.label(
+            egui::RichText::new(format!(
+                "Cost: {} samples, {} on the GPU, {:.1} ms per frame",
+                thousands(open.samples_with_mips),
+                human_bytes(self.gpu_bytes()),
+                self.frame_stats.frame_ms
+            ))
+            .weak(),
+        );
+        let failed = match self.view.shown {
+            Shown::MeshColors => None,
+            Shown::SourceTexture => open.alternates.source_texture.as_ref().and_then(|b| b.as_ref().err()),
+            Shown::PositionColors => open.alternates.position_colors.as_ref().and_then(|b| b.as_ref().err()),
+        };
+        if let Some(message) = failed {
+            ui.colored_label(ui.visuals().warn_fg_color, format!("Showing the mesh colors: {message}"));
+        }
+        if self.view.shown != Shown::SourceTexture {
+            return;
+        }
+        // The loss: PSNR of this view against the source texture, measured again whenever the
+        // view changes and no button is held (not while orbiting).
+        let key: PsnrKey = (self.render_settings(), self.viewport.size_px(), self.scene_generation);
+        let dragging = ui.input(|i| i.pointer.any_down());
+        if !dragging
+            && self.source_psnr.as_ref().is_none_or(|(measured, _)| *measured != key)
+            && let Some(result) = self.measure_source_psnr()
+        {
+            self.source_psnr = Some((key, result));
+        }
+        match &self.source_psnr {
+            Some((_, Ok(db))) => {
+                let text = if db.is_finite() { format!("{db:.1} dB") } else { "identical".to_owned() };
+                ui.label(format!("Mesh colors vs source texture, this view: PSNR {text}"))
+                    .on_hover_text("Both rendered offscreen with the current camera, filter and shading");
+            }
+            Some((_, Err(message))) => {
+                ui.colored_label(ui.visuals().warn_fg_color, format!("PSNR not measured: {message}"));
+            }
+            None => {
+                ui.label(egui::RichText::new("PSNR: preparing the source texture…").weak());
+            }
+        }
     }
 
     /// Filter, shading, overlays and camera.
@@ -181,12 +236,16 @@ impl Editor {
         }
         ui.horizontal(|ui| {
             ui.label("Shading:");
-            ui.radio_value(&mut self.view.shading, Shading::Lit, "Lit");
-            ui.radio_value(&mut self.view.shading, Shading::Unlit, "Unlit");
+            ui.radio_value(&mut self.view.shading, Shading::Smooth, "Smooth")
+                .on_hover_text("Lit with vertex normals (edges sharper than 45° stay sharp)");
+            ui.radio_value(&mut self.view.shading, Shading::Lit, "Flat").on_hover_text("Lit with face normals");
+            ui.radio_value(&mut self.view.shading, Shading::Unlit, "Unlit").on_hover_text("The colours as they are");
         });
-        ui.checkbox(&mut self.view.overlays.wireframe, "Wireframe").on_hover_text("W");
-        ui.checkbox(&mut self.view.overlays.heatmap, "Resolution heat map")
-            .on_hover_text("H — log2 R: dark blue 0, blue, cyan, green, yellow, orange, magenta 12");
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut self.view.overlays.wireframe, "Wireframe").on_hover_text("W");
+            ui.checkbox(&mut self.view.overlays.heatmap, "Resolution heat map")
+                .on_hover_text("H — log2 R: dark blue 0, blue, cyan, green, yellow, orange, magenta 12");
+        });
         ui.horizontal(|ui| {
             if ui.button("Frame all").on_hover_text("Home").clicked() {
                 input::perform(self, Action::FrameAll);
@@ -199,6 +258,7 @@ impl Editor {
                 .weak(),
             );
         });
+        self.shown_ui(ui);
     }
 
     /// Triangles, samples, GPU memory, fps, last repack time.

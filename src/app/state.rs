@@ -48,9 +48,39 @@ pub struct Status {
     pub severity: Severity,
 }
 
+/// What the 3D view shows of the document.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Shown {
+    /// The mesh colors (what is painted and saved).
+    #[default]
+    MeshColors,
+    /// The source file drawn the conventional way, with its UVs and base-colour texture
+    /// (the UV baseline): what the conversion to mesh colors is compared with.
+    SourceTexture,
+    /// A colour field of the position (shows the shape and the sample lattice; a view only,
+    /// never the document's colours).
+    PositionColors,
+}
+
+impl Shown {
+    /// Every choice, in the order the view panel lists them.
+    pub const ALL: [Shown; 3] = [Shown::MeshColors, Shown::SourceTexture, Shown::PositionColors];
+
+    /// The name the view panel shows.
+    pub fn name(self) -> &'static str {
+        match self {
+            Shown::MeshColors => "Mesh colors",
+            Shown::SourceTexture => "Source texture",
+            Shown::PositionColors => "Position colours",
+        }
+    }
+}
+
 /// Everything that decides how the 3D view looks, besides the camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViewSettings {
+    /// What is drawn: the mesh colors, or for comparison the source texture or position colours.
+    pub shown: Shown,
     /// Mesh-colors reconstruction filter.
     pub filter: FilterMode,
     /// Lit or unlit.
@@ -64,8 +94,9 @@ pub struct ViewSettings {
 impl Default for ViewSettings {
     fn default() -> Self {
         ViewSettings {
+            shown: Shown::MeshColors,
             filter: FilterMode::Trilinear,
-            shading: Shading::Lit,
+            shading: Shading::Smooth,
             overlays: Overlays::default(),
             continuous_redraw: false,
         }

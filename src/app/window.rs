@@ -24,7 +24,7 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::window::{Window, WindowId};
 
-use crate::render::{DEPTH_FORMAT, DrawItem, GpuContext, OFFSCREEN_FORMAT, RenderTarget, Renderer};
+use crate::render::{DEPTH_FORMAT, GpuContext, OFFSCREEN_FORMAT, RenderTarget, Renderer};
 
 use super::editor::Editor;
 use crate::io::document::Source;
@@ -143,7 +143,7 @@ struct Running {
     editor: Editor,
     last_logged_viewport: Option<([i32; 2], [u32; 2])>,
     /// What the 3D view's target holds: it is redrawn only when this changes.
-    drawn_view: Option<(crate::render::RenderSettings, [u32; 2], u64)>,
+    drawn_view: Option<(crate::render::RenderSettings, super::state::Shown, [u32; 2], u64)>,
 }
 
 impl Shell {
@@ -339,9 +339,9 @@ impl Running {
             self.drawn_view = None;
         }
         let settings = self.editor.render_settings();
-        let view_key = (settings, self.view.size, self.editor.scene_generation);
-        let mesh = self.editor.document.as_ref().and_then(|d| d.gpu_mesh.as_ref());
-        if let (Some(mesh), Some(gpu)) = (mesh.filter(|_| self.drawn_view != Some(view_key)), &self.gpu) {
+        let view_key = (settings, self.editor.view.shown, self.view.size, self.editor.scene_generation);
+        let item = self.editor.shown_item();
+        if let (Some(item), Some(gpu)) = (item.filter(|_| self.drawn_view != Some(view_key)), &self.gpu) {
             self.drawn_view = Some(view_key);
             let target = RenderTarget {
                 color: &self.view.srgb_view,
@@ -349,7 +349,7 @@ impl Running {
                 width: self.view.size[0],
                 height: self.view.size[1],
             };
-            gpu.renderer.draw(ctx, &mut encoder, &target, DrawItem::MeshColors(mesh), &settings);
+            gpu.renderer.draw(ctx, &mut encoder, &target, item, &settings);
         }
 
         let screen =

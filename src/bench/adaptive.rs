@@ -53,6 +53,7 @@ impl AdaptiveRow {
     pub fn to_json(&self) -> serde_json::Value {
         let (resolution, bound, rule) = match self.rule {
             ResolutionRule::Uniform(r) => (Some(r.get()), None, "uniform"),
+            ResolutionRule::WhereTextured(r) => (Some(r.get()), None, "where-textured"),
             ResolutionRule::TexelDensity { .. } => (None, None, "texel-density"),
             ResolutionRule::ErrorBound { bound, .. } => (None, Some(bound), "error"),
             ResolutionRule::Budget { .. } => (None, None, "budget"),

@@ -34,7 +34,7 @@ pub(super) struct RenderArgs {
     #[command(flatten)]
     resolution: ResolutionArg,
     /// Shading: unlit (the exact colour) or lit (Lambert + ambient).
-    #[arg(long, value_enum, default_value_t = RenderShading::Lit)]
+    #[arg(long, value_enum, default_value_t = RenderShading::Smooth)]
     shading: RenderShading,
     #[command(flatten)]
     camera: CameraArgs,
@@ -65,8 +65,13 @@ enum RenderFilter {
 /// `--shading` values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum RenderShading {
+    /// The colours as they are.
     Unlit,
-    Lit,
+    /// Lit with vertex normals; edges sharper than 45° stay sharp.
+    #[value(alias = "lit")]
+    Smooth,
+    /// Lit with face normals (faceted).
+    Flat,
 }
 
 /// The filter mode `--filter` and `--level` select.
@@ -91,7 +96,8 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
         settings.filter = filter;
         settings.shading = match args.shading {
             RenderShading::Unlit => Shading::Unlit,
-            RenderShading::Lit => Shading::Lit,
+            RenderShading::Smooth => Shading::Smooth,
+            RenderShading::Flat => Shading::Lit,
         };
         settings.overlays = Overlays { wireframe: args.wireframe, heatmap: args.heatmap };
         settings

@@ -80,6 +80,8 @@ pub struct Resolution {
 impl Resolution {
     /// Resolution 1: vertex colours only.
     pub const ONE: Resolution = Resolution { log2: 0 };
+    /// `R = 64`.
+    pub const SIXTY_FOUR: Resolution = Resolution { log2: 6 };
     /// The largest supported resolution.
     pub const MAX: Resolution = Resolution { log2: MAX_LOG2_RESOLUTION as u8 };
 

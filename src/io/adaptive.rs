@@ -43,6 +43,11 @@ use crate::packing::sampler::{Filter, sample};
 pub enum ResolutionRule {
     /// The same `R` on every face.
     Uniform(Resolution),
+    /// `R` on faces whose material has a base-colour texture, `R = 1` (the lowest) on the
+    /// others: what the editor opens a mesh at by default. A face without a texture shows
+    /// one colour, or its vertex colours, which `R = 1` holds exactly; painting raises it
+    /// (resolution follows the brush), so memory grows only where the artist paints.
+    WhereTextured(Resolution),
     /// One sample per texel along each face's longest UV edge, up to `max`.
     TexelDensity {
         /// The largest `R` given.
@@ -76,6 +81,7 @@ impl ResolutionRule {
     pub fn describe(&self) -> String {
         match self {
             ResolutionRule::Uniform(r) => format!("R = {}", r.get()),
+            ResolutionRule::WhereTextured(r) => format!("R = {} where textured, 1 elsewhere", r.get()),
             ResolutionRule::TexelDensity { max } => format!("texel density, R ≤ {}", max.get()),
             ResolutionRule::ErrorBound { bound, max } => format!("error ≤ {bound}, R ≤ {}", max.get()),
             ResolutionRule::Budget { samples, max } => format!("≤ {samples} samples, R ≤ {}", max.get()),
@@ -96,16 +102,28 @@ pub fn face_resolutions(mesh: &WeldedMesh, scene: &Scene, face_count: usize, rul
     if let ResolutionRule::Budget { samples, max } = rule {
         return allocate_budget(mesh, &materials, &shared, &pyramids, samples, max);
     }
+    let material_boundary = if matches!(rule, ResolutionRule::WhereTextured(_)) {
+        faces_on_material_boundaries(mesh, face_count)
+    } else {
+        Vec::new()
+    };
     (0..face_count)
         .into_par_iter()
         .map(|face| {
             let material = &materials[face];
             if material.texture.is_none() {
-                return Resolution::ONE;
+                // Shared vertices hold one colour: a face touching another material keeps
+                // `R` so the blend between the two colours stays within one sample spacing.
+                return match rule {
+                    ResolutionRule::WhereTextured(r) if material_boundary.get(face).copied().unwrap_or(false) => r,
+                    _ => Resolution::ONE,
+                };
             }
             let uvs = mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
             match rule {
-                ResolutionRule::Uniform(r) | ResolutionRule::Budget { max: r, .. } => r,
+                ResolutionRule::Uniform(r)
+                | ResolutionRule::WhereTextured(r)
+                | ResolutionRule::Budget { max: r, .. } => r,
                 ResolutionRule::TexelDensity { max } => power_of_two_at_least(material.longest_uv_edge_texels, max),
                 ResolutionRule::ErrorBound { bound, max } => {
                     let fit = FaceFit::new(&materials, face, shared[face], &pyramids, uvs, max);
@@ -115,6 +133,30 @@ pub fn face_resolutions(mesh: &WeldedMesh, scene: &Scene, face_count: usize, rul
                         .unwrap_or(max)
                 }
             }
+        })
+        .collect()
+}
+
+/// For each face, whether one of its vertices is shared with a face of another material.
+fn faces_on_material_boundaries(mesh: &WeldedMesh, face_count: usize) -> Vec<bool> {
+    const NONE: u32 = u32::MAX;
+    const MIXED: u32 = u32::MAX - 1;
+    let material = |f: usize| mesh.triangle_materials.get(f).copied().flatten().unwrap_or(NONE - 2);
+    let mut vertex_material = vec![NONE; mesh.positions_world.len()];
+    for (f, triangle) in mesh.triangles.iter().enumerate().take(face_count) {
+        for &v in triangle {
+            if let Some(slot) = vertex_material.get_mut(v as usize) {
+                *slot = match *slot {
+                    NONE => material(f),
+                    m if m == material(f) => m,
+                    _ => MIXED,
+                };
+            }
+        }
+    }
+    (0..face_count)
+        .map(|f| {
+            mesh.triangles.get(f).is_some_and(|t| t.iter().any(|&v| vertex_material.get(v as usize) == Some(&MIXED)))
         })
         .collect()
 }

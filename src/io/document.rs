@@ -143,27 +143,28 @@ pub struct Displayed {
     pub pack_time: Duration,
 }
 
-/// Opens `source` for display: glTF at uniform `gltf_resolution` or a packed file, refuses a
+/// Opens `source` for display: a mesh at the face resolutions of `rule` (a [`Resolution`] is
+/// uniform) or a packed file, refuses a
 /// mesh without triangles, and packs it in its display format. `progress(fraction, stage)`
 /// is told each stage. Importer notes are in `document.warnings`.
 pub fn open_for_display(
     source: &Source,
-    gltf_resolution: Resolution,
+    rule: impl Into<ResolutionRule>,
     progress: &mut dyn FnMut(f32, &str),
 ) -> Result<Displayed, DocumentError> {
-    open_for_display_within(source, gltf_resolution, &Budget::from_environment(), progress)
+    open_for_display_within(source, rule, &Budget::from_environment(), progress)
 }
 
 /// [`open_for_display`] within `budget` (the app adds its GPU's limits): every count is
 /// checked before the samples are allocated.
 pub fn open_for_display_within(
     source: &Source,
-    gltf_resolution: Resolution,
+    rule: impl Into<ResolutionRule>,
     budget: &Budget,
     progress: &mut dyn FnMut(f32, &str),
 ) -> Result<Displayed, DocumentError> {
     progress(0.05, "reading and importing");
-    let document = Document::open_source_within(source, gltf_resolution, budget)?;
+    let document = Document::open_source_within(source, rule, budget)?;
     let name = PathBuf::from(source.name());
     if document.store.topology().face_count() == 0 {
         return Err(DocumentError::NoTriangles { path: name });
@@ -199,6 +200,10 @@ pub struct Document {
     pub source: SourceKind,
     /// Importer notes (skipped primitives, ignored features).
     pub warnings: Vec<String>,
+    /// Whether some face's material has a base-colour texture (false for packed files: they
+    /// keep no texture). The editor turns "resolution follows the brush" on for untextured
+    /// documents.
+    pub textured: bool,
 }
 
 /// A smooth, deterministic colour field over the bounding box that shows the shape and the
@@ -326,6 +331,22 @@ pub fn import_scene(path: &Path) -> Result<(Scene, SourceKind), DocumentError> {
     import_scene_within(path, &Budget::from_environment())
 }
 
+/// The scene of `source` (the built-in Duck or a mesh file) within `budget`, as it was
+/// imported before conversion to mesh colors: what the UV-textured view of the editor
+/// draws. `None` for a packed file, which keeps no source scene.
+pub fn import_source_scene(source: &Source, budget: &Budget) -> Result<Option<Scene>, DocumentError> {
+    match source {
+        Source::BuiltIn => Ok(Some(import_gltf_slice_within(BUILT_IN_GLB, None, "Duck.glb", &import_limits(budget))?)),
+        Source::File(path) => {
+            let head = read_head(path)?;
+            if packed_file::looks_like_packed(&head) {
+                return Ok(None);
+            }
+            Ok(Some(import_scene_after(path, &head, budget)?.0))
+        }
+    }
+}
+
 /// [`import_scene`] within `budget` (a glTF file's triangles after instancing, nodes and
 /// texels are checked while it is read).
 pub fn import_scene_within(path: &Path, budget: &Budget) -> Result<(Scene, SourceKind), DocumentError> {
@@ -374,22 +395,22 @@ impl Document {
     }
 
     /// Opens `source`: the built-in scene or a file, as [`Document::open`] does.
-    pub fn open_source(source: &Source, gltf_resolution: Resolution) -> Result<Self, DocumentError> {
-        Self::open_source_within(source, gltf_resolution, &Budget::from_environment())
+    pub fn open_source(source: &Source, rule: impl Into<ResolutionRule>) -> Result<Self, DocumentError> {
+        Self::open_source_within(source, rule, &Budget::from_environment())
     }
 
     /// [`Document::open_source`] within `budget`.
     pub fn open_source_within(
         source: &Source,
-        gltf_resolution: Resolution,
+        rule: impl Into<ResolutionRule>,
         budget: &Budget,
     ) -> Result<Self, DocumentError> {
         match source {
             Source::BuiltIn => {
                 let scene = import_gltf_slice_within(BUILT_IN_GLB, None, "Duck.glb", &import_limits(budget))?;
-                Self::from_scene_within(scene, gltf_resolution, Path::new(BUILT_IN_NAME), budget)
+                Self::from_scene_within(scene, rule, Path::new(BUILT_IN_NAME), budget)
             }
-            Source::File(path) => Self::open_within(path, gltf_resolution, budget),
+            Source::File(path) => Self::open_within(path, rule, budget),
         }
     }
 
@@ -458,7 +479,12 @@ impl Document {
             apply_vertex_colors(&mut store, &welded.vertex_colors, has_base_color);
         }
         store.take_dirty();
+        let textured = welded
+            .triangle_materials
+            .iter()
+            .any(|m| m.and_then(|m| scene.materials.get(m as usize)).is_some_and(|m| m.base_color_texture.is_some()));
         Ok(Document {
+            textured,
             positions: welded.positions_world,
             store,
             degenerate_triangles_dropped: welded.degenerate_triangles_dropped,
@@ -480,6 +506,7 @@ impl Document {
             degenerate_triangles_dropped: 0,
             source: SourceKind::Packed(packed.format),
             warnings: Vec::new(),
+            textured: false,
         })
     }
 

@@ -1,6 +1,7 @@
 //! Documents on disk: open glTF, OBJ, PLY, STL or packed files into a store, export glTF
 //! (tessellated or textured), bake textures into mesh colors (at a per-face resolution chosen by the content, `adaptive`)
-//! and back, autosave and recovery.
+//! and back, autosave and recovery; `subdivide` splits an imported scene's triangles 1→4 (how
+//! the benchmarks reach a million triangles).
 
 pub mod adaptive;
 pub mod autosave;
@@ -10,5 +11,6 @@ pub mod document;
 pub mod export_fit;
 pub mod export_gltf;
 pub mod export_textured;
+pub mod subdivide;
 
 pub use document::{Document, SourceKind};

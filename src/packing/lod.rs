@@ -48,6 +48,7 @@
 use half::f16;
 
 use super::linear::PackedMesh;
+use crate::mesh::normals::{face_cross, unit_or_zero};
 
 /// The smallest `|n · v̂|` the footprint stretch uses: at most 4 levels coarser at grazing
 /// angles. Keep in sync with `LOD_MIN_COSINE` in shaders/mesh_colors.wgsl.
@@ -73,13 +74,13 @@ impl VertexLod {
         let n = packed.positions.len();
         let mut density = vec![0.0f64; n];
         let mut normal = vec![[0.0f64; 3]; n];
-        let point = |v: u32| packed.positions.get(v as usize).map(|p| p.map(f64::from));
         for (corners, record) in packed.indices.iter().zip(&packed.face_records) {
-            let (Some(a), Some(b), Some(c)) = (point(corners[0]), point(corners[1]), point(corners[2])) else {
+            let Some(p) =
+                corners.iter().map(|&v| packed.positions.get(v as usize).copied()).collect::<Option<Vec<_>>>()
+            else {
                 continue;
             };
-            let (e1, e2) = (sub(b, a), sub(c, a));
-            let cross = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+            let cross = face_cross(p[0], p[1], p[2]);
             let twice_area = (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]).sqrt();
             let Some(resolution) = record.resolution() else { continue };
             if !(twice_area.is_finite() && twice_area > 0.0) {
@@ -95,11 +96,9 @@ impl VertexLod {
             }
         }
         let normal_bits = normal
-            .iter()
+            .into_iter()
             .map(|nv| {
-                let length = (nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]).sqrt();
-                let unit = if length.is_finite() && length > 0.0 { nv.map(|x| x / length) } else { [0.0; 3] };
-                let bits = unit.map(|x| f16::from_f64(x).to_bits());
+                let bits = unit_or_zero(nv).map(|x| f16::from_f64(x).to_bits());
                 [bits[0], bits[1], bits[2], 0]
             })
             .collect();
@@ -112,8 +111,4 @@ impl VertexLod {
         let bits = self.normal_bits.get(v)?;
         Some([0, 1, 2].map(|k| f16::from_bits(bits[k]).to_f32()))
     }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }

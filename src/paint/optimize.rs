@@ -26,9 +26,11 @@
 //! colour within float rounding ([`LOSSLESS_TOLERANCE`]). Flat-coloured regions collapse
 //! to `R = 1` (the lifting reduction of a constant is that constant).
 //!
-//! The trials run on a copy of the store; the accepted changes are then replayed on the
-//! store through [`StoreWriter`], the one write path, as one undo step labelled
-//! "optimize".
+//! The trials run on a copy of the store ([`plan`], which the editor runs on a worker
+//! thread); the accepted changes are then replayed on the store through [`StoreWriter`],
+//! the one write path, as one undo step labelled "optimize" ([`apply`]).
+
+use rayon::prelude::*;
 
 use crate::colors::format::Rgba;
 use crate::colors::layout::Resolution;
@@ -58,26 +60,55 @@ pub struct OptimizeReport {
     pub step: Option<StepSummary>,
 }
 
+/// The changes [`plan`] found, to be applied with [`apply`] to the store they were planned on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OptimizePlan {
+    /// Accepted halvings, in the order they were tried (faces may appear more than once).
+    pub changes: Vec<(u32, Resolution)>,
+    /// The largest error of the accepted changes at the test points.
+    pub max_error: f32,
+    /// Rounds over all faces.
+    pub rounds: u32,
+    /// Level-0 samples of the store planned on.
+    pub samples_before: u64,
+}
+
 /// Lowers face resolutions of `store` while the shown colours stay within `bound` of what
-/// they are now (see the module docs), as one undo step in `history`.
+/// they are now (see the module docs), as one undo step in `history`: [`plan`] then [`apply`].
 pub fn optimize(store: &mut ColorStore, history: &mut UndoHistory, bound: f32) -> Result<OptimizeReport, BrushError> {
+    let plan = plan(store, bound, &|_| {})?;
+    apply(store, history, &plan)
+}
+
+/// Finds the changes [`optimize`] makes, on a copy of `store` (which it does not touch), so
+/// it can run on a worker thread while the editor stays responsive. The reference colours
+/// are computed in parallel (rayon); the trials are sequential (each depends on the
+/// previous ones). `progress(fraction)` is told how far the first round is.
+pub fn plan(store: &ColorStore, bound: f32, progress: &(dyn Fn(f32) + Sync)) -> Result<OptimizePlan, BrushError> {
     if !(bound.is_finite() && bound >= 0.0) {
         return Err(BrushError::InvalidSetting(format!("the error bound must be a number ≥ 0, got {bound}")));
     }
     let tolerance = bound.max(LOSSLESS_TOLERANCE);
-    let samples_before = store.sample_count();
-    let original = store.clone();
-    let points: Vec<Vec<[f32; 3]>> = (0..original.topology().face_count()).map(|f| test_points(&original, f)).collect();
-    let reference: Vec<Vec<Rgba>> = (0..original.topology().face_count())
-        .map(|f| points[f as usize].iter().map(|&b| shown(&original, f, b)).collect())
-        .collect();
-    let mut work = original.clone();
-    let mut accepted: Vec<(u32, Resolution)> = Vec::new();
+    let face_count = store.topology().face_count();
+    let (points, reference): (Vec<Vec<[f32; 3]>>, Vec<Vec<Rgba>>) = (0..face_count)
+        .into_par_iter()
+        .map(|f| {
+            let points = test_points(store, f);
+            let reference = points.iter().map(|&b| shown(store, f, b)).collect();
+            (points, reference)
+        })
+        .unzip();
+    progress(0.2);
+    let mut work = store.clone();
+    let mut changes: Vec<(u32, Resolution)> = Vec::new();
     let (mut rounds, mut max_error) = (0, 0.0f32);
     loop {
         rounds += 1;
         let mut changed = false;
-        for face in 0..work.topology().face_count() {
+        for face in 0..face_count {
+            if rounds == 1 && face % 4096 == 0 {
+                progress(0.2 + 0.8 * face as f32 / face_count.max(1) as f32);
+            }
             let Some(r) = work.face_resolution(face) else { continue };
             let Ok(lower) = Resolution::from_log2(r.log2().saturating_sub(1)) else { continue };
             if lower == r {
@@ -90,7 +121,7 @@ pub fn optimize(store: &mut ColorStore, history: &mut UndoHistory, bound: f32) -
                 .map(|g| largest_difference(&work, g, &points[g as usize], &reference[g as usize]))
                 .fold(0.0f32, f32::max);
             if error <= tolerance {
-                accepted.push((face, lower));
+                changes.push((face, lower));
                 max_error = max_error.max(error);
                 changed = true;
             } else {
@@ -101,27 +132,38 @@ pub fn optimize(store: &mut ColorStore, history: &mut UndoHistory, bound: f32) -
             break;
         }
     }
-    let step = if accepted.is_empty() {
+    progress(1.0);
+    Ok(OptimizePlan { changes, max_error, rounds, samples_before: store.sample_count() })
+}
+
+/// Applies `plan` to `store` (the store it was planned on, unchanged since) through
+/// [`StoreWriter`], the one write path, as one undo step labelled "optimize".
+pub fn apply(
+    store: &mut ColorStore,
+    history: &mut UndoHistory,
+    plan: &OptimizePlan,
+) -> Result<OptimizeReport, BrushError> {
+    let step = if plan.changes.is_empty() {
         None
     } else {
         history.begin_step(store, "optimize")?;
         let result = {
             let mut writer = StoreWriter::new(store, history);
-            accepted.iter().try_for_each(|&(face, r)| writer.set_face_resolution(face, r).map(|_| ()))
+            plan.changes.iter().try_for_each(|&(face, r)| writer.set_face_resolution(face, r).map(|_| ()))
         };
         let step = history.end_step();
         result?;
         step
     };
-    let mut lowered: Vec<u32> = accepted.iter().map(|&(face, _)| face).collect();
+    let mut lowered: Vec<u32> = plan.changes.iter().map(|&(face, _)| face).collect();
     lowered.sort_unstable();
     lowered.dedup();
     Ok(OptimizeReport {
         faces_lowered: lowered.len() as u32,
-        samples_before,
+        samples_before: plan.samples_before,
         samples_after: store.sample_count(),
-        max_error,
-        rounds,
+        max_error: plan.max_error,
+        rounds: plan.rounds,
         step,
     })
 }

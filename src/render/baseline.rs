@@ -15,7 +15,7 @@ use crate::mesh::scene::Texture;
 
 /// One vertex of the baseline's vertex buffer (three per face: faces keep their own UVs).
 ///
-/// Keep in sync with `struct VertexIn` in shaders/uv_baseline.wgsl (32 bytes).
+/// Keep in sync with `struct VertexIn` in shaders/uv_baseline.wgsl (44 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
 pub struct BaselineVertex {
@@ -25,16 +25,19 @@ pub struct BaselineVertex {
     pub uv: [f32; 2],
     /// Unit face normal (counter-clockwise front; +Z for a degenerate face).
     pub normal: [f32; 3],
+    /// The corner's normal for smooth shading ([`crate::mesh::normals::smooth_corner_normal`]
+    /// of the area-weighted vertex normal, as the mesh-colors shader does).
+    pub corner_normal: [f32; 3],
 }
 
-const _: () = assert!(std::mem::size_of::<BaselineVertex>() == 32);
+const _: () = assert!(std::mem::size_of::<BaselineVertex>() == 44);
 
 impl BaselineVertex {
-    /// The vertex buffer layout: locations 0 (position), 1 (uv), 2 (normal).
+    /// The vertex buffer layout: locations 0 (position), 1 (uv), 2 (normal), 3 (corner normal).
     pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<BaselineVertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x2, 2 => Float32x3],
+        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x2, 2 => Float32x3, 3 => Float32x3],
     };
 }
 
@@ -142,13 +145,20 @@ impl BaselineMesh {
             })?;
             Ok((DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - origin).as_vec3())
         };
+        let vertex_normals = crate::mesh::normals::vertex_normals(positions, triangles);
         let mut vertices = Vec::with_capacity(vertex_total);
         for (corners, uvs) in triangles.iter().zip(corner_uvs) {
             let p = [relative(corners[0])?, relative(corners[1])?, relative(corners[2])?];
             let n = (p[1] - p[0]).cross(p[2] - p[0]);
             let normal = if n.length() > 0.0 && n.length().is_finite() { n.normalize() } else { Vec3::Z };
             for k in 0..3 {
-                vertices.push(BaselineVertex { position: p[k].to_array(), uv: uvs[k], normal: normal.to_array() });
+                let vertex_normal = vertex_normals.get(corners[k] as usize).map_or([0.0; 3], |n| n.map(|x| x as f32));
+                vertices.push(BaselineVertex {
+                    position: p[k].to_array(),
+                    uv: uvs[k],
+                    normal: normal.to_array(),
+                    corner_normal: crate::mesh::normals::smooth_corner_normal(vertex_normal, normal.to_array()),
+                });
             }
         }
         let bytes = (vertices.len() * std::mem::size_of::<BaselineVertex>()) as u64;

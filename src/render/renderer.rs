@@ -57,9 +57,14 @@ impl FilterMode {
 pub enum Shading {
     /// The exact filtered colour (linear), encoded by the sRGB target.
     Unlit,
-    /// Lambert + ambient with the face normal (two-sided), light from above-left of the eye.
+    /// Lambert + ambient with the face normal (two-sided, flat), light from above-left of
+    /// the eye.
     #[default]
     Lit,
+    /// Lambert + ambient with smooth normals (two-sided): each corner takes its vertex's
+    /// area-weighted normal within 45° of the face normal ([`crate::mesh::normals`]), the
+    /// lighting is interpolated over the face (Gouraud). The editor's default.
+    Smooth,
 }
 
 /// Diagnostic overlays.
@@ -372,8 +377,10 @@ impl Renderer {
             (2.0 * (settings.camera.fov_y_degrees.to_radians() * 0.5).tan() / f64::from(height.max(1))) as f32;
         let (filter_kind, level_mode, level) = settings.filter.uniform_fields();
         let mut flags = 0;
-        if settings.shading == Shading::Lit {
-            flags |= FrameUniforms::FLAG_LIT;
+        match settings.shading {
+            Shading::Unlit => {}
+            Shading::Lit => flags |= FrameUniforms::FLAG_LIT,
+            Shading::Smooth => flags |= FrameUniforms::FLAG_LIT | FrameUniforms::FLAG_SMOOTH,
         }
         if settings.overlays.wireframe {
             flags |= FrameUniforms::FLAG_WIREFRAME;

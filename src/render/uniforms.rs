@@ -66,4 +66,6 @@ impl FrameUniforms {
     pub const FLAG_WIREFRAME: u32 = 2;
     /// Per-face resolution heat map instead of the painted colour.
     pub const FLAG_HEATMAP: u32 = 4;
+    /// With [`FrameUniforms::FLAG_LIT`]: smooth normals (crate::mesh::normals) instead of the face normal.
+    pub const FLAG_SMOOTH: u32 = 8;
 }

@@ -118,5 +118,8 @@ pub use footprint::{OCCLUSION_TOLERANCE, visible};
 pub use kernels::DabStats;
 pub use painter::{Dab, MAX_DABS_PER_SEGMENT, MIN_SPACING_PX, PaintView, Painter, StrokeUpdate};
 pub use replay::{parse_hex_color, parse_stroke, replay_stroke, samples_within};
-pub use settings::{BlendMode, BrushRadius, BrushSettings, Falloff, ResolutionOp, Tool, resolution_for_brush};
+pub use settings::{
+    BlendMode, BrushRadius, BrushSettings, FOLLOW_BRUSH_MAX_RESOLUTION, Falloff, ResolutionOp, Tool,
+    resolution_for_brush,
+};
 pub use tools::{FillScope, connected_faces, eyedropper, fill, set_resolution};

@@ -180,6 +180,9 @@ pub enum Tool {
     Resolution(ResolutionOp),
 }
 
+/// The largest `R` resolution-follows-the-brush raises a face to (the editor's setting).
+pub const FOLLOW_BRUSH_MAX_RESOLUTION: Resolution = Resolution::SIXTY_FOUR;
+
 /// Brush settings. A stroke uses the settings it began with.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BrushSettings {

@@ -14,8 +14,8 @@
 
 use std::collections::HashMap;
 
-use super::scene::{Scene, SourceMesh};
 use crate::colors::budget::{Budget, BudgetError};
+use crate::mesh::scene::{Scene, SourceMesh};
 
 /// Splits every triangle of `scene` into four, `levels` times, after checking that the
 /// resulting triangle count fits `budget` (nothing is allocated past it).

@@ -1,0 +1,133 @@
+//! How the editor gives an opened mesh its face resolutions: the choice in the open dialog
+//! (and the file panel), turned into one [`ResolutionRule`] of [`crate::io::adaptive`].
+
+use crate::colors::layout::Resolution;
+use crate::io::adaptive::ResolutionRule;
+
+/// The kinds of choice the open dialog offers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImportMode {
+    /// `R` where textured, the lowest `R` elsewhere (the default; painting raises it).
+    Automatic,
+    /// The same `R` on every face.
+    Uniform,
+    /// One sample per texel along each face's longest UV edge (texel density).
+    MatchTexture,
+    /// The lowest `R` per face whose reconstruction stays within `E` of the texture.
+    ErrorBound,
+}
+
+impl ImportMode {
+    /// Every mode, in the order the dialog lists them.
+    pub const ALL: [ImportMode; 4] =
+        [ImportMode::Automatic, ImportMode::Uniform, ImportMode::MatchTexture, ImportMode::ErrorBound];
+
+    /// The name the dialog shows.
+    pub fn name(self) -> &'static str {
+        match self {
+            ImportMode::Automatic => "Automatic",
+            ImportMode::Uniform => "Uniform R",
+            ImportMode::MatchTexture => "Match texture",
+            ImportMode::ErrorBound => "Error ≤ E",
+        }
+    }
+
+    /// What the mode does, for the hover text.
+    pub fn explanation(self) -> &'static str {
+        match self {
+            ImportMode::Automatic => {
+                "R on textured faces, R = 1 on the others (a flat colour or vertex colours need no more; \
+                 resolution follows the brush where you paint)"
+            }
+            ImportMode::Uniform => "The same R on every face",
+            ImportMode::MatchTexture => "One sample per texel along each face's longest UV edge, up to the largest R",
+            ImportMode::ErrorBound => {
+                "The lowest R per face whose linear reconstruction stays within E of the texture \
+                 (RMS of sRGB-encoded differences, 0..1), up to the largest R"
+            }
+        }
+    }
+}
+
+/// The open dialog's resolution choice.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImportSettings {
+    /// Which rule.
+    pub mode: ImportMode,
+    /// `R` of [`ImportMode::Automatic`] and [`ImportMode::Uniform`].
+    pub resolution: Resolution,
+    /// `E` of [`ImportMode::ErrorBound`] (colour units, full range = 1).
+    pub error_bound: f32,
+    /// The largest `R` of the content-driven modes.
+    pub max_resolution: Resolution,
+}
+
+impl Default for ImportSettings {
+    fn default() -> Self {
+        ImportSettings {
+            mode: ImportMode::Automatic,
+            resolution: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
+            error_bound: 0.01,
+            max_resolution: Resolution::from_log2(6).unwrap_or(Resolution::ONE),
+        }
+    }
+}
+
+impl ImportSettings {
+    /// The rule opening applies.
+    pub fn rule(&self) -> ResolutionRule {
+        match self.mode {
+            ImportMode::Automatic => ResolutionRule::WhereTextured(self.resolution),
+            ImportMode::Uniform => ResolutionRule::Uniform(self.resolution),
+            ImportMode::MatchTexture => ResolutionRule::TexelDensity { max: self.max_resolution },
+            ImportMode::ErrorBound => {
+                ResolutionRule::ErrorBound { bound: self.error_bound.max(0.0), max: self.max_resolution }
+            }
+        }
+    }
+
+    /// The mode combo and its parameters, one row, after `label`.
+    pub fn ui(&mut self, ui: &mut egui::Ui, label: &str) {
+        ui.horizontal_wrapped(|ui| {
+            let label = ui.label(label);
+            egui::ComboBox::from_id_salt("import mode")
+                .selected_text(self.mode.name())
+                .show_ui(ui, |ui| {
+                    for mode in ImportMode::ALL {
+                        ui.selectable_value(&mut self.mode, mode, mode.name()).on_hover_text(mode.explanation());
+                    }
+                })
+                .response
+                .labelled_by(label.id)
+                .on_hover_text(self.mode.explanation());
+            match self.mode {
+                ImportMode::Automatic | ImportMode::Uniform => {
+                    resolution_combo(ui, "R", "import R", &mut self.resolution)
+                }
+                ImportMode::MatchTexture => resolution_combo(ui, "R ≤", "import max R", &mut self.max_resolution),
+                ImportMode::ErrorBound => {
+                    let label = ui.label("E");
+                    ui.add(egui::DragValue::new(&mut self.error_bound).range(0.0..=1.0).speed(0.001).max_decimals(4))
+                        .labelled_by(label.id);
+                    resolution_combo(ui, "R ≤", "import max R", &mut self.max_resolution);
+                }
+            }
+        });
+    }
+}
+
+/// A labelled combo of `R` = 1 … 64.
+fn resolution_combo(ui: &mut egui::Ui, label: &str, salt: &str, resolution: &mut Resolution) {
+    let label = ui.label(label);
+    egui::ComboBox::from_id_salt(salt)
+        .selected_text(resolution.get().to_string())
+        .show_ui(ui, |ui| {
+            for log2 in 0..=6 {
+                if let Ok(r) = Resolution::from_log2(log2) {
+                    ui.selectable_value(resolution, r, r.get().to_string());
+                }
+            }
+        })
+        .response
+        .labelled_by(label.id);
+}
