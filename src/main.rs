@@ -8,6 +8,7 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
+    restore_default_sigpipe();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let args = cli::Cli::parse();
     match cli::run(args) {
@@ -19,3 +20,17 @@ fn main() -> ExitCode {
         }
     }
 }
+
+/// `meshpaint info FILE | head` ends quietly when `head` stops reading, as Unix tools do:
+/// Rust ignores SIGPIPE, so `println!` would panic on the closed pipe instead.
+#[cfg(unix)]
+fn restore_default_sigpipe() {
+    // SAFETY: called first in `main`, before any other thread exists; SIG_DFL is a valid
+    // disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+#[cfg(not(unix))]
+fn restore_default_sigpipe() {}

@@ -506,3 +506,19 @@ fn truncated_packed_file_is_refused() {
         }
     }
 }
+
+/// `meshpaint info FILE | head` must end quietly when the reader goes away: the read end
+/// of the pipe is closed before `info` prints, so every write meets a closed pipe.
+#[test]
+fn a_closed_stdout_pipe_ends_the_command_without_a_panic() {
+    let mut child = Command::new(BIN)
+        .args(["info", model("Duck/Duck.glb").to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let output = child.wait_with_output().unwrap();
+    let stderr = text(&output.stderr);
+    assert!(!stderr.contains("panicked") && !stderr.contains("Broken pipe"), "{:?}: {stderr}", output.status);
+}
