@@ -241,3 +241,22 @@ fn the_command_line_writes_glb_and_png_and_reports_faces_without_uvs() {
     assert!(ok, "{stderr}");
     assert!(stderr.contains("285 of 285 faces have no UVs"), "{stderr}");
 }
+
+/// UV-island texels against counts made by hand: a texel counts when its centre is in a
+/// face's UV triangle, once however many faces cover it, wherever the UVs repeat.
+#[test]
+fn uv_island_texels_count_covered_texel_centres_once() {
+    use meshpaint::io::bake_uv::uv_island_texels;
+    let square = [[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]], [[0.0, 0.0], [1.0, 1.0], [0.0, 1.0]]];
+    assert_eq!(uv_island_texels(&square, [8, 4]), 32, "the whole texture");
+    // The lower-left half u + v ≤ 1 of an 8 × 8 texture: centres (i + ½, j + ½) / 8 with
+    // i + j + 1 ≤ 8, i.e. i + j ≤ 7: 36 texels.
+    let half = [[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]];
+    assert_eq!(uv_island_texels(&half, [8, 8]), 36);
+    // Mirrored (the same triangle wound the other way) and stacked islands count once; UVs
+    // shifted by whole repeats cover the same texels.
+    let mirrored = [half[0], [[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]], [[3.0, -2.0], [4.0, -2.0], [3.0, -1.0]]];
+    assert_eq!(uv_island_texels(&mirrored, [8, 8]), 36);
+    // A face with no UV area covers nothing.
+    assert_eq!(uv_island_texels(&[[[0.5, 0.5]; 3]], [8, 8]), 0);
+}

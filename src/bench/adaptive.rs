@@ -199,3 +199,62 @@ pub fn psnr(a: &RgbaImage, b: &RgbaImage) -> f64 {
     }
     10.0 * (255.0f64 * 255.0 / (sum / count as f64)).log10()
 }
+
+/// Texels the UV islands of `scene` cover in their base-colour textures (per texture, UVs
+/// wrapped; texels several faces cover count once), summed over the textures.
+pub fn uv_island_texels(scene: &Scene) -> u64 {
+    let welded = crate::mesh::weld::weld_scene(scene);
+    let texture_of = |material: &Option<u32>| {
+        material.and_then(|m| scene.materials.get(m as usize)).and_then(|m| m.base_color_texture)
+    };
+    scene
+        .textures
+        .iter()
+        .enumerate()
+        .map(|(index, texture)| {
+            let faces = welded
+                .corner_uvs
+                .iter()
+                .zip(&welded.triangle_materials)
+                .filter(|(_, material)| texture_of(material) == Some(index as u32))
+                .map(|(uvs, _)| uvs);
+            crate::io::bake_uv::uv_island_texels(faces, [texture.width, texture.height])
+        })
+        .sum()
+}
+
+/// The goals of the adaptive-resolution issue, checked on `rows`: the fewest samples of any
+/// rule at ≥ 38 dB (mean over the views) against `uv_island_texels`, and for each uniform
+/// R the fewest samples of a content-driven rule reaching its PSNR (`ratio` = uniform
+/// samples / those; the goal is ≥ 3).
+pub fn summary(rows: &[AdaptiveRow], uv_island_texels: u64) -> serde_json::Value {
+    let mean = |row: &AdaptiveRow| row.psnr_db.iter().sum::<f64>() / row.psnr_db.len().max(1) as f64;
+    let fewest_at = |db: f64, adaptive_only: bool| {
+        rows.iter()
+            .filter(|row| mean(row) >= db && !(adaptive_only && matches!(row.rule, ResolutionRule::Uniform(_))))
+            .min_by_key(|row| row.samples)
+    };
+    let at_38 = fewest_at(38.0, false);
+    let uniform: Vec<serde_json::Value> = rows
+        .iter()
+        .filter(|row| matches!(row.rule, ResolutionRule::Uniform(_)))
+        .map(|row| {
+            let best = fewest_at(mean(row), true);
+            serde_json::json!({
+                "uniform": row.rule.describe(),
+                "uniform_samples": row.samples,
+                "psnr_db": mean(row),
+                "adaptive": best.map(|b| b.rule.describe()),
+                "adaptive_samples": best.map(|b| b.samples),
+                "ratio": best.map(|b| row.samples as f64 / b.samples.max(1) as f64),
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "uv_island_texels": uv_island_texels,
+        "fewest_samples_at_38_db": at_38.map(|row| row.samples),
+        "rule_at_38_db": at_38.map(|row| row.rule.describe()),
+        "goal_38_db_within_texels": at_38.is_some_and(|row| row.samples <= uv_island_texels),
+        "same_psnr_fewer_samples": uniform,
+    })
+}

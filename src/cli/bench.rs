@@ -79,12 +79,17 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             let scene = meshpaint::mesh::import::import_gltf(&file)?;
             let rules = meshpaint::bench::adaptive::default_rules(max);
             let rows = meshpaint::bench::adaptive::bench_adaptive(&file, &scene, &rules, Some(max), size, views)?;
-            for row in rows {
+            for row in &rows {
                 let mut value = row.to_json();
                 value["bench"] = "adaptive".into();
                 value["file"] = file.display().to_string().into();
                 println!("{value}");
             }
+            let texels = meshpaint::bench::adaptive::uv_island_texels(&scene);
+            let mut summary = meshpaint::bench::adaptive::summary(&rows, texels);
+            summary["bench"] = "adaptive-summary".into();
+            summary["file"] = file.display().to_string().into();
+            println!("{summary}");
             Ok(())
         }
         BenchCommand::Pack { file, resolution, format, runs } => {

@@ -125,12 +125,24 @@ struct Target<'a> {
     overlaps: &'a mut Overlaps,
 }
 
-/// Writes the texels of `face`'s UV triangle; false when it has no area.
-fn rasterise_face(store: &ColorStore, face: u32, uvs: &[[f32; 2]; 3], target: Target<'_>) -> bool {
-    let Target { size, rgba, covered, overlaps } = target;
-    let n = f64::from(size);
+/// Texels of a `width × height` texture whose centre lies in some face's UV triangle (UVs
+/// wrapped, as glTF's default REPEAT sampler reads them; texels several faces cover count
+/// once): the texels a model's UV islands hold.
+pub fn uv_island_texels<'a>(corner_uvs: impl IntoIterator<Item = &'a [[f32; 2]; 3]>, [width, height]: [u32; 2]) -> u64 {
+    let mut covered = vec![false; width as usize * height as usize];
+    for uvs in corner_uvs {
+        for_each_texel(uvs, [width, height], |texel, _| covered[texel] = true);
+    }
+    covered.iter().filter(|&&c| c).count() as u64
+}
+
+/// Calls `visit(texel, barycentric)` for each texel of a `width × height` texture whose
+/// centre lies in the UV triangle `uvs` (texel index wrapped into the texture); false when
+/// it has no area.
+fn for_each_texel(uvs: &[[f32; 2]; 3], [width, height]: [u32; 2], mut visit: impl FnMut(usize, [f64; 3])) -> bool {
+    let (nx, ny) = (f64::from(width), f64::from(height));
     // Corners in texel units (texel centres at k + ½).
-    let p = uvs.map(|uv| [f64::from(uv[0]) * n, f64::from(uv[1]) * n]);
+    let p = uvs.map(|uv| [f64::from(uv[0]) * nx, f64::from(uv[1]) * ny]);
     if !p.iter().flatten().all(|x| x.is_finite()) {
         return false;
     }
@@ -144,8 +156,8 @@ fn rasterise_face(store: &ColorStore, face: u32, uvs: &[[f32; 2]; 3], target: Ta
     // repetition around its first corner (such UVs would overlap themselves anyway).
     let (x0, x1) = ((min(0) - 0.5).ceil() as i64, (max(0) - 0.5).floor() as i64);
     let (y0, y1) = ((min(1) - 0.5).ceil() as i64, (max(1) - 0.5).floor() as i64);
-    let span = i64::from(size);
-    let (x1, y1) = (x1.min(x0 + span - 1), y1.min(y0 + span - 1));
+    let (span_x, span_y) = (i64::from(width), i64::from(height));
+    let (x1, y1) = (x1.min(x0 + span_x - 1), y1.min(y0 + span_y - 1));
     for y in y0..=y1 {
         for x in x0..=x1 {
             let c = [x as f64 + 0.5, y as f64 + 0.5];
@@ -157,25 +169,32 @@ fn rasterise_face(store: &ColorStore, face: u32, uvs: &[[f32; 2]; 3], target: Ta
             if w0 < EPS || w1 < EPS || w2 < EPS {
                 continue;
             }
-            let bary = [w0 as f32, w1 as f32, w2 as f32];
-            let Some(color) = sampler::sample(store, face, bary, Filter::Linear, 0) else {
-                continue;
-            };
-            let texel = (y.rem_euclid(span) * span + x.rem_euclid(span)) as usize;
-            let encoded = encode_rgba8_srgb(color);
-            // Strictly inside this face and already written: another face's UVs overlap.
-            if covered[texel] && w0.min(w1).min(w2) > 1e-6 {
-                overlaps.texels += 1;
-                let old = &rgba[texel * 4..texel * 4 + 4];
-                if old.iter().zip(encoded).any(|(a, b)| a.abs_diff(b) > 32) {
-                    overlaps.conflicts += 1;
-                }
-            }
-            rgba[texel * 4..texel * 4 + 4].copy_from_slice(&encoded);
-            covered[texel] = true;
+            visit((y.rem_euclid(span_y) * span_x + x.rem_euclid(span_x)) as usize, [w0, w1, w2]);
         }
     }
     true
+}
+
+/// Writes the texels of `face`'s UV triangle; false when it has no area.
+fn rasterise_face(store: &ColorStore, face: u32, uvs: &[[f32; 2]; 3], target: Target<'_>) -> bool {
+    let Target { size, rgba, covered, overlaps } = target;
+    for_each_texel(uvs, [size, size], |texel, [w0, w1, w2]| {
+        let bary = [w0 as f32, w1 as f32, w2 as f32];
+        let Some(color) = sampler::sample(store, face, bary, Filter::Linear, 0) else {
+            return;
+        };
+        let encoded = encode_rgba8_srgb(color);
+        // Strictly inside this face and already written: another face's UVs overlap.
+        if covered[texel] && w0.min(w1).min(w2) > 1e-6 {
+            overlaps.texels += 1;
+            let old = &rgba[texel * 4..texel * 4 + 4];
+            if old.iter().zip(encoded).any(|(a, b)| a.abs_diff(b) > 32) {
+                overlaps.conflicts += 1;
+            }
+        }
+        rgba[texel * 4..texel * 4 + 4].copy_from_slice(&encoded);
+        covered[texel] = true;
+    })
 }
 
 /// `passes` of 8-neighbour dilation in linear light, then the islands' mean everywhere else.
