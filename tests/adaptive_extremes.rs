@@ -153,9 +153,9 @@ fn a_one_texel_texture_gives_r1_everywhere_with_zero_error() {
     let texel = [200u8, 100, 50, 255];
     let scene = scene_of(&quad_and_triangle([[0.1, 0.1], [0.9, 0.2], [0.4, 0.8]]), texture_from(1, 1, |_, _| texel));
     let want = [0, 1, 2, 3].map(|c| if c < 3 { srgb_to_linear(f32::from(texel[c]) / 255.0) } else { 1.0 });
-    let mut rules = content_rules(64);
-    rules.push(ResolutionRule::TexelDensity { max: r(64) });
-    for rule in rules {
+    // (Texel density is a closed form of the UV edge length, not of the content: 1.1 texels
+    // give R = 2 by its definition, so it is not among these rules.)
+    for rule in content_rules(64) {
         let document = convert(&scene, rule);
         let resolutions: Vec<u32> = document.store.face_resolutions().iter().map(|x| x.get()).collect();
         assert!(resolutions.iter().all(|&x| x == 1), "{rule:?}: {resolutions:?}");
@@ -252,7 +252,9 @@ fn a_texture_of_8192_squared_converts_within_the_budget() {
     let scene = scene_of(&quad_and_triangle([[0.1, 0.1], [0.9, 0.2], [0.4, 0.8]]), texture);
     let budget = Budget::from_environment();
     eprintln!("texture 8192² = {} texels; memory budget {} bytes", 8192u64 * 8192, budget.memory_bytes);
-    for rule in [ResolutionRule::TexelDensity { max: r(64) }, ResolutionRule::ErrorBound { bound: 0.05, max: r(64) }] {
+    // One rule: a conversion at this size takes ~100 s in a debug build (the texture's
+    // pyramid); texel density at this size is the closed form of the Box test.
+    for rule in [ResolutionRule::ErrorBound { bound: 0.05, max: r(64) }] {
         let start = std::time::Instant::now();
         let document = convert(&scene, rule);
         let resolutions: Vec<u32> = document.store.face_resolutions().iter().map(|x| x.get()).collect();
@@ -262,12 +264,8 @@ fn a_texture_of_8192_squared_converts_within_the_budget() {
             start.elapsed().as_secs_f64(),
             peak_rss_kb()
         );
-        match rule {
-            // The longest UV edge spans thousands of texels: the cap.
-            ResolutionRule::TexelDensity { .. } => assert!(resolutions.iter().all(|&x| x == 64)),
-            // One texel in 4096 differs (by 0.5 %): RMS far below 0.05, so R = 1 suffices.
-            _ => assert!(resolutions.iter().all(|&x| x == 1), "{resolutions:?}"),
-        }
+        // One texel in 4096 differs (by 0.5 %): RMS far below 0.05, so R = 1 suffices.
+        assert!(resolutions.iter().all(|&x| x == 1), "{resolutions:?}");
     }
 }
 
@@ -282,8 +280,11 @@ fn peak_rss_kb() -> u64 {
 
 #[test]
 fn sliver_faces_meet_the_bound_at_random_points() {
-    // Stripes along u, 8 texels wide, on a 256² texture.
-    let texture = texture_from(256, 256, |x, _| if (x / 8) % 2 == 0 { [230, 40, 40, 255] } else { [30, 30, 200, 255] });
+    // A sine along u, period 64 texels, on a 256² texture: smooth, so some R < 64 meets E.
+    let texture = texture_from(256, 256, |x, _| {
+        let s = (std::f64::consts::TAU * f64::from(x) / 64.0).sin();
+        [(128.0 + 100.0 * s) as u8, (128.0 - 100.0 * s) as u8, 90, 255]
+    });
     // Face 0: a sliver in UV space (a line across the stripes, UV area ~1e-9) on a normal
     // world triangle; face 1: a sliver in world space (height 1e-6) with normal UVs; face
     // 2: the same UVs as face 1 on a normal world triangle (the fit reads UVs only).
@@ -307,7 +308,10 @@ fn sliver_faces_meet_the_bound_at_random_points() {
         let resolutions: Vec<u32> = document.store.face_resolutions().iter().map(|x| x.get()).collect();
         let errors: Vec<f32> = (0..3).map(|f| face_error(&scene, &document, f, uvs[f as usize], 400)).collect();
         eprintln!("sliver E = {bound}: R {resolutions:?}, random-point RMS {errors:?}");
-        assert!(resolutions[0] > 1, "the UV sliver crosses stripes");
+        assert!(resolutions[0] > 1, "the UV sliver crosses the sine's periods");
+        if bound >= 0.05 {
+            assert!(resolutions[2] < 64, "smooth content fits below the cap");
+        }
         assert_eq!(resolutions[1], resolutions[2], "a world sliver is fitted by its UVs like any face");
         for f in 0..3 {
             assert!(resolutions[f] == 64 || errors[f] <= 1.5 * bound, "face {f}: {errors:?} {resolutions:?}");
@@ -319,21 +323,28 @@ fn sliver_faces_meet_the_bound_at_random_points() {
 fn non_manifold_edges_whose_faces_want_different_resolutions() {
     // Three pages on one spine (0,0,0)–(0,1,0): page 0 maps onto a flat region, page 1 onto a
     // gentle ramp, page 2 onto noise. Page 0 is the spine's owner (lowest face id), so the
-    // spine shows its flat colour on every page.
-    let texture = texture_from(256, 256, |x, y| match x {
-        0..=84 => [120, 160, 90, 255],
-        85..=169 => [120, 160, 90u8.saturating_add(((x - 85) / 4) as u8), 255],
+    // spine shows its flat colour on every page. The flat region is wide (x < 768 of 1024):
+    // the bake reads a face at R = 1 at MIP level log2(longest UV edge in texels), whose
+    // bilinear footprint reaches about that far around the face — an island of other colours
+    // within it makes a flat face need a higher R (measured: R = 16 with noise 50 texels away,
+    // R = 2 with page 0 at u = 0.05, where REPEAT wraps the footprint onto the noise at u ≈ 1).
+    let texture = texture_from(1024, 1024, |x, y| match x {
+        0..=767 => [120, 160, 90, 255],
+        768..=895 => [120, 160, 90u8.saturating_add(((x - 768) / 2) as u8), 255],
         _ => {
             let mut rng = Rng(u64::from(x) * 7919 + u64::from(y));
             [0; 4].map(|_| (rng.unit() * 255.0) as u8)
         }
     });
-    let page = |tip: [f32; 3], region: f32| {
-        let (u0, u1) = (region + 0.02, region + 0.3);
-        [([0.0, 0.0, 0.0], [u0, 0.9]), ([0.0, 1.0, 0.0], [u0, 0.1]), (tip, [u1, 0.5])]
+    let page = |tip: [f32; 3], (u0, u1): (f32, f32)| {
+        [([0.0, 0.0, 0.0], [u0, 0.55]), ([0.0, 1.0, 0.0], [u0, 0.45]), (tip, [u1, 0.5])]
     };
-    let corners: Vec<([f32; 3], [f32; 2])> =
-        [page([1.0, 0.5, 0.0], 0.0), page([-0.5, 0.5, 0.8], 1.0 / 3.0), page([-0.5, 0.5, -0.8], 2.0 / 3.0)].concat();
+    let corners: Vec<([f32; 3], [f32; 2])> = [
+        page([1.0, 0.5, 0.0], (0.25, 0.4)),
+        page([-0.5, 0.5, 0.8], (0.76, 0.86)),
+        page([-0.5, 0.5, -0.8], (0.885, 0.99)),
+    ]
+    .concat();
     let scene = scene_of(&corners, texture);
     let uvs = corner_uvs(&scene);
     let bound = 0.02f32;
