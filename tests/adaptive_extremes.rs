@@ -350,7 +350,8 @@ fn non_manifold_edges_whose_faces_want_different_resolutions() {
     let bound = 0.02f32;
     let document = convert(&scene, ResolutionRule::ErrorBound { bound, max: r(64) });
     let topology = document.store.topology();
-    let spine = (0..topology.edge_count()).find(|&e| topology.faces_of_edge(e).len() == 3).expect("a non-manifold edge");
+    let spine =
+        (0..topology.edge_count()).find(|&e| topology.faces_of_edge(e).len() == 3).expect("a non-manifold edge");
     let resolutions: Vec<u32> = document.store.face_resolutions().iter().map(|x| x.get()).collect();
     let errors: Vec<f32> = (0..3).map(|f| face_error(&scene, &document, f, uvs[f as usize], 400)).collect();
     eprintln!("non-manifold pages: R {resolutions:?}, random-point RMS {errors:?}");

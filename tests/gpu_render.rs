@@ -31,8 +31,9 @@ use common::gpu::{shared as gpu, textured_baseline};
 use common::{Rng, model, output_dir};
 
 const SIZE: u32 = 256;
-/// Largest allowed per-channel difference in 8-bit steps.
-const MAX_STEPS: u32 = 2;
+/// Largest allowed per-channel difference in 8-bit steps (every comparison here reached at
+/// most 1 on lavapipe: the rounding of the sRGB8 encode; README "GPU vs CPU reference").
+const MAX_STEPS: u32 = 1;
 /// Pixels whose centre has a barycentric coordinate below this are edge pixels (skipped).
 const EDGE_MARGIN: f64 = 1e-4;
 /// Nearest filtering: pixels within this many lattice units of a cell boundary are skipped.
@@ -162,7 +163,8 @@ impl Scene {
 /// (silhouettes, near-equal depths); background only when those rays miss too.
 fn bvh_truth(bvh: &MeshBvh, camera: &OrbitCamera, x: u32, y: u32) -> Truth {
     let cast = |dx: f64, dy: f64| {
-        let (origin, direction) = camera.ray_through_pixel(f64::from(x) + 0.5 + dx, f64::from(y) + 0.5 + dy, SIZE, SIZE);
+        let (origin, direction) =
+            camera.ray_through_pixel(f64::from(x) + 0.5 + dx, f64::from(y) + 0.5 + dy, SIZE, SIZE);
         bvh.cast(origin, direction, f64::INFINITY)
     };
     let center = cast(0.0, 0.0);
@@ -515,7 +517,8 @@ fn trilinear_on_the_duck_in_perspective_matches_the_continuous_level_of_detail()
                 |face, bary| sample_trilinear(&packed, face, bary, continuous_lod_with(&scene, &inputs, face, bary)),
                 |_, _| false,
             );
-            if stats.over_limit > 0 || stats.coverage_errors > 0 || stats.compared < 5_000 {
+            // The far view covers ~2 000 pixels.
+            if stats.over_limit > 0 || stats.coverage_errors > 0 || stats.compared < 1_500 {
                 failures.push(format!("{name}: {stats:?}"));
             }
         }

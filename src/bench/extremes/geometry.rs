@@ -82,7 +82,12 @@ pub fn r4096_perspective(gpu: &Gpu) -> Result<Vec<ExtremeCase>, ExtremesError> {
 /// reads another sample than the `f64` hit says must lie within the distance of a cell
 /// boundary that the barycentric precision explains. Also the `f32` lattice error of the
 /// index computation alone (exact barycentrics rounded to `f32`, as the CPU mirror does).
-fn index_precision(gpu: &Gpu, probe: &Probe, packed: &PackedMesh, mesh: &GpuMesh) -> Result<ExtremeCase, ExtremesError> {
+fn index_precision(
+    gpu: &Gpu,
+    probe: &Probe,
+    packed: &PackedMesh,
+    mesh: &GpuMesh,
+) -> Result<ExtremeCase, ExtremesError> {
     let res = r(12);
     let all = compare(
         gpu,
@@ -106,7 +111,8 @@ fn index_precision(gpu: &Gpu, probe: &Probe, packed: &PackedMesh, mesh: &GpuMesh
         let rounded = layout::sanitize_barycentric(exact.map(|w| w as f32));
         let scale = f64::from(res.get());
         let (u_f32, v_f32) = (rounded[1] * res.get() as f32, rounded[2] * res.get() as f32);
-        lattice_error = lattice_error.max((f64::from(u_f32) - u * scale).abs()).max((f64::from(v_f32) - v * scale).abs());
+        lattice_error =
+            lattice_error.max((f64::from(u_f32) - u * scale).abs()).max((f64::from(v_f32) - v * scale).abs());
         let chosen = layout::nearest_sample(res, rounded);
         let exact_choice = nearest_exact(res, exact);
         cells_differ += u32::from(chosen != exact_choice && nearest_boundary_distance(res, exact) > 1e-3);
@@ -149,9 +155,10 @@ fn nearest_exact(res: Resolution, bary: [f64; 3]) -> (u32, u32) {
 /// vertices are not representable in `f32`: moving it rounds every one of them).
 fn octahedron(size: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let rotation = glam::DMat3::from_euler(glam::EulerRot::YXZ, 0.3, 0.7, 0.1);
-    let positions = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]
-        .map(|p| (rotation * DVec3::from_array(p) * size).to_array())
-        .to_vec();
+    let positions =
+        [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]
+            .map(|p| (rotation * DVec3::from_array(p) * size).to_array())
+            .to_vec();
     let triangles = vec![[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
     (positions, triangles)
 }
@@ -245,8 +252,7 @@ fn offset_pick(transform: Transform, meshes: &Meshes, ulp: f64) -> ExtremeCase {
             let (px, py) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
             let (o, d) = meshes.base_camera.ray_through_pixel(px, py, SIZE, SIZE);
             let (o2, d2) = meshes.camera.ray_through_pixel(px, py, SIZE, SIZE);
-            let (Some(a), Some(b)) = (base_bvh.cast(o, d, f64::INFINITY), moved_bvh.cast(o2, d2, f64::INFINITY))
-            else {
+            let (Some(a), Some(b)) = (base_bvh.cast(o, d, f64::INFINITY), moved_bvh.cast(o2, d2, f64::INFINITY)) else {
                 continue;
             };
             if a.barycentric.iter().any(|&w| w < 1e-3) {
@@ -295,7 +301,14 @@ fn offset_paint(transform: Transform, meshes: &Meshes, ulp: f64) -> Result<Extre
     let center = [f64::from(SIZE) * 0.5 + 0.25; 2];
     let radius = 0.3 * transform.size;
     let base = dab_on(meshes.base, meshes.triangles, &meshes.base_camera, settings, center, (r(5), Some(radius)))?;
-    let moved = dab_on(meshes.moved, meshes.triangles, &meshes.camera, settings, center, (r(5), Some(radius * transform.scale)))?;
+    let moved = dab_on(
+        meshes.moved,
+        meshes.triangles,
+        &meshes.camera,
+        settings,
+        center,
+        (r(5), Some(radius * transform.scale)),
+    )?;
     let band = 4.0 * ulp / transform.scale;
     let (mut painted, mut in_band, mut differ) = (0u32, 0u32, 0u32);
     let mut sites = Vec::new();
@@ -494,10 +507,9 @@ pub fn grazing_brush() -> Result<Vec<ExtremeCase>, ExtremesError> {
         let dabbed = dab_on(&positions, &triangles, &camera, settings, cursor, (r(6), None))?;
         let (origin, direction) = camera.ray_through_pixel(cursor[0], cursor[1], SIZE, SIZE);
         let truth = origin + direction * (-origin.y / direction.y);
-        let world_per_px = 2.0
-            * (truth - camera.eye()).dot(-camera.eye_direction())
-            * (camera.fov_y_degrees.to_radians() * 0.5).tan()
-            / f64::from(SIZE);
+        let world_per_px =
+            2.0 * (truth - camera.eye()).dot(-camera.eye_direction()) * (camera.fov_y_degrees.to_radians() * 0.5).tan()
+                / f64::from(SIZE);
         let pick_error_px = (dabbed.center - truth).length() / world_per_px;
         let radius = dabbed.radius_world;
         let (mut painted, mut inside, mut differ) = (0u32, 0u32, 0u32);

@@ -27,7 +27,7 @@ use crate::render::{Gpu, RenderError};
 
 /// Largest per-channel GPU-vs-CPU difference the render cases allow, 8-bit steps (the
 /// `MAX_STEPS` of `tests/gpu_render.rs`).
-pub const MAX_STEPS: f64 = 2.0;
+pub const MAX_STEPS: f64 = 1.0;
 /// Nearest filtering: pixels within this many lattice units of a cell boundary cannot be
 /// called (the `CELL_MARGIN` of `tests/gpu_render.rs`).
 pub const CELL_MARGIN: f64 = 1e-3;

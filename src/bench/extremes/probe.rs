@@ -146,7 +146,8 @@ pub struct Comparison {
     pub sum_steps: f64,
     /// Background where a face is, or the reverse.
     pub coverage_errors: u64,
-    /// Every compared pixel over 2 steps: face, `f64` barycentrics, steps.
+    /// Every compared pixel over 2 steps (reading another sample, not rounding): face,
+    /// `f64` barycentrics, steps.
     pub over: Vec<(u32, [f64; 3], u32)>,
 }
 
@@ -169,7 +170,12 @@ impl Comparison {
 }
 
 /// Renders `mesh` unlit on a transparent background with `filter`.
-pub fn render(gpu: &Gpu, mesh: &GpuMesh, camera: OrbitCamera, filter: FilterMode) -> Result<image::RgbaImage, ExtremesError> {
+pub fn render(
+    gpu: &Gpu,
+    mesh: &GpuMesh,
+    camera: OrbitCamera,
+    filter: FilterMode,
+) -> Result<image::RgbaImage, ExtremesError> {
     let mut settings = RenderSettings::new(camera);
     settings.filter = filter;
     settings.shading = Shading::Unlit;
