@@ -2,6 +2,7 @@
 //! each measures what the editor really does.
 
 pub mod adaptive;
+pub mod extremes;
 pub mod pack;
 pub mod paint;
 pub mod render;

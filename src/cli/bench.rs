@@ -1,4 +1,4 @@
-//! `meshpaint bench pack | render | paint`: measurements printed as JSON.
+//! `meshpaint bench pack | render | paint | adaptive | extremes`: measurements printed as JSON.
 
 use std::path::PathBuf;
 
@@ -70,10 +70,20 @@ pub(super) enum BenchCommand {
         #[arg(long)]
         json: bool,
     },
+    /// The numerical extremes (R = 4096 in perspective, offsets 1e5 / 1e6, scale 1e-4,
+    /// slivers, valence 200, RGBA16F's largest value, HDR Add, NaN / ∞ colours, grazing
+    /// brushes, the shader's index precision): per case the error measured against an
+    /// independent truth and the tolerance its test enforces. Fails when a case is over.
+    Extremes {
+        /// One JSON object per line (default: a table).
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 pub(super) fn run(what: BenchCommand) -> Result<()> {
     match what {
+        BenchCommand::Extremes { json } => extremes(json),
         BenchCommand::Adaptive { file, max_resolution, size, views } => {
             let max = meshpaint::colors::layout::Resolution::new(max_resolution).context("--max-resolution")?;
             let scene = meshpaint::mesh::import::import_gltf(&file)?;
@@ -134,4 +144,30 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// `bench extremes`: every case, as JSON lines or a table; an error when a case fails.
+fn extremes(json: bool) -> Result<()> {
+    let gpu = meshpaint::render::Gpu::new_headless()?;
+    let cases = meshpaint::bench::extremes::extreme_cases(&gpu)?;
+    for case in &cases {
+        if json {
+            println!("{}", case.to_json());
+        } else {
+            println!(
+                "{:<32} {:>12.4e} ≤ {:<10.3e} {}  {} [{}]",
+                case.case,
+                case.measured,
+                case.tolerance,
+                if case.passes() { "ok  " } else { "FAIL" },
+                case.unit,
+                case.outcome
+            );
+        }
+    }
+    let failed: Vec<&str> = cases.iter().filter(|c| !c.passes()).map(|c| c.case.as_str()).collect();
+    if !failed.is_empty() {
+        anyhow::bail!("{} of {} extreme cases fail their tolerance: {}", failed.len(), cases.len(), failed.join(", "));
+    }
+    Ok(())
 }

@@ -24,6 +24,10 @@
 //! single texel spike should not force a whole face to the finest `R`; the PSNR the
 //! measurements report is an RMS measure too.
 //!
+//! Errors at or below [`ROUNDING`] count as zero (the float rounding of the bake and of
+//! the reconstruction), so `E = 0` means lossless within rounding, as for `optimize`, and a
+//! constant colour (a 1 × 1 texture, a face whose UVs have no area) needs only `R = 1`.
+//!
 //! The fit treats each face alone (its edges at its own `R`). In the mesh an edge takes
 //! the larger `R` of its two faces, which only adds texture samples along it. Faces are
 //! fitted in parallel (rayon).
@@ -37,6 +41,11 @@ use crate::io::bake::{FaceMaterial, bake_texture, face_materials, interpolate_uv
 use crate::mesh::scene::Scene;
 use crate::mesh::weld::WeldedMesh;
 use crate::packing::sampler::{Filter, sample};
+
+/// Errors (RMS, sRGB-encoded colour units) at or below this are float rounding and count as
+/// zero: a constant colour baked and reconstructed differs from its texel by a few ulps.
+/// The same value as [`crate::paint::optimize::LOSSLESS_TOLERANCE`].
+pub const ROUNDING: f32 = 1e-6;
 
 /// How faces get their resolution when a glTF mesh is converted.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -129,7 +138,7 @@ pub fn face_resolutions(mesh: &WeldedMesh, scene: &Scene, face_count: usize, rul
                     let fit = FaceFit::new(&materials, face, shared[face], &pyramids, uvs, max);
                     (0..=max.log2())
                         .filter_map(|log2| Resolution::from_log2(log2).ok())
-                        .find(|&r| fit.error(r) <= bound)
+                        .find(|&r| fit.error(r) <= bound.max(ROUNDING))
                         .unwrap_or(max)
                 }
             }
@@ -188,7 +197,10 @@ fn allocate_budget(
             let area = world_area(mesh, face);
             let fit = FaceFit::new(materials, face, shared[face], pyramids, uvs, max);
             (0..levels)
-                .map(|l| Resolution::from_log2(l as u32).map_or(0.0, |r| f64::from(fit.error(r)).powi(2) * area))
+                .map(|l| {
+                    let error = Resolution::from_log2(l as u32).map_or(0.0, |r| fit.error(r));
+                    if error <= ROUNDING { 0.0 } else { f64::from(error).powi(2) * area }
+                })
                 .collect()
         })
         .collect();
@@ -319,7 +331,8 @@ pub fn bake_and_verify(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene,
                 }
                 let uvs = mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
                 let fit = FaceFit::new(&materials, face, shared[face], &pyramids, uvs, max);
-                fit.error_of(|bary| sample(shown, face as u32, bary, Filter::Linear, 0).unwrap_or([0.0; 4])) > bound
+                fit.error_of(|bary| sample(shown, face as u32, bary, Filter::Linear, 0).unwrap_or([0.0; 4]))
+                    > bound.max(ROUNDING)
             })
             .map(|face| face as u32)
             .collect();

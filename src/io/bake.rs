@@ -304,10 +304,16 @@ pub fn bake_texture(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene) {
     });
 }
 
-/// `w0·uv0 + w1·uv1 + w2·uv2`, non-finite UVs read as `(0, 0)`.
+/// `w0·uv0 + w1·uv1 + w2·uv2`, non-finite UVs read as `(0, 0)`. Evaluated as
+/// `uv0 + w1·(uv1 − uv0) + w2·(uv2 − uv0)` in `f64` and rounded once, so that equal corner
+/// UVs (a face with zero UV area) give exactly that UV, and UVs far from 0 (wrapped, e.g.
+/// `u + 1000`) lose nothing beyond their own rounding (assuming `w0 + w1 + w2 = 1`).
 pub(crate) fn interpolate_uv(uvs: [[f32; 2]; 3], w: [f32; 3]) -> [f32; 2] {
-    let clean = |x: f32| if x.is_finite() { x } else { 0.0 };
-    std::array::from_fn(|a| (0..3).map(|k| w[k] * clean(uvs[k][a])).sum())
+    let clean = |x: f32| if x.is_finite() { f64::from(x) } else { 0.0 };
+    std::array::from_fn(|a| {
+        let base = clean(uvs[0][a]);
+        (base + f64::from(w[1]) * (clean(uvs[1][a]) - base) + f64::from(w[2]) * (clean(uvs[2][a]) - base)) as f32
+    })
 }
 
 /// Longest edge of a UV triangle measured in texels of a `width × height` image.
