@@ -19,8 +19,9 @@
 //! 8 and at most `2·max`, so every texel the face covers holds several points. The truth
 //! at a test point is the texture's level 0 read bilinearly there (what a magnified UV
 //! render shows) times the factor. The error is the **root mean square** of the
-//! differences over the test points and the four channels, in linear light (colour units:
-//! full range = 1; RMS 0.01 ≈ 40 dB PSNR in linear light). RMS, not the maximum, because a
+//! differences over the test points and the four channels, the colour channels compared
+//! **sRGB-encoded** (as a display and the PSNR of 8-bit images see them; alpha as is;
+//! colour units: full range = 1, RMS 0.01 ≈ 40 dB PSNR of 8-bit images). RMS, not the maximum, because a
 //! single texel spike should not force a whole face to the finest `R`; the PSNR the
 //! measurements report is an RMS measure too.
 //!
@@ -70,7 +71,7 @@ pub enum ResolutionRule {
         /// The largest `R` given.
         max: Resolution,
     },
-    /// The lowest `R` whose reconstruction error (RMS, linear light) is at most `bound`.
+    /// The lowest `R` whose reconstruction error (RMS of sRGB-encoded differences) is at most `bound`.
     ErrorBound {
         /// `E`, colour units (full range = 1).
         bound: f32,
