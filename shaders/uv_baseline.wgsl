@@ -5,7 +5,9 @@
 // shaders/mesh_colors.wgsl (lighting, wireframe) and nothing more.
 //
 // Vertices come from a vertex buffer, three per face (faces keep their own UVs across
-// seams), positions relative to the render origin.
+// seams), positions relative to the render origin. Each corner carries its material's
+// baseColorFactor (× COLOR_0), which multiplies the texel; a mesh with several materials is
+// one draw per texture, untextured faces reading a 1×1 white texture.
 
 // `FrameUniforms` (the uniform block `u`), the `FLAG_*` bits and `wireframe_overlay` are in
 // shaders/frame.wgsl, which the renderer prepends to this file.
@@ -20,6 +22,7 @@ struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) uv: vec2<f32>,
     @location(2) normal: vec3<f32>,
+    @location(3) color: vec4<f32>,
 }
 
 struct VertexOut {
@@ -27,6 +30,7 @@ struct VertexOut {
     @location(0) uv: vec2<f32>,
     @location(1) bary: vec3<f32>,
     @location(2) @interpolate(flat) normal: vec3<f32>,
+    @location(3) color: vec4<f32>,
 }
 
 @vertex
@@ -37,6 +41,7 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.uv = in.uv;
     out.bary = vec3<f32>(f32(corner == 0u), f32(corner == 1u), f32(corner == 2u));
     out.normal = in.normal;
+    out.color = in.color;
     return out;
 }
 
@@ -46,8 +51,8 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     let texel = textureSample(base_color, base_sampler, in.uv);
     let bary_width = fwidth(in.bary);
 
-    var rgb = texel.rgb * u.tint.rgb;
-    let alpha = texel.a * u.tint.a;
+    var rgb = texel.rgb * in.color.rgb * u.tint.rgb;
+    let alpha = texel.a * in.color.a * u.tint.a;
     if (u.flags & FLAG_LIT) != 0u {
         let n = select(-in.normal, in.normal, front_facing);
         let ambient = u.light.w;
