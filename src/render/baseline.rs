@@ -154,7 +154,11 @@ impl BaselineMesh {
 
     /// Uploads `source`: faces grouped by texture (one draw each), faces without one
     /// drawing their corner colours over a 1×1 white texture.
-    pub fn from_source(ctx: &GpuContext, renderer: &Renderer, source: &BaselineSource<'_>) -> Result<Self, RenderError> {
+    pub fn from_source(
+        ctx: &GpuContext,
+        renderer: &Renderer,
+        source: &BaselineSource<'_>,
+    ) -> Result<Self, RenderError> {
         ctx.checked(|| Self::from_source_unchecked(ctx, renderer, source))
     }
 

@@ -6,7 +6,9 @@ use std::sync::Arc;
 
 use image::RgbaImage;
 
-use super::{BaselineMesh, BaselineSource, DrawItem, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderError};
+use super::{
+    BaselineMesh, BaselineSource, DrawItem, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderError,
+};
 use super::{RenderSettings, Renderer};
 use crate::mesh::scene::Scene;
 use crate::mesh::weld::weld_scene;
@@ -43,9 +45,8 @@ impl Gpu {
     /// vertex colours), faces whose material has no texture at their factor, faces without a
     /// material white (glTF's default material). `None` when no material has a texture.
     pub fn upload_baseline(&self, scene: &Scene) -> Result<Option<BaselineMesh>, RenderError> {
-        let textured = |m: &crate::mesh::scene::Material| {
-            m.base_color_texture.filter(|&t| (t as usize) < scene.textures.len())
-        };
+        let textured =
+            |m: &crate::mesh::scene::Material| m.base_color_texture.filter(|&t| (t as usize) < scene.textures.len());
         if !scene.materials.iter().any(|m| textured(m).is_some()) {
             return Ok(None);
         }
