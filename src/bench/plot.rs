@@ -168,11 +168,14 @@ pub fn plot_tradeoff(
                 .label("Pareto front")
                 .legend(|(x, y)| PathElement::new(vec![(x - 10, y), (x + 10, y)], BLACK.stroke_width(2)));
             chart
-                .draw_series(front.iter().map(|&i| {
+                .draw_series(front.iter().enumerate().map(|(k, &i)| {
                     let p = finite[i];
+                    // Labels alternate above and below the point: neighbours on the front
+                    // are often close.
+                    let dy = if k % 2 == 0 { -20 } else { 6 };
                     EmptyElement::at((p.cost, p.quality))
                         + Circle::new((0, 0), 8, BLACK.stroke_width(1))
-                        + Text::new(p.label.clone(), (8, -18), (FONT, 15).into_font())
+                        + Text::new(p.label.clone(), (10, dy), (FONT, 15).into_font())
                 }))
                 .map_err(|e| draw_error(e.to_string()))?;
             if let Some((x, y, name)) = reference

@@ -13,7 +13,10 @@
 //! - a glTF with a base-colour texture: its UV-textured render (the baseline pipeline, every
 //!   material's factor × texture, hardware trilinear);
 //! - anything else (a painted packed file, an untextured mesh): the same document packed in
-//!   RGBA32F, linear filter at level 0.
+//!   RGBA32F, linear filter at level 0 — per resolution choice, so the figure isolates what
+//!   the filter and the format lose (an untextured glTF is swept over uniform R like a
+//!   textured one; a packed file is measured at its own resolutions). Frame ratios are then
+//!   to `bench render`'s synthetic planar UV baseline.
 //!
 //! Pixels are compared where the reference's 16 subsamples are all covered and the test
 //! render covers the pixel: the silhouette, whose aliasing no colour setting changes, is left
@@ -63,7 +66,7 @@ use crate::mesh::import::import_gltf;
 use crate::packing::linear::PackedMesh;
 use crate::packing::sampler::{Filter, sample, sample_trilinear};
 use crate::paint::picking::{BvhPreset, MeshBvh};
-use crate::render::{BaselineMesh, DrawItem, FilterMode, Gpu, GpuMesh, RenderSettings, Shading};
+use crate::render::{DrawItem, FilterMode, Gpu, GpuMesh, RenderSettings, Shading};
 
 /// What `bench trade` measures.
 #[derive(Debug, Clone, PartialEq)]
@@ -222,6 +225,8 @@ struct Choice {
     convert_seconds: f64,
     packs: Vec<Packed>,
     dab: serde_json::Value,
+    /// Without a textured baseline: this document at RGBA32F, the reference of its rows.
+    reference: Option<GpuMesh>,
 }
 
 struct Packed {
@@ -229,12 +234,6 @@ struct Packed {
     packed: PackedMesh,
     mesh: GpuMesh,
     pack_seconds: f64,
-}
-
-/// The reference of the study and what it was.
-enum Reference {
-    Baseline(Box<BaselineMesh>),
-    Document(Box<GpuMesh>),
 }
 
 /// Runs the study on the file at `path` and returns its JSON rows: one `meta` row, one
@@ -249,21 +248,31 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
         Some(scene) => gpu.upload_baseline(scene)?,
         None => None,
     };
+    let textured = baseline.is_some();
     let file = path.display().to_string();
     let mut rows = Vec::new();
 
-    // The resolution choices.
+    // The resolution choices: a glTF is swept over uniform R (and, with a texture, the error
+    // bounds); any other file is measured as it is.
     let mut choices: Vec<Choice> = Vec::new();
     let started = Instant::now();
-    match (&scene, &baseline) {
-        (Some(scene), Some(_)) => {
+    let mut push = |label, error_bound, document, convert_seconds| {
+        choices.push(Choice {
+            label,
+            error_bound,
+            document,
+            convert_seconds,
+            packs: Vec::new(),
+            dab: 0.into(),
+            reference: None,
+        });
+    };
+    match &scene {
+        Some(scene) => {
             let mut rules: Vec<ResolutionRule> = options.uniform.iter().copied().map(ResolutionRule::Uniform).collect();
-            rules.extend(
-                options
-                    .error_bounds
-                    .iter()
-                    .map(|&bound| ResolutionRule::ErrorBound { bound, max: options.max_resolution }),
-            );
+            // Error bounds fit a texture: only with one.
+            let bounds: &[f32] = if textured { &options.error_bounds } else { &[] };
+            rules.extend(bounds.iter().map(|&bound| ResolutionRule::ErrorBound { bound, max: options.max_resolution }));
             for rule in rules {
                 let started = Instant::now();
                 let document = Document::from_scene_within(scene.clone(), rule, path, &budget)?;
@@ -272,28 +281,12 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
                     ResolutionRule::ErrorBound { bound, .. } => (format!("error<={bound}").into(), Some(bound)),
                     _ => (rule_resolution(&document), None),
                 };
-                choices.push(Choice {
-                    label,
-                    error_bound,
-                    document,
-                    convert_seconds,
-                    packs: Vec::new(),
-                    dab: 0.into(),
-                });
+                push(label, error_bound, document, convert_seconds);
             }
         }
-        _ => {
+        None => {
             let document = Document::open_within(path, Resolution::from_log2(3).unwrap_or(Resolution::MAX), &budget)?;
-            let label = rule_resolution(&document);
-            let convert_seconds = started.elapsed().as_secs_f64();
-            choices.push(Choice {
-                label,
-                error_bound: None,
-                document,
-                convert_seconds,
-                packs: Vec::new(),
-                dab: 0.into(),
-            });
+            push(rule_resolution(&document), None, document, started.elapsed().as_secs_f64());
         }
     }
     for choice in &mut choices {
@@ -303,36 +296,30 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
             let mesh = gpu.upload(&packed)?;
             choice.packs.push(Packed { format, packed, mesh, pack_seconds: timing.best_seconds });
         }
-        let samples = choice.document.store.sample_count();
+        if !textured {
+            choice.reference = Some(gpu.upload(&choice.document.pack(ColorFormat::Rgba32F)?)?);
+        }
         // A brush of a tenth of the samples (at least 64: a brush at the rim of one sample
         // paints nothing), at most 10k as `bench paint`'s middle size.
-        let target = (samples / 10).clamp(64, 10_000);
+        let target = (choice.document.store.sample_count() / 10).clamp(64, 10_000);
         choice.dab = paint::dab_throughput(&choice.document, target, options.dabs)
             .unwrap_or_else(|error| serde_json::json!({ "error": error.to_string() }));
     }
     let Some(first) = choices.first() else {
         return Ok(rows);
     };
-    let reference = match baseline {
-        Some(baseline) => Reference::Baseline(Box::new(baseline)),
-        None => Reference::Document(Box::new(gpu.upload(&first.document.pack(ColorFormat::Rgba32F)?)?)),
-    };
-    let reference_item = || match &reference {
-        Reference::Baseline(mesh) => DrawItem::Baseline(mesh),
-        Reference::Document(mesh) => DrawItem::MeshColors(mesh),
-    };
-    let (reference_name, reference_bytes) = match &reference {
-        Reference::Baseline(mesh) => ("uv-texture render, 4x4 supersampled".to_owned(), mesh.gpu_bytes()),
-        Reference::Document(mesh) => {
-            ("document at rgba32f, linear level 0, 4x4 supersampled".to_owned(), mesh.gpu_bytes())
-        }
+    let reference_name = if textured {
+        "uv-texture render, 4x4 supersampled"
+    } else {
+        "the same document at rgba32f, linear level 0, 4x4 supersampled"
     };
     // Frame times are ratios to a UV-texture baseline: the file's own, else (a document
     // without texture) `bench render`'s synthetic planar one.
-    let synthetic = match &reference {
-        Reference::Document(_) => Some(super::render::baseline(&gpu, path, &first.document)?.1),
-        Reference::Baseline(_) => None,
+    let timing_baseline = match baseline {
+        Some(mesh) => mesh,
+        None => super::render::baseline(&gpu, path, &first.document)?.1,
     };
+    let baseline_bytes = timing_baseline.gpu_bytes();
     let bounds =
         first.packs.first().map_or_else(|| BoundingSphere::of_points(&first.document.positions), |p| p.mesh.bounds);
     let face_count = first.document.store.topology().face_count();
@@ -346,8 +333,17 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
 
     let size = options.size;
     for view in views(bounds, options.views) {
-        let reference_image: Supersampled =
-            render_supersampled(&gpu, reference_item(), &unlit(view.camera, FilterMode::Linear), size)?;
+        let settings = unlit(view.camera, FilterMode::Linear);
+        // One reference per view (textured), or one per resolution choice.
+        let mut references: Vec<Supersampled> = Vec::new();
+        if textured {
+            references.push(render_supersampled(&gpu, DrawItem::Baseline(&timing_baseline), &settings, size)?);
+        } else {
+            for mesh in choices.iter().filter_map(|c| c.reference.as_ref()) {
+                references.push(render_supersampled(&gpu, DrawItem::MeshColors(mesh), &settings, size)?);
+            }
+        }
+        let reference_of = |c: usize| &references[if textured { 0 } else { c.min(references.len().saturating_sub(1)) }];
         // Frame times, interleaved: each round times the baseline, then every configuration,
         // the baseline again after every eight.
         let timer = FrameTimer::new(&gpu, size, size);
@@ -355,13 +351,8 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
             .flat_map(|c| (0..choices[c].packs.len()).flat_map(move |p| (0..FILTERS.len()).map(move |f| (c, p, f))))
             .collect();
         let item = |&(c, p, _): &(usize, usize, usize)| DrawItem::MeshColors(&choices[c].packs[p].mesh);
-        let time_baseline = |timer: &FrameTimer| match (&reference, &synthetic) {
-            (Reference::Baseline(mesh), _) => timer.frame(DrawItem::Baseline(mesh), FilterMode::Linear, view.camera),
-            (_, Some(mesh)) => timer.frame(DrawItem::Baseline(mesh), FilterMode::Linear, view.camera),
-            (Reference::Document(mesh), None) => {
-                timer.frame(DrawItem::MeshColors(mesh), FilterMode::Linear, view.camera)
-            }
-        };
+        let time_baseline =
+            |timer: &FrameTimer| timer.frame(DrawItem::Baseline(&timing_baseline), FilterMode::Linear, view.camera);
         time_baseline(&timer);
         for key in &items {
             timer.frame(item(key), FILTERS[key.2].1, view.camera);
@@ -377,26 +368,26 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
             }
         }
         let baseline_ms = median(&mut baseline_times) * 1e3;
-        let mask_for = |test: &RgbaImage| -> Vec<bool> {
-            reference_image.interior.iter().zip(test.pixels()).map(|(&inside, p)| inside && p.0[3] > 0).collect()
+        let mask_for = |reference: &Supersampled, test: &RgbaImage| -> Vec<bool> {
+            reference.interior.iter().zip(test.pixels()).map(|(&inside, p)| inside && p.0[3] > 0).collect()
         };
-        let covered = reference_image.interior.iter().filter(|&&x| x).count() as f64;
+        let covered = reference_of(0).interior.iter().filter(|&&x| x).count() as f64;
         let view_json = serde_json::json!({
             "view": view.name, "direction": view.direction, "distance_factor": view.distance_factor,
             "interior_pixels": covered, "pixels_per_face": covered / f64::from(face_count.max(1)),
         });
-        if let Reference::Baseline(mesh) = &reference {
+        if textured {
             // The baseline itself at the image size: the error floor of texture filtering.
-            let native =
-                gpu.render_image(DrawItem::Baseline(mesh), &unlit(view.camera, FilterMode::Linear), size, size)?;
-            let error = compare(&reference_image.image, &native, &mask_for(&native));
+            let native = gpu.render_image(DrawItem::Baseline(&timing_baseline), &settings, size, size)?;
+            let reference = reference_of(0);
+            let error = compare(&reference.image, &native, &mask_for(reference, &native));
             let mut row = error_json(&error);
             merge(&mut row, &view_json);
             merge(
                 &mut row,
                 &serde_json::json!({
                     "bench": "trade", "kind": "baseline", "file": file, "filter": "baseline-uv",
-                    "gpu_bytes": reference_bytes, "frame_ms": baseline_ms, "frame_ratio": 1.0,
+                    "gpu_bytes": baseline_bytes, "frame_ms": baseline_ms, "frame_ratio": 1.0,
                 }),
             );
             rows.push(row);
@@ -406,7 +397,8 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
             let (filter_name, filter) = FILTERS[f];
             let image =
                 gpu.render_image(DrawItem::MeshColors(&packed.mesh), &unlit(view.camera, filter), size, size)?;
-            let error = compare(&reference_image.image, &image, &mask_for(&image));
+            let reference = reference_of(c);
+            let error = compare(&reference.image, &image, &mask_for(reference, &image));
             let frame_ms = median(&mut times[k]) * 1e3;
             let resolutions = choice.document.store.face_resolutions();
             let mut row = error_json(&error);
