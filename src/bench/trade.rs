@@ -520,7 +520,9 @@ pub fn seam_jumps(packed: &PackedMesh) -> Vec<SeamJump> {
         }
     }
     let resolution = |face: u32| packed.face_records.get(face as usize).and_then(|r| r.resolution());
-    let mut pairs: Vec<((u32, u32), (u32, u8), (u32, u8))> = Vec::new();
+    // (sorted vertex pair, one side (face, k), the other side)
+    type Side = (u32, u8);
+    let mut pairs: Vec<((u32, u32), Side, Side)> = Vec::new();
     for (&key, sides) in &edges {
         for (x, &first) in sides.iter().enumerate() {
             for &second in &sides[x + 1..] {
