@@ -6,7 +6,7 @@
 
 // Keep in sync with `FrameUniforms` in src/render/uniforms.rs (same fields, same order,
 // 176 bytes; tests/shaders.rs compares the member offsets). The baseline reads
-// clip_from_world, light, wire_color, tint (the glTF baseColorFactor), flags and wire_width.
+// clip_from_world, light, wire_color, tint (1; the baseline carries baseColorFactor per vertex), flags and wire_width.
 struct FrameUniforms {
     // clip ← (world − render origin)
     clip_from_world: mat4x4<f32>,

@@ -5,7 +5,9 @@
 // shaders/mesh_colors.wgsl (lighting, wireframe) and nothing more.
 //
 // Vertices come from a vertex buffer, three per face (faces keep their own UVs across
-// seams), positions relative to the render origin.
+// seams), positions relative to the render origin. Each corner carries its material's
+// baseColorFactor (× COLOR_0), which multiplies the texel; a mesh with several materials is
+// one draw per texture, untextured faces reading a 1×1 white texture.
 
 // `FrameUniforms` (the uniform block `u`), the `FLAG_*` bits and `wireframe_overlay` are in
 // shaders/frame.wgsl, which the renderer prepends to this file.
@@ -20,7 +22,8 @@ struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) uv: vec2<f32>,
     @location(2) normal: vec3<f32>,
-    @location(3) corner_normal: vec3<f32>,
+    @location(3) color: vec4<f32>,
+    @location(4) corner_normal: vec3<f32>,
 }
 
 struct VertexOut {
@@ -28,8 +31,9 @@ struct VertexOut {
     @location(0) uv: vec2<f32>,
     @location(1) bary: vec3<f32>,
     @location(2) @interpolate(flat) normal: vec3<f32>,
-    // FLAG_SMOOTH: the file's corner normals, interpolated.
-    @location(3) smooth_normal: vec3<f32>,
+    @location(3) color: vec4<f32>,
+    // FLAG_SMOOTH: the corner normals (vertex normals within the crease), interpolated.
+    @location(4) smooth_normal: vec3<f32>,
 }
 
 @vertex
@@ -40,6 +44,7 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.uv = in.uv;
     out.bary = vec3<f32>(f32(corner == 0u), f32(corner == 1u), f32(corner == 2u));
     out.normal = in.normal;
+    out.color = in.color;
     out.smooth_normal = in.corner_normal;
     return out;
 }
@@ -50,8 +55,8 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     let texel = textureSample(base_color, base_sampler, in.uv);
     let bary_width = fwidth(in.bary);
 
-    var rgb = texel.rgb * u.tint.rgb;
-    let alpha = texel.a * u.tint.a;
+    var rgb = texel.rgb * in.color.rgb * u.tint.rgb;
+    let alpha = texel.a * in.color.a * u.tint.a;
     if (u.flags & FLAG_LIT) != 0u {
         var n = select(-in.normal, in.normal, front_facing);
         if (u.flags & FLAG_SMOOTH) != 0u {

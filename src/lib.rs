@@ -20,7 +20,7 @@
 //! | [`atomic_write`] | the one way files are written: temporary file, `sync_all`, rename, directory sync |
 //! | [`camera`] | the orbit camera: matrices, framing, pixel rays (shared by render, picking, replay) |
 //! | [`render`] | **GPU**: wgpu context, packed buffers on the GPU, sampling pipelines, readback |
-//! | [`bench`](mod@bench) | **GPU**: the measurements behind `meshpaint bench` (time and size, as JSON; [`bench::extremes`]: the numerical extremes, each against an independent truth with the tolerance its test enforces) |
+//! | [`bench`](mod@bench) | **GPU**: the measurements behind `meshpaint bench` (time, size and error, as JSON; [`bench::trade`] every choice's cost and error side by side, [`bench::plot`] its PNG plots; [`bench::extremes`]: the numerical extremes, each against an independent truth with the tolerance its test enforces) |
 //! | [`app`] | **GPU + UI**: the desktop editor (winit, egui, wgpu): window, panels, input, background jobs |
 //!
 //! `mesh`, `colors`, `packing`, `paint`, `io`, `camera` and `atomic_write` are the core: they never import

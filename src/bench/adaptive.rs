@@ -99,7 +99,6 @@ pub fn bench_adaptive(
     let baseline = gpu
         .upload_baseline(scene)?
         .ok_or_else(|| BenchRenderError::NoReference(format!("{}: no base-colour texture", path.display())))?;
-    let big = size * SUPERSAMPLE;
     let cameras: Vec<_> = (0..views.max(1))
         .map(|k| default_camera(baseline.bounds, 30.0 + 360.0 * f64::from(k) / f64::from(views.max(1)), 20.0, None))
         .collect();
@@ -113,7 +112,7 @@ pub fn bench_adaptive(
     let references: Vec<RgbaImage> = cameras
         .iter()
         .map(|&camera| {
-            gpu.render_image(DrawItem::Baseline(&baseline), &settings(camera), big, big).map(|i| box_down(&i))
+            render_supersampled(&gpu, DrawItem::Baseline(&baseline), &settings(camera), size).map(|s| s.image)
         })
         .collect::<Result<_, _>>()?;
     let mut rows: Vec<AdaptiveRow> = Vec::new();
@@ -127,7 +126,7 @@ pub fn bench_adaptive(
         let mesh = gpu.upload(&packed)?;
         let mut psnr_db = Vec::new();
         for (camera, reference) in cameras.iter().zip(&references) {
-            let image = box_down(&gpu.render_image(DrawItem::MeshColors(&mesh), &settings(*camera), big, big)?);
+            let image = render_supersampled(&gpu, DrawItem::MeshColors(&mesh), &settings(*camera), size)?.image;
             psnr_db.push(psnr(reference, &image));
         }
         let resolutions = document.store.face_resolutions();
@@ -164,29 +163,63 @@ pub fn default_rules(max: Resolution) -> Vec<ResolutionRule> {
     rules
 }
 
+/// A render supersampled [`SUPERSAMPLE`]² and box-filtered to its size, with the pixels all of
+/// whose subsamples the mesh covers (alpha > 0): the interior, free of silhouette aliasing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Supersampled {
+    /// The box-filtered image (8-bit sRGB values averaged, alpha too).
+    pub image: RgbaImage,
+    /// Per pixel (row-major): every subsample covered.
+    pub interior: Vec<bool>,
+}
+
+/// Renders `item` at `size · SUPERSAMPLE` per side and box-filters it to `size × size` — the
+/// reference of `bench adaptive` and `bench trade`.
+pub fn render_supersampled(
+    gpu: &Gpu,
+    item: DrawItem<'_>,
+    settings: &RenderSettings,
+    size: u32,
+) -> Result<Supersampled, crate::render::RenderError> {
+    let big = size * SUPERSAMPLE;
+    Ok(box_down(&gpu.render_image(item, settings, big, big)?))
+}
+
 /// Box filter `SUPERSAMPLE × SUPERSAMPLE` (in 8-bit sRGB values, alpha averaged too).
-fn box_down(image: &RgbaImage) -> RgbaImage {
+fn box_down(image: &RgbaImage) -> Supersampled {
     let (w, h) = (image.width() / SUPERSAMPLE, image.height() / SUPERSAMPLE);
-    RgbaImage::from_fn(w, h, |x, y| {
+    let mut interior = vec![false; w as usize * h as usize];
+    let image = RgbaImage::from_fn(w, h, |x, y| {
         let mut sum = [0u32; 4];
+        let mut covered = 0;
         for dy in 0..SUPERSAMPLE {
             for dx in 0..SUPERSAMPLE {
                 let p = image.get_pixel(x * SUPERSAMPLE + dx, y * SUPERSAMPLE + dy).0;
                 for c in 0..4 {
                     sum[c] += u32::from(p[c]);
                 }
+                covered += u32::from(p[3] > 0);
             }
         }
         let n = SUPERSAMPLE * SUPERSAMPLE;
+        interior[y as usize * w as usize + x as usize] = covered == n;
         image::Rgba(sum.map(|s| ((s + n / 2) / n) as u8))
-    })
+    });
+    Supersampled { image, interior }
 }
 
 /// PSNR in dB over RGB of the pixels either image covers (alpha > 0); `inf` when equal.
 pub fn psnr(a: &RgbaImage, b: &RgbaImage) -> f64 {
+    let covered: Vec<bool> = a.pixels().zip(b.pixels()).map(|(pa, pb)| pa.0[3] > 0 || pb.0[3] > 0).collect();
+    psnr_over(a, b, &covered)
+}
+
+/// PSNR in dB over RGB of the pixels where `mask` (row-major) is true; `inf` when they are
+/// equal there or the mask is empty.
+pub fn psnr_over(a: &RgbaImage, b: &RgbaImage, mask: &[bool]) -> f64 {
     let (mut sum, mut count) = (0.0f64, 0u64);
-    for (pa, pb) in a.pixels().zip(b.pixels()) {
-        if pa.0[3] == 0 && pb.0[3] == 0 {
+    for ((pa, pb), &keep) in a.pixels().zip(b.pixels()).zip(mask) {
+        if !keep {
             continue;
         }
         for c in 0..3 {

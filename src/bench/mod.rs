@@ -5,7 +5,9 @@ pub mod adaptive;
 pub mod extremes;
 pub mod pack;
 pub mod paint;
+pub mod plot;
 pub mod render;
+pub mod trade;
 
 pub use pack::{Timing, bench_pack};
 pub use paint::{PaintBenchOptions, bench_paint};

@@ -71,17 +71,7 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
     let mut brushes = Vec::new();
     let scene_radius = camera.scene_radius.max(1e-12);
     for &target in &options.target_samples {
-        // Radius by bisection on the measured footprint.
-        let (mut lo, mut hi) = (0.0f64, scene_radius * 2.0);
-        for _ in 0..40 {
-            let mid = 0.5 * (lo + hi);
-            if samples_within(&view, &store, center, mid) < target {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let radius = hi;
+        let radius = radius_covering(&view, &store, center, scene_radius, target);
         let mut row = serde_json::json!({ "target_samples": target, "radius_world": radius,
             "radius_px": radius / view.world_per_px_at(center).max(f64::MIN_POSITIVE) });
         let (query, faces) = Timing::measure(options.dabs.max(5), || view.bvh.faces_in_sphere(center, radius));
@@ -132,18 +122,61 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
     }))
 }
 
-/// Build and pick time of every BVH preset, and its hits, on rays through a grid of pixels
-/// that hit the mesh (found with `reference`).
-fn bvh_presets(
-    positions: &[[f32; 3]],
-    triangles: &[[u32; 3]],
+/// The brush radius (world units, by bisection on the measured footprint) whose dab covers
+/// `target` samples around `center`.
+fn radius_covering(view: &PaintView, store: &ColorStore, center: DVec3, scene_radius: f64, target: u64) -> f64 {
+    let (mut lo, mut hi) = (0.0f64, scene_radius * 2.0);
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if samples_within(view, store, center, mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
+/// Paint-mode dab throughput of [`bench_paint`]'s `paint_in_stroke` case on `document`, one
+/// brush covering about `target_samples` samples at the default view's centre pick (a 1280×720
+/// viewport), `dabs` dabs in one stroke. Returns the same JSON object as each case there.
+pub fn dab_throughput(document: &Document, target_samples: u64, dabs: usize) -> Result<serde_json::Value, BrushError> {
+    let positions = &document.positions;
+    let triangles = &document.store.topology().face_vertices;
+    let camera = default_camera(BoundingSphere::of_points(positions), DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
+    let bvh = MeshBvh::build(positions, triangles, BvhPreset::FastBuild);
+    let base = document.store.clone();
+    let mut store = document.store.clone();
+    let viewport_px = [1280, 720];
+    let view = PaintView { positions, bvh: &bvh, camera: &camera, viewport_px, base: Some(&base) };
+    let hit = view.pick([640.0, 360.0]);
+    let center = hit.map(|hit| DVec3::from_array(hit.position_world)).unwrap_or(DVec3::from_array(camera.target));
+    let radius = radius_covering(&view, &store, center, camera.scene_radius.max(1e-12), target_samples);
+    let settings = BrushSettings {
+        tool: Tool::Paint,
+        blend: BlendMode::Mix,
+        strength: 0.5,
+        falloff: Falloff::Smooth,
+        occlusion: false,
+        backface_culling: false,
+        mirror_x: false,
+        ..BrushSettings::default()
+    };
+    let mut painter = Painter::new(positions);
+    let mut row = measure_dabs(&view, &mut store, &mut painter, settings, (center, radius), dabs, false)?;
+    row["radius_world"] = radius.into();
+    Ok(row)
+}
+
+/// Rays through a `grid × grid` lattice of pixel centres of a `viewport_px` view from
+/// `camera` that hit the mesh (as `reference` finds): the picks every BVH preset is timed on.
+pub(crate) fn pick_rays(
     camera: &OrbitCamera,
+    viewport_px: [u32; 2],
+    grid: u32,
     reference: &MeshBvh,
-    options: &PaintBenchOptions,
-) -> Vec<serde_json::Value> {
-    // Pixels on the mesh, on a grid over the viewport (for picks).
-    let [width, height] = options.viewport_px;
-    let grid = 64u32;
+) -> Vec<(DVec3, DVec3)> {
+    let [width, height] = viewport_px;
     let mut on_mesh = Vec::new();
     for gy in 0..grid {
         for gx in 0..grid {
@@ -156,6 +189,20 @@ fn bvh_presets(
             }
         }
     }
+    on_mesh
+}
+
+/// Build and pick time of every BVH preset, and its hits, on rays through a grid of pixels
+/// that hit the mesh (found with `reference`).
+fn bvh_presets(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    camera: &OrbitCamera,
+    reference: &MeshBvh,
+    options: &PaintBenchOptions,
+) -> Vec<serde_json::Value> {
+    // Pixels on the mesh, on a grid over the viewport (for picks).
+    let on_mesh = pick_rays(camera, options.viewport_px, 64, reference);
     let mut presets = Vec::new();
     for preset in BvhPreset::ALL {
         let (build, bvh) = Timing::measure(1, || MeshBvh::build(positions, triangles, preset));

@@ -100,46 +100,41 @@ fn synthetic_texture(size: u32) -> Texture {
     Texture { width: size, height: size, rgba8_srgb }
 }
 
-/// Runs the benchmark on `document` (opened from `path`, which is re-imported for its UVs).
-pub fn bench_render(
-    path: &std::path::Path,
-    document: &Document,
+/// Times frames the way every benchmark does: one unlit render pass into an offscreen
+/// target of a fixed size, submitted and waited for (`poll(wait)`).
+pub struct FrameTimer<'a> {
+    gpu: &'a Gpu,
+    color_view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
     width: u32,
     height: u32,
-    frames: usize,
-) -> Result<RenderBench, BenchRenderError> {
-    let gpu = Gpu::new_headless()?;
-    let (ctx, renderer) = (&*gpu.ctx, &gpu.renderer);
-    let packed = document.pack(ColorFormat::Rgba8Srgb)?;
-    let mesh = gpu.upload(&packed)?;
+}
 
-    let (baseline_name, baseline) = baseline(&gpu, path, document)?;
+impl<'a> FrameTimer<'a> {
+    /// Targets of `width × height` on `gpu`.
+    pub fn new(gpu: &'a Gpu, width: u32, height: u32) -> Self {
+        let ctx = &*gpu.ctx;
+        let color = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("bench colour"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: OFFSCREEN_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let depth = Renderer::create_depth_texture(ctx, width, height);
+        let color_view = color.create_view(&wgpu::TextureViewDescriptor::default());
+        let depth_view = depth.create_view(&wgpu::TextureViewDescriptor::default());
+        FrameTimer { gpu, color_view, depth_view, width, height }
+    }
 
-    let camera: OrbitCamera = default_camera(mesh.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
-    let color = ctx.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("bench colour"),
-        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: OFFSCREEN_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-        view_formats: &[],
-    });
-    let depth = Renderer::create_depth_texture(ctx, width, height);
-    let color_view = color.create_view(&wgpu::TextureViewDescriptor::default());
-    let depth_view = depth.create_view(&wgpu::TextureViewDescriptor::default());
-    let target = RenderTarget { color: &color_view, depth: &depth_view, width, height };
-
-    let filters = [
-        ("nearest", FilterMode::Nearest),
-        ("linear", FilterMode::Linear),
-        ("mip-1", FilterMode::MipLevel(1)),
-        ("trilinear", FilterMode::Trilinear),
-    ];
-    let paths = 1 + filters.len();
-    let mut times: Vec<Vec<f64>> = vec![Vec::with_capacity(frames); paths];
-    let frame = |item: DrawItem<'_>, filter: FilterMode| -> f64 {
+    /// Seconds of one unlit frame of `item` with `filter` seen by `camera`.
+    pub fn frame(&self, item: DrawItem<'_>, filter: FilterMode, camera: OrbitCamera) -> f64 {
+        let (ctx, renderer) = (&*self.gpu.ctx, &self.gpu.renderer);
+        let target =
+            RenderTarget { color: &self.color_view, depth: &self.depth_view, width: self.width, height: self.height };
         let mut settings = RenderSettings::new(camera);
         settings.filter = filter;
         settings.shading = Shading::Unlit;
@@ -150,7 +145,36 @@ pub fn bench_render(
         // A failed wait leaves the timing as measured so far; the report still compares.
         let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
         start.elapsed().as_secs_f64()
-    };
+    }
+}
+
+/// Runs the benchmark on `document` (opened from `path`, which is re-imported for its UVs).
+pub fn bench_render(
+    path: &std::path::Path,
+    document: &Document,
+    width: u32,
+    height: u32,
+    frames: usize,
+) -> Result<RenderBench, BenchRenderError> {
+    let gpu = Gpu::new_headless()?;
+    let ctx = &*gpu.ctx;
+    let packed = document.pack(ColorFormat::Rgba8Srgb)?;
+    let mesh = gpu.upload(&packed)?;
+
+    let (baseline_name, baseline) = baseline(&gpu, path, document)?;
+
+    let camera: OrbitCamera = default_camera(mesh.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
+    let timer = FrameTimer::new(&gpu, width, height);
+
+    let filters = [
+        ("nearest", FilterMode::Nearest),
+        ("linear", FilterMode::Linear),
+        ("mip-1", FilterMode::MipLevel(1)),
+        ("trilinear", FilterMode::Trilinear),
+    ];
+    let paths = 1 + filters.len();
+    let mut times: Vec<Vec<f64>> = vec![Vec::with_capacity(frames); paths];
+    let frame = |item: DrawItem<'_>, filter: FilterMode| timer.frame(item, filter, camera);
     // One warm-up frame per path (pipeline and cache warm-up), then interleaved rounds.
     frame(DrawItem::Baseline(&baseline), FilterMode::Linear);
     for (_, filter) in filters {
@@ -190,7 +214,7 @@ pub fn bench_render(
 /// The baseline of `document`: the file's own UVs and texture when it has them, else a
 /// planar projection onto a synthetic texture of as many texels as the document has
 /// samples. Returns its name for the report and the mesh.
-fn baseline(
+pub(crate) fn baseline(
     gpu: &Gpu,
     path: &std::path::Path,
     document: &Document,

@@ -1,4 +1,4 @@
-//! `meshpaint bench pack | render | paint | adaptive | extremes`: measurements printed as JSON.
+//! `meshpaint bench pack | render | paint | adaptive | trade | extremes`: measurements printed as JSON.
 
 use std::path::PathBuf;
 
@@ -55,6 +55,40 @@ pub(super) enum BenchCommand {
         #[arg(long, default_value_t = 3)]
         views: u32,
     },
+    /// What every choice costs and buys: filter × resolution (uniform R 1…32 and --error
+    /// bounds) × colour format, per view at several distances — PSNR, max error, FLIP against a
+    /// 4×4-supersampled reference, samples, GPU bytes, pack time, frame-time ratio to the UV
+    /// baseline (interleaved), dab throughput; plus seam jumps and BVH presets. One JSON object
+    /// per line; with --out, error-vs-cost plots (PNG).
+    Trade {
+        /// A .glb / .gltf file (textured: the UV render is the reference) or a packed file.
+        file: PathBuf,
+        /// View directions around the model (each at near, mid, far and tiny distances).
+        #[arg(long, default_value_t = 1)]
+        views: u32,
+        /// Write the plots trade_<name>_bytes.png and trade_<name>_frame.png into DIR.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// The largest R the --error bounds give a face.
+        #[arg(long, default_value_t = 64)]
+        max_resolution: u64,
+        /// Image side in pixels (the reference is rendered at 4× and box-filtered).
+        #[arg(long, default_value_t = 256)]
+        size: u32,
+        /// Largest uniform R measured (powers of two from 1).
+        #[arg(long, default_value_t = 32)]
+        max_uniform: u64,
+        /// Interleaved timing rounds per view.
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+        /// The --error bounds measured (comma-separated; textured glTF only).
+        #[arg(long, value_delimiter = ',', default_values_t = [0.05f32, 0.02, 0.01, 0.005])]
+        errors: Vec<f32>,
+        /// Leave out the numerical extremes (`bench extremes`), which the report includes
+        /// after the configurations (`"bench": "extremes"` rows).
+        #[arg(long)]
+        no_extremes: bool,
+    },
     /// Picking and painting: BVH presets, pick latency, dab time and samples/s for brushes
     /// covering ~1k / 10k / 100k samples, upload bytes per dab, repack time.
     Paint {
@@ -84,6 +118,40 @@ pub(super) enum BenchCommand {
 pub(super) fn run(what: BenchCommand) -> Result<()> {
     match what {
         BenchCommand::Extremes { json } => extremes(json),
+        BenchCommand::Trade { file, views, out, max_resolution, size, max_uniform, frames, errors, no_extremes } => {
+            use meshpaint::colors::layout::Resolution;
+            anyhow::ensure!(size >= 8, "--size must be at least 8");
+            anyhow::ensure!(errors.iter().all(|e| e.is_finite() && *e >= 0.0), "--errors must be numbers ≥ 0");
+            let max_uniform = Resolution::new(max_uniform).context("--max-uniform")?;
+            let options = meshpaint::bench::trade::TradeOptions {
+                views,
+                size,
+                max_resolution: Resolution::new(max_resolution).context("--max-resolution")?,
+                uniform: (0..=max_uniform.log2()).filter_map(|l| Resolution::from_log2(l).ok()).collect(),
+                frames,
+                error_bounds: errors,
+                ..Default::default()
+            };
+            let rows = meshpaint::bench::trade::bench_trade(&file, &options)?;
+            for row in &rows {
+                println!("{row}");
+            }
+            if !no_extremes {
+                let gpu = meshpaint::render::Gpu::new_headless()?;
+                for mut row in meshpaint::bench::extremes::extremes_rows(&gpu)? {
+                    row["bench"] = "extremes".into();
+                    println!("{row}");
+                }
+            }
+            if let Some(dir) = out {
+                std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+                let stem = file.file_stem().map_or("mesh".to_owned(), |s| s.to_string_lossy().to_lowercase());
+                for written in meshpaint::bench::trade::write_plots(&rows, &dir, &stem)? {
+                    eprintln!("wrote {}", written.display());
+                }
+            }
+            Ok(())
+        }
         BenchCommand::Adaptive { file, max_resolution, size, views } => {
             let max = meshpaint::colors::layout::Resolution::new(max_resolution).context("--max-resolution")?;
             let scene = meshpaint::mesh::import::import_gltf(&file)?;

@@ -6,7 +6,9 @@ use std::sync::Arc;
 
 use image::RgbaImage;
 
-use super::{BaselineMesh, DrawItem, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderError};
+use super::{
+    BaselineMesh, BaselineSource, DrawItem, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderError,
+};
 use super::{RenderSettings, Renderer};
 use crate::mesh::scene::Scene;
 use crate::mesh::weld::weld_scene;
@@ -38,26 +40,43 @@ impl Gpu {
         GpuMesh::upload(&self.ctx, &self.renderer, packed, &MeshUploadOptions::default())
     }
 
-    /// Uploads the UV-texture baseline of `scene`: its welded mesh with the first material
-    /// that has a base-colour texture. `None` when no material has one.
+    /// Uploads the UV-texture baseline of `scene`: its welded mesh, every face with its own
+    /// material — `baseColorFactor` × base-colour texture (× COLOR_0 where the file has
+    /// vertex colours), faces whose material has no texture at their factor, faces without a
+    /// material white (glTF's default material). `None` when no material has a texture.
     pub fn upload_baseline(&self, scene: &Scene) -> Result<Option<BaselineMesh>, RenderError> {
-        let Some((material, texture)) = scene.materials.iter().find_map(|material| {
-            let texture = scene.textures.get(material.base_color_texture? as usize)?;
-            Some((material, texture))
-        }) else {
+        let textured =
+            |m: &crate::mesh::scene::Material| m.base_color_texture.filter(|&t| (t as usize) < scene.textures.len());
+        if !scene.materials.iter().any(|m| textured(m).is_some()) {
             return Ok(None);
-        };
+        }
         let welded = weld_scene(scene);
-        let mesh = BaselineMesh::new(
-            &self.ctx,
-            &self.renderer,
-            &welded.positions_world,
-            &welded.triangles,
-            &welded.corner_uvs,
-            texture,
-            material.base_color_factor,
-        )?;
-        Ok(Some(mesh))
+        let material = |face: usize| {
+            welded.triangle_materials.get(face).copied().flatten().and_then(|m| scene.materials.get(m as usize))
+        };
+        let face_textures: Vec<Option<u32>> =
+            (0..welded.triangles.len()).map(|face| material(face).and_then(textured)).collect();
+        let corner_colors: Vec<[[f32; 4]; 3]> = welded
+            .triangles
+            .iter()
+            .enumerate()
+            .map(|(face, corners)| {
+                let factor = material(face).map_or([1.0; 4], |m| m.base_color_factor);
+                corners.map(|v| {
+                    let vertex = welded.vertex_colors.get(v as usize).copied().unwrap_or([1.0; 4]);
+                    std::array::from_fn(|c| factor[c] * vertex[c])
+                })
+            })
+            .collect();
+        let source = BaselineSource {
+            positions: &welded.positions_world,
+            triangles: &welded.triangles,
+            corner_uvs: &welded.corner_uvs,
+            corner_colors: &corner_colors,
+            face_textures: &face_textures,
+            textures: &scene.textures,
+        };
+        Ok(Some(BaselineMesh::from_source(&self.ctx, &self.renderer, &source)?))
     }
 
     /// Renders `item` offscreen at `width`×`height` and reads it back (sRGB RGBA8).

@@ -42,7 +42,7 @@ mod readback;
 mod renderer;
 mod uniforms;
 
-pub use baseline::{BaselineMesh, BaselineVertex, mip_chain_linear};
+pub use baseline::{BaselineMesh, BaselineSource, BaselineVertex, mip_chain_linear};
 pub use context::{GpuContext, backends_from_env};
 pub use gpu::Gpu;
 pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshUploadOptions, atlas_texture_format, default_atlas_width};

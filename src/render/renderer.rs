@@ -416,7 +416,6 @@ impl Renderer {
                 uniforms.vertex_count = mesh.vertex_count;
             }
             DrawItem::Baseline(mesh) => {
-                uniforms.tint = mesh.base_color_factor;
                 uniforms.face_count = mesh.vertex_count / 3;
             }
         }
@@ -436,12 +435,11 @@ impl Renderer {
     ) {
         let (color, depth) = (target.color, target.depth);
         let uniforms = Self::uniforms(item, settings, target.width, target.height);
-        let (uniform_buffer, bind_group, pipeline, vertex_count) = match item {
+        let (uniform_buffer, pipeline) = match item {
             DrawItem::MeshColors(mesh) => {
-                let pipeline = &self.mesh_pipelines[mesh_pipeline_index(uniforms.filter_kind, uniforms.level_mode)];
-                (&mesh.uniforms, &mesh.bind_group, pipeline, mesh.face_count.saturating_mul(3))
+                (&mesh.uniforms, &self.mesh_pipelines[mesh_pipeline_index(uniforms.filter_kind, uniforms.level_mode)])
             }
-            DrawItem::Baseline(mesh) => (&mesh.uniforms, &mesh.bind_group, &self.baseline_pipeline, mesh.vertex_count),
+            DrawItem::Baseline(mesh) => (&mesh.uniforms, &self.baseline_pipeline),
         };
         ctx.queue.write_buffer(uniform_buffer, 0, bytemuck::bytes_of(&uniforms));
         let [r, g, b, a] = settings.background.map(f64::from);
@@ -466,12 +464,24 @@ impl Renderer {
             multiview_mask: None,
         });
         pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, bind_group, &[]);
-        if let DrawItem::Baseline(mesh) = item {
-            pass.set_vertex_buffer(0, mesh.vertex_buffer().slice(..));
-        }
-        if vertex_count > 0 {
-            pass.draw(0..vertex_count, 0..1);
+        match item {
+            DrawItem::MeshColors(mesh) => {
+                pass.set_bind_group(0, &mesh.bind_group, &[]);
+                let vertex_count = mesh.face_count.saturating_mul(3);
+                if vertex_count > 0 {
+                    pass.draw(0..vertex_count, 0..1);
+                }
+            }
+            DrawItem::Baseline(mesh) => {
+                pass.set_vertex_buffer(0, mesh.vertex_buffer().slice(..));
+                // One draw per texture (the uniforms are shared).
+                for (bind_group, vertices) in mesh.draws() {
+                    pass.set_bind_group(0, bind_group, &[]);
+                    if !vertices.is_empty() {
+                        pass.draw(vertices, 0..1);
+                    }
+                }
+            }
         }
     }
 

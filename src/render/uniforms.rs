@@ -16,7 +16,7 @@ pub struct FrameUniforms {
     pub light: [f32; 4],
     /// Wireframe colour, linear RGBA (alpha = line opacity).
     pub wire_color: [f32; 4],
-    /// Multiplies the base colour (the baseline's glTF `baseColorFactor`; 1 for mesh colors).
+    /// Multiplies the base colour (1 for both pipelines; the baseline's `baseColorFactor` is per vertex).
     pub tint: [f32; 4],
     /// Trilinear level of detail (src/packing/lod.rs): xyz the camera's eye relative to the
     /// render origin, w `κ = 2 tan(fov_y / 2) / height`, the world size of a pixel at unit depth.
