@@ -9,8 +9,6 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::trade::pareto_front;
-
 /// One configuration on a plot.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlotPoint {
@@ -89,6 +87,8 @@ fn filter_color(filter: &str) -> RGBColor {
 /// Writes a PNG of `points` (`x_label` on a log axis when `log_x`) with the Pareto front
 /// (least cost, most quality) as a black line and labelled points; `reference`, if given, is
 /// drawn as a black star (the UV-texture baseline).
+/// Long: one plotters chart (axes, front, points, labels, legend) whose builder calls
+/// share the drawing area and coordinate system; split, each part would take them all.
 pub fn plot_tradeoff(
     path: &Path,
     title: &str,
@@ -224,4 +224,28 @@ pub fn plot_tradeoff(
     .map_err(|e| draw_error(e.to_string()))?;
     root.present().map_err(|e| draw_error(e.to_string()))?;
     Ok(())
+}
+
+/// Indices of the points of `points` (`(cost, quality)`) on the Pareto front: no other point
+/// costs at most as much with at least the quality, one of the two strictly. Sorted by cost.
+/// Points with a NaN coordinate are never on it.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..points.len()).filter(|&i| !points[i].0.is_nan() && !points[i].1.is_nan()).collect();
+    // Cheapest first; among equal costs the best quality first.
+    order.sort_by(|&a, &b| points[a].0.total_cmp(&points[b].0).then(points[b].1.total_cmp(&points[a].1)));
+    let mut front = Vec::new();
+    let mut best = f64::NEG_INFINITY;
+    let mut last_cost = f64::NAN;
+    for i in order {
+        let (cost, quality) = points[i];
+        if quality > best {
+            front.push(i);
+            best = quality;
+            last_cost = cost;
+        } else if quality == best && cost == last_cost {
+            // An exact duplicate of a front point is not dominated either.
+            front.push(i);
+        }
+    }
+    front
 }

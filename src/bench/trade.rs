@@ -53,6 +53,7 @@ use image::RgbaImage;
 
 use crate::bench::adaptive::{Supersampled, psnr_over, render_supersampled};
 use crate::bench::pack::Timing;
+pub use crate::bench::plot::pareto_front;
 use crate::bench::plot::{PlotError, PlotPoint, plot_tradeoff};
 use crate::bench::render::FrameTimer;
 use crate::bench::{BenchRenderError, paint};
@@ -162,30 +163,6 @@ pub fn compare(reference: &RgbaImage, test: &RgbaImage, mask: &[bool]) -> ImageE
     ImageError { psnr_db, max_error_steps, flip_mean, pixels }
 }
 
-/// Indices of the points of `points` (`(cost, quality)`) on the Pareto front: no other point
-/// costs at most as much with at least the quality, one of the two strictly. Sorted by cost.
-/// Points with a NaN coordinate are never on it.
-pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..points.len()).filter(|&i| !points[i].0.is_nan() && !points[i].1.is_nan()).collect();
-    // Cheapest first; among equal costs the best quality first.
-    order.sort_by(|&a, &b| points[a].0.total_cmp(&points[b].0).then(points[b].1.total_cmp(&points[a].1)));
-    let mut front = Vec::new();
-    let mut best = f64::NEG_INFINITY;
-    let mut last_cost = f64::NAN;
-    for i in order {
-        let (cost, quality) = points[i];
-        if quality > best {
-            front.push(i);
-            best = quality;
-            last_cost = cost;
-        } else if quality == best && cost == last_cost {
-            // An exact duplicate of a front point is not dominated either.
-            front.push(i);
-        }
-    }
-    front
-}
-
 /// One camera of the study.
 #[derive(Debug, Clone, Copy)]
 struct View {
@@ -240,6 +217,9 @@ struct Packed {
 /// `baseline` row per view (textured input), one `config` row per configuration and view, one
 /// `seam` row per resolution choice with mixed resolutions, filter and level, one `bvh` row
 /// per preset.
+/// Long: the study's one pass (choices → packs → interleaved frames → per-view errors →
+/// seams → BVH rows) keeps the GPU, references and timers in scope; its stages are the
+/// helpers below.
 pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json::Value>, BenchRenderError> {
     let gpu = Gpu::new_headless()?;
     let budget = Budget::from_environment().with_gpu(gpu.budget_limits());

@@ -203,40 +203,7 @@ impl BaselineMesh {
 
         let bounds = BoundingSphere::of_points(positions);
         let origin = DVec3::from_array(bounds.center);
-        let relative = |v: u32| -> Result<Vec3, RenderError> {
-            let p = positions.get(v as usize).ok_or_else(|| {
-                RenderError::InvalidMesh(format!("vertex {v} out of range ({} vertices)", positions.len()))
-            })?;
-            Ok((DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - origin).as_vec3())
-        };
-        let vertex_normals = crate::mesh::normals::vertex_normals(positions, triangles);
-        // Faces in texture order (untextured first), so each texture draws one vertex range.
-        let mut order: Vec<usize> = (0..triangles.len()).collect();
-        order.sort_by_key(|&face| texture_of(face));
-        let mut vertices = Vec::with_capacity(vertex_total);
-        let mut ranges: Vec<(Option<u32>, std::ops::Range<u32>)> = Vec::new();
-        for &face in &order {
-            let key = texture_of(face);
-            let first = vertices.len() as u32;
-            match ranges.last_mut() {
-                Some((last, range)) if *last == key => range.end = first + 3,
-                _ => ranges.push((key, first..first + 3)),
-            }
-            let corners = triangles[face];
-            let p = [relative(corners[0])?, relative(corners[1])?, relative(corners[2])?];
-            let n = (p[1] - p[0]).cross(p[2] - p[0]);
-            let normal = if n.length() > 0.0 && n.length().is_finite() { n.normalize() } else { Vec3::Z };
-            for k in 0..3 {
-                let vertex_normal = vertex_normals.get(corners[k] as usize).map_or([0.0; 3], |n| n.map(|x| x as f32));
-                vertices.push(BaselineVertex {
-                    position: p[k].to_array(),
-                    uv: corner_uvs[face][k],
-                    normal: normal.to_array(),
-                    color: corner_colors[face][k],
-                    corner_normal: crate::mesh::normals::smooth_corner_normal(vertex_normal, normal.to_array()),
-                });
-            }
-        }
+        let (vertices, ranges) = baseline_vertices(source, origin, texture_of)?;
         let bytes = (vertices.len() * std::mem::size_of::<BaselineVertex>()) as u64;
         if bytes > limits.max_buffer_size {
             return Err(RenderError::BufferTooLarge {
@@ -364,4 +331,50 @@ fn upload_texture(ctx: &GpuContext, texture: &Texture) -> wgpu::Texture {
         );
     }
     gpu_texture
+}
+
+/// The baseline's vertices, three per face in texture order (untextured first), positions
+/// relative to `origin`, with the vertex range each texture draws.
+#[allow(clippy::type_complexity)]
+fn baseline_vertices(
+    source: &BaselineSource<'_>,
+    origin: DVec3,
+    texture_of: impl Fn(usize) -> Option<u32>,
+) -> Result<(Vec<BaselineVertex>, Vec<(Option<u32>, std::ops::Range<u32>)>), RenderError> {
+    let BaselineSource { positions, triangles, corner_uvs, corner_colors, .. } = *source;
+    let relative = |v: u32| -> Result<Vec3, RenderError> {
+        let p = positions.get(v as usize).ok_or_else(|| {
+            RenderError::InvalidMesh(format!("vertex {v} out of range ({} vertices)", positions.len()))
+        })?;
+        Ok((DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - origin).as_vec3())
+    };
+    let vertex_normals = crate::mesh::normals::vertex_normals(positions, triangles);
+    // Faces in texture order (untextured first), so each texture draws one vertex range.
+    let mut order: Vec<usize> = (0..triangles.len()).collect();
+    order.sort_by_key(|&face| texture_of(face));
+    let mut vertices = Vec::with_capacity(triangles.len() * 3);
+    let mut ranges: Vec<(Option<u32>, std::ops::Range<u32>)> = Vec::new();
+    for &face in &order {
+        let key = texture_of(face);
+        let first = vertices.len() as u32;
+        match ranges.last_mut() {
+            Some((last, range)) if *last == key => range.end = first + 3,
+            _ => ranges.push((key, first..first + 3)),
+        }
+        let corners = triangles[face];
+        let p = [relative(corners[0])?, relative(corners[1])?, relative(corners[2])?];
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        let normal = if n.length() > 0.0 && n.length().is_finite() { n.normalize() } else { Vec3::Z };
+        for k in 0..3 {
+            let vertex_normal = vertex_normals.get(corners[k] as usize).map_or([0.0; 3], |n| n.map(|x| x as f32));
+            vertices.push(BaselineVertex {
+                position: p[k].to_array(),
+                uv: corner_uvs[face][k],
+                normal: normal.to_array(),
+                color: corner_colors[face][k],
+                corner_normal: crate::mesh::normals::smooth_corner_normal(vertex_normal, normal.to_array()),
+            });
+        }
+    }
+    Ok((vertices, ranges))
 }
