@@ -144,6 +144,9 @@ struct Running {
     last_logged_viewport: Option<([i32; 2], [u32; 2])>,
     /// What the 3D view's target holds: it is redrawn only when this changes.
     drawn_view: Option<(crate::render::RenderSettings, [u32; 2], u64)>,
+    /// UI passes run so far, and where to write that count after each one
+    /// (`MESHPAINT_FRAME_COUNT_FILE`, for the idle test: at rest the count must not grow).
+    frame_count: (u64, Option<std::path::PathBuf>),
 }
 
 impl Shell {
@@ -226,6 +229,7 @@ impl Shell {
             editor,
             last_logged_viewport: None,
             drawn_view: None,
+            frame_count: (0, std::env::var_os("MESHPAINT_FRAME_COUNT_FILE").map(std::path::PathBuf::from)),
         })
     }
 }
@@ -285,6 +289,11 @@ impl Running {
         }
         if drawn {
             self.editor.frame_stats.record(started.elapsed());
+        }
+        self.frame_count.0 += 1;
+        if let Some(path) = &self.frame_count.1 {
+            // Written in place (not atomically): the test only reads a number that grows.
+            let _ = std::fs::write(path, self.frame_count.0.to_string());
         }
         Ok(repaint_delay)
     }

@@ -2,10 +2,12 @@
 //! each measures what the editor really does.
 
 pub mod adaptive;
+pub mod load;
 pub mod pack;
 pub mod paint;
 pub mod render;
 
+pub use load::{BenchLoadError, bench_load};
 pub use pack::{Timing, bench_pack};
 pub use paint::{PaintBenchOptions, bench_paint};
 pub use render::{BenchRenderError, ModeTiming, RenderBench, bench_render};

@@ -137,6 +137,33 @@ impl ColorFormat {
         }
     }
 
+    /// Encodes `color` (clamped) into `out` (`bytes_per_sample` long) and returns what
+    /// decoding those bytes gives, i.e. [`ColorFormat::quantize`] with the encoding done once.
+    #[inline]
+    pub fn encode_quantized(self, color: Rgba, out: &mut [u8]) -> Rgba {
+        let color = clamp_color(color);
+        match self {
+            ColorFormat::Rgba8Srgb => {
+                let bytes = encode_rgba8_srgb(color);
+                out.copy_from_slice(&bytes);
+                decode_rgba8_srgb(bytes)
+            }
+            ColorFormat::Rgba16F => {
+                let halves = color.map(f16::from_f32);
+                for (pair, half) in out.chunks_exact_mut(2).zip(halves) {
+                    pair.copy_from_slice(&half.to_bits().to_le_bytes());
+                }
+                halves.map(f16::to_f32)
+            }
+            ColorFormat::Rgba32F => {
+                for (quad, channel) in out.chunks_exact_mut(4).zip(color) {
+                    quad.copy_from_slice(&channel.to_le_bytes());
+                }
+                color
+            }
+        }
+    }
+
     /// Encodes `colors` (each clamped by [`clamp_color`]) into `out`, which must be exactly
     /// `colors.len() * bytes_per_sample()` long (extra input or output is ignored).
     pub fn encode_slice(self, colors: &[Rgba], out: &mut [u8]) {
@@ -197,7 +224,19 @@ fn srgb_tables() -> &'static SrgbTables {
         let to_linear = |encoded: f64| {
             if encoded <= 0.040_45 { encoded / 12.92 } else { ((encoded + 0.055) / 1.055).powf(2.4) }
         };
-        let thresholds: [f32; 255] = std::array::from_fn(|b| to_linear((b as f64 + 0.5) / 255.0) as f32);
+        // Each threshold is the smallest f32 at or above the exact (f64) boundary, so
+        // "reaches the threshold" is exactly "the f64 formula rounds up" for every f32.
+        let thresholds: [f32; 255] = std::array::from_fn(|b| {
+            let exact = to_linear((b as f64 + 0.5) / 255.0);
+            let mut t = exact as f32;
+            while f64::from(t) < exact {
+                t = t.next_up();
+            }
+            while f64::from(t.next_down()) >= exact {
+                t = t.next_down();
+            }
+            t
+        });
         let guess = (0..=GUESS_STEPS)
             .map(|k| {
                 let linear = k as f32 / GUESS_STEPS as f32;

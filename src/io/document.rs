@@ -186,6 +186,17 @@ pub enum SourceKind {
     Packed(ColorFormat),
 }
 
+/// How long the phases of [`Document::from_scene_phased`] took.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct OpenPhases {
+    /// Welding the scene into one indexed mesh.
+    pub weld: Duration,
+    /// Building the topology (edges, incidence).
+    pub topology: Duration,
+    /// Allocating and colouring the store (budget check, bake or fill, vertex colours).
+    pub store: Duration,
+}
+
 /// An open mesh with its editable colours.
 #[derive(Debug, Clone)]
 pub struct Document {
@@ -417,10 +428,25 @@ impl Document {
         name: &Path,
         budget: &Budget,
     ) -> Result<Self, DocumentError> {
+        Self::from_scene_phased(scene, rule, name, budget, &mut OpenPhases::default())
+    }
+
+    /// [`Document::from_scene_within`], recording how long each phase took in `phases`
+    /// (`meshpaint bench load`).
+    pub fn from_scene_phased(
+        scene: Scene,
+        rule: impl Into<ResolutionRule>,
+        name: &Path,
+        budget: &Budget,
+        phases: &mut OpenPhases,
+    ) -> Result<Self, DocumentError> {
         let rule = rule.into();
         let budget_error = |source| DocumentError::Budget { path: name.to_owned(), source };
         budget.check_triangles("the scene", scene.instanced_triangle_count() as u64).map_err(budget_error)?;
+        let started = Instant::now();
         let welded = weld_scene(&scene);
+        phases.weld = started.elapsed();
+        let started = Instant::now();
         if let Some((vertex, position)) =
             (0u64..).zip(&welded.positions_world).find(|(_, p)| !p.iter().all(|c| c.is_finite()))
         {
@@ -428,6 +454,8 @@ impl Document {
         }
         let topology = Topology::build(welded.positions_world.len() as u32, &welded.triangles)
             .map_err(|source| DocumentError::Topology { path: name.to_owned(), source })?;
+        phases.topology = started.elapsed();
+        let started = Instant::now();
         let resolutions = match rule {
             ResolutionRule::Uniform(r) => {
                 let counts = SampleCounts::uniform_on(&topology, r);
@@ -458,6 +486,7 @@ impl Document {
             apply_vertex_colors(&mut store, &welded.vertex_colors, has_base_color);
         }
         store.take_dirty();
+        phases.store = started.elapsed();
         Ok(Document {
             positions: welded.positions_world,
             store,

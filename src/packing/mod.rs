@@ -8,6 +8,7 @@
 //! | [`packer`] | store → linear (MIP chains, eq. 2.5/2.6) and linear → store |
 //! | [`paint_layout`] | paint mode: level 0 in blocks with slack; dirty ranges and patched records |
 //! | [`lod`] | the level of detail of trilinear filtering, continuous over the mesh (per-vertex density and normal) |
+//! | [`reference`] | the straightforward serial packer the fast and incremental ones are tested against byte for byte |
 //! | [`sampler`] | the CPU reference sampler (nearest, linear, MIP level) on the store and on packed buffers: the truth the GPU is tested against |
 //! | [`file`] | the packed file format (docs/FORMAT.md): writer and hostile-input-proof reader |
 
@@ -16,8 +17,9 @@ pub mod linear;
 pub mod lod;
 pub mod packer;
 pub mod paint_layout;
+pub mod reference;
 pub mod sampler;
 
 pub use linear::{FaceRecord, PackedMesh};
-pub use packer::{PackError, pack};
+pub use packer::{PackCache, PackError, pack};
 pub use paint_layout::PaintLayout;
