@@ -147,6 +147,8 @@ struct Running {
     /// UI passes run so far, and where to write that count after each one
     /// (`MESHPAINT_FRAME_COUNT_FILE`, for the idle test: at rest the count must not grow).
     frame_count: (u64, Option<std::path::PathBuf>),
+    /// The window title last set.
+    title: String,
 }
 
 impl Shell {
@@ -230,6 +232,7 @@ impl Shell {
             last_logged_viewport: None,
             drawn_view: None,
             frame_count: (0, std::env::var_os("MESHPAINT_FRAME_COUNT_FILE").map(std::path::PathBuf::from)),
+            title: "meshpaint".to_owned(),
         })
     }
 }
@@ -260,9 +263,12 @@ impl Running {
         let editor = &mut self.editor;
         let full_output = self.egui_ctx.run_ui(raw_input, |ui| editor.ui(ui));
         self.egui_state.handle_platform_output(&self.window, full_output.platform_output);
+        // Compared with what we last set: winit's `Window::title` is always empty on X11,
+        // so comparing with it re-set WM_NAME on every frame.
         let title = self.editor.window_title();
-        if self.window.title() != title {
+        if self.title != title {
             self.window.set_title(&title);
+            self.title = title;
         }
         if self.editor.quit_requested {
             event_loop.exit();
@@ -421,7 +427,9 @@ impl ApplicationHandler<UserEvent> for Shell {
             return;
         }
         let response = running.egui_state.on_window_event(&running.window, &event);
-        if response.repaint {
+        // egui-winit answers `repaint: true` to RedrawRequested itself: asking for another
+        // redraw then drew frame after frame for ever (the idle editor's busy CPU).
+        if response.repaint && !matches!(event, WindowEvent::RedrawRequested) {
             running.window.request_redraw();
         }
         match event {
