@@ -224,6 +224,12 @@ fn srgb8_lookup_equals_the_exact_formula_on_every_f32_that_matters() {
         }
     }
     assert!(checked > 17_000_000, "{checked}");
+    // Alpha: linear 8-bit unorm, rounded half away from zero, on the same stride.
+    for bits in (0..=one).step_by(61).chain([0.5f32 / 255.0, 1.5 / 255.0, 254.5 / 255.0].map(f32::to_bits)) {
+        let a = f32::from_bits(bits);
+        let want = (a * 255.0).round() as u8;
+        assert_eq!(meshpaint::colors::format::encode_rgba8_srgb([0.0, 0.0, 0.0, a])[3], want, "alpha {a:e}");
+    }
     assert_eq!(encode_srgb8(1.0), 255);
     assert_eq!(encode_srgb8(0.0), 0);
 }
