@@ -140,7 +140,8 @@ impl Editor {
             let pack_time = started.elapsed();
             job.progress(0.7, "uploading to the GPU");
             let packed = cache.packed();
-            let upload_error = |error: crate::render::RenderError| format!("uploading the repacked buffers failed: {error}");
+            let upload_error =
+                |error: crate::render::RenderError| format!("uploading the repacked buffers failed: {error}");
             let gpu_mesh = match (gpu, compact_gpu_mesh, &ranges) {
                 (Some(gpu), Some(mesh), Some(ranges)) => {
                     let size = packed.format.bytes_per_sample();

@@ -84,7 +84,8 @@ pub fn bench_load(
         },
         || {
             let started = Instant::now();
-            let bvh = MeshBvh::build(&document.positions, &document.store.topology().face_vertices, BvhPreset::FastBuild);
+            let bvh =
+                MeshBvh::build(&document.positions, &document.store.topology().face_vertices, BvhPreset::FastBuild);
             (bvh, started.elapsed())
         },
     );

@@ -190,7 +190,12 @@ pub(super) fn open(path: &Path, resolution: ResolutionArg, budget: &Budget) -> R
 
 /// [`open`], after midpoint-subdividing a mesh file's scene `subdivide` times (how the
 /// benchmarks reach a million triangles); `subdivide = 0` is [`open`].
-pub(super) fn open_subdivided(path: &Path, resolution: ResolutionArg, subdivide: u32, budget: &Budget) -> Result<Document> {
+pub(super) fn open_subdivided(
+    path: &Path,
+    resolution: ResolutionArg,
+    subdivide: u32,
+    budget: &Budget,
+) -> Result<Document> {
     if subdivide == 0 {
         return open(path, resolution, budget);
     }

@@ -145,7 +145,8 @@ pub struct DirtyAccumulator {
 impl DirtyAccumulator {
     /// An empty accumulator for `topology`'s elements.
     pub fn new(topology: &Topology) -> Self {
-        let (v, e, f) = (topology.vertex_count as usize, topology.edge_count() as usize, topology.face_count() as usize);
+        let (v, e, f) =
+            (topology.vertex_count as usize, topology.edge_count() as usize, topology.face_count() as usize);
         DirtyAccumulator {
             vertices: DirtySet::new(v),
             edges: DirtySet::new(e),

@@ -304,7 +304,9 @@ impl Context<'_> {
     /// Writes level 0 of `edge` from the store and its encoding.
     fn edge_level0(&self, edge: u32, chain: &mut [Rgba], bytes: &mut [u8]) {
         let size = self.format.bytes_per_sample();
-        for ((slot, out), &color) in chain.iter_mut().zip(bytes.chunks_exact_mut(size)).zip(self.store.edge_samples(edge)) {
+        for ((slot, out), &color) in
+            chain.iter_mut().zip(bytes.chunks_exact_mut(size)).zip(self.store.edge_samples(edge))
+        {
             *slot = self.format.encode_quantized(color, out);
         }
     }
@@ -538,16 +540,19 @@ fn build_all(ctx: &Context, chains: &mut [Rgba], bytes: &mut [u8], vertex_edge: 
     let (edge_bytes, interior_bytes) = rest_bytes.split_at_mut((s.edge_end - s.vertex_end) * size);
     // Level 0 of vertices and edges (encoded once, here), every interior chain.
     let levels = s.levels;
-    vertex_colors.par_chunks_mut(levels).zip(vertex_bytes.par_chunks_mut(levels * size)).enumerate().for_each(
-        |(v, (chain, out))| ctx.vertex_level0(v as u32, chain, out),
-    );
+    vertex_colors
+        .par_chunks_mut(levels)
+        .zip(vertex_bytes.par_chunks_mut(levels * size))
+        .enumerate()
+        .for_each(|(v, (chain, out))| ctx.vertex_level0(v as u32, chain, out));
     let edge_base = |e: u32| {
         let len = store.edge_resolution(e).map_or(0, layout::edge_chain_len);
         (len > 0).then(|| layout.edge_base[e as usize] as usize)
     };
     let edge_len = |e: u32| store.edge_resolution(e).map_or(0, layout::edge_chain_len) as usize;
-    split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base).into_par_iter().for_each(
-        |block| {
+    split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base)
+        .into_par_iter()
+        .for_each(|block| {
             for e in block.ids.clone() {
                 if let Some(b) = edge_base(e) {
                     let at = b - block.offset;
@@ -555,8 +560,7 @@ fn build_all(ctx: &Context, chains: &mut [Rgba], bytes: &mut [u8], vertex_edge: 
                     ctx.edge_level0(e, &mut block.chains[at..at + len], &mut block.bytes[at * size..(at + len) * size]);
                 }
             }
-        },
-    );
+        });
     let interior_base = |f: u32| {
         let r = store.face_resolution(f).unwrap_or(Resolution::ONE);
         (layout::interior_chain_len(r) > 0).then(|| layout.interior_base[f as usize] as usize)
@@ -570,7 +574,11 @@ fn build_all(ctx: &Context, chains: &mut [Rgba], bytes: &mut [u8], vertex_edge: 
                 if let Some(b) = interior_base(f) {
                     let at = b - block.offset;
                     let len = interior_len(f);
-                    ctx.interior_chain(f, &mut block.chains[at..at + len], &mut block.bytes[at * size..(at + len) * size]);
+                    ctx.interior_chain(
+                        f,
+                        &mut block.chains[at..at + len],
+                        &mut block.bytes[at * size..(at + len) * size],
+                    );
                 }
             }
         });
@@ -626,17 +634,21 @@ fn build_all(ctx: &Context, chains: &mut [Rgba], bytes: &mut [u8], vertex_edge: 
         );
     }
     // Levels 1.. of edges and vertices, encoded once they are final.
-    split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base).into_par_iter().for_each(
-        |block| {
+    split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base)
+        .into_par_iter()
+        .for_each(|block| {
             for e in block.ids.clone() {
                 if let Some(b) = edge_base(e) {
                     let at = b - block.offset;
                     let len = edge_len(e);
-                    ctx.encode_edge_upper(e, &block.chains[at..at + len], &mut block.bytes[at * size..(at + len) * size]);
+                    ctx.encode_edge_upper(
+                        e,
+                        &block.chains[at..at + len],
+                        &mut block.bytes[at * size..(at + len) * size],
+                    );
                 }
             }
-        },
-    );
+        });
     if levels > 1 {
         vertex_colors.par_chunks(levels).zip(vertex_bytes.par_chunks_mut(levels * size)).for_each(|(chain, out)| {
             ctx.format.encode_slice(&chain[1..], &mut out[size..]);
@@ -668,8 +680,11 @@ impl PackCache {
         }
         let layout = PackLayout::of(store)?;
         let sections = Sections::of(store, &layout);
-        let records: Vec<FaceRecord> =
-            (0..topology.face_count()).into_par_iter().with_min_len(BLOCK).map(|f| layout.face_record(store, f)).collect();
+        let records: Vec<FaceRecord> = (0..topology.face_count())
+            .into_par_iter()
+            .with_min_len(BLOCK)
+            .map(|f| layout.face_record(store, f))
+            .collect();
         let size = format.bytes_per_sample();
         let mut chains = vec![[0.0f32; 4]; sections.total];
         let mut colors = vec![0u8; sections.total * size];
@@ -862,7 +877,15 @@ impl PackCache {
             for &v in &vertices {
                 let at = v as usize * levels;
                 let list = &incident[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
-                reduce_vertex_level(&ctx, list, v, &mut vertex_colors[at..at + levels], level, edge_colors, &mut neighbours);
+                reduce_vertex_level(
+                    &ctx,
+                    list,
+                    v,
+                    &mut vertex_colors[at..at + levels],
+                    level,
+                    edge_colors,
+                    &mut neighbours,
+                );
             }
         }
         // Encode what changed; report it as ranges.

@@ -425,7 +425,11 @@ fn reduce_edge_level(
 
 /// The packer as it was before the rayon / encode-once rewrite, serial: the reference the
 /// new packer and the incremental repack are tested against byte for byte.
-pub fn pack_reference(store: &ColorStore, positions: &[[f32; 3]], format: ColorFormat) -> Result<PackedMesh, PackError> {
+pub fn pack_reference(
+    store: &ColorStore,
+    positions: &[[f32; 3]],
+    format: ColorFormat,
+) -> Result<PackedMesh, PackError> {
     let topology = store.topology();
     if positions.len() != topology.vertex_count as usize {
         return Err(PackError::PositionCount { positions: positions.len(), vertices: topology.vertex_count });
@@ -444,4 +448,3 @@ pub fn pack_reference(store: &ColorStore, positions: &[[f32; 3]], format: ColorF
         colors,
     })
 }
-
