@@ -289,7 +289,8 @@ fn fill_with_position_colors(store: &mut ColorStore, positions: &[[f32; 3]]) {
 /// base colour already baked, multiplies it (glTF: COLOR_0 scales the base colour).
 fn apply_vertex_colors(store: &mut ColorStore, vertex_colors: &[[f32; 4]], multiply: bool) {
     let corners = store.topology().face_vertices.clone();
-    let current = store.clone();
+    // The colours before are needed only to multiply (a copy of the whole store otherwise).
+    let current = multiply.then(|| store.clone());
     store.fill_with(|site| {
         let face = corners[site.face as usize];
         let w = site.barycentric;
@@ -302,11 +303,12 @@ fn apply_vertex_colors(store: &mut ColorStore, vertex_colors: &[[f32; 4]], multi
             [_, _, 1.0] => c2,
             _ => std::array::from_fn(|c| w[0] * c0[c] + w[1] * c1[c] + w[2] * c2[c]),
         };
-        if multiply {
-            let base = current.get(site.sample).unwrap_or([1.0; 4]);
-            std::array::from_fn(|c| base[c] * interpolated[c])
-        } else {
-            interpolated
+        match &current {
+            Some(current) => {
+                let base = current.get(site.sample).unwrap_or([1.0; 4]);
+                std::array::from_fn(|c| base[c] * interpolated[c])
+            }
+            None => interpolated,
         }
     });
 }
