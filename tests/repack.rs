@@ -88,7 +88,7 @@ fn stroke(store: &mut ColorStore, rng: &mut Rng) {
         }
     }
     // Sometimes a single sample only (a tiny dab).
-    if rng.next() % 3 == 0 {
+    if rng.next().is_multiple_of(3) {
         let v = (rng.next() % u64::from(topology.vertex_count)) as u32;
         store.set(SampleRef::Vertex(v), [0.25, 0.5, 0.75, 1.0]);
     }

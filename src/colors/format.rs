@@ -270,8 +270,8 @@ impl SrgbTables {
     /// [`encode_srgb8`] with the tables at hand.
     #[inline(always)]
     fn encode(&self, linear: f32) -> u8 {
-        if !(linear > 0.0) {
-            return 0; // NaN, negative, zero
+        if linear.is_nan() || linear <= 0.0 {
+            return 0;
         }
         if linear >= 1.0 {
             return 255;

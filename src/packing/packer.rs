@@ -227,7 +227,7 @@ fn split_blocks<'a>(
         if let Some(b) = base(id) {
             next = b;
         }
-        if id as usize % BLOCK == 0 {
+        if (id as usize).is_multiple_of(BLOCK) {
             starts[id as usize / BLOCK] = next;
         }
     }
@@ -520,7 +520,7 @@ fn coarse_table(ctx: &Context, view: &ChainsView, edges: &[u32], level: u32) -> 
     (ids, values)
 }
 
-fn coarse_of<'a>(table: &'a (Vec<u32>, Vec<Vec<Rgba>>), edge: u32) -> &'a [Rgba] {
+fn coarse_of(table: &(Vec<u32>, Vec<Vec<Rgba>>), edge: u32) -> &[Rgba] {
     match table.0.binary_search(&edge) {
         Ok(n) => &table.1[n],
         Err(_) => &[],
