@@ -507,7 +507,7 @@ impl Document {
     pub fn from_packed_within(packed: &PackedMesh, budget: &Budget) -> Result<Self, PackError> {
         Ok(Document {
             positions: packed.positions.clone(),
-            store: packer::unpack_within(packed, budget)?,
+            store: crate::packing::unpack::unpack_within(packed, budget)?,
             degenerate_triangles_dropped: 0,
             source: SourceKind::Packed(packed.format),
             warnings: Vec::new(),

@@ -33,10 +33,13 @@ use thiserror::Error;
 
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::{self, Resolution};
-use crate::colors::store::{ColorStore, DirtyElements, SampleRef};
-use crate::mesh::topology::{Topology, TopologyError};
+use crate::colors::store::{ColorStore, DirtyElements};
+use crate::mesh::topology::TopologyError;
+use crate::packing::blocks::{BLOCK, split_blocks};
+use crate::packing::chains_view::ChainsView;
 use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
-use crate::packing::sampler::{self, Filter, MeshColorSource};
+use crate::packing::mip::{interior_row_start, mip_filter, reduce_interior_chain, vertex_edges};
+use crate::packing::sampler::{self, Filter};
 
 /// Errors of packing and unpacking.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -118,135 +121,9 @@ impl PackLayout {
     }
 }
 
-/// `(C + ½ Σ N) / (1 + n/2)`: the thesis' MIP filter with the weights taken.
-#[inline]
-fn mip_filter(center: Rgba, neighbours: &[Rgba]) -> Rgba {
-    let mut sum = [0.0f32; 4];
-    for n in neighbours {
-        for c in 0..4 {
-            sum[c] += n[c];
-        }
-    }
-    let norm = 1.0 / (1.0 + 0.5 * neighbours.len() as f32);
-    std::array::from_fn(|c| (center[c] + 0.5 * sum[c]) * norm)
-}
-
-/// For each vertex, its incident edges (CSR).
-fn vertex_edges(topology: &Topology) -> (Vec<u32>, Vec<u32>) {
-    let mut offsets = vec![0u32; topology.vertex_count as usize + 1];
-    for &[a, b] in &topology.edge_vertices {
-        offsets[a as usize + 1] += 1;
-        offsets[b as usize + 1] += 1;
-    }
-    for v in 0..topology.vertex_count as usize {
-        offsets[v + 1] += offsets[v];
-    }
-    let mut fill = offsets.clone();
-    let mut edges = vec![0u32; offsets[topology.vertex_count as usize] as usize];
-    for (edge, &[a, b]) in topology.edge_vertices.iter().enumerate() {
-        for v in [a, b] {
-            edges[fill[v as usize] as usize] = edge as u32;
-            fill[v as usize] += 1;
-        }
-    }
-    (offsets, edges)
-}
-
-/// Start of interior row `i` (`i >= 1`) of a face at resolution `r` (thesis eq. 3.2).
-fn interior_row_start(r: usize, i: usize) -> usize {
-    (i - 1) * (2 * r - 2 - i) / 2
-}
-
-/// Computes one face's whole interior chain in place: `chain` starts with level 0.
-fn reduce_interior_chain(chain: &mut [Rgba], r: Resolution) {
-    for level in 1..=r.log2() {
-        let r_src = (r.get() >> (level - 1)) as usize;
-        let r_dst = r_src / 2;
-        if r_dst < 3 {
-            break; // no interior samples at this level or below
-        }
-        let src_start = layout::interior_level_offset(r, level - 1).unwrap_or(0) as usize;
-        let dst_start = layout::interior_level_offset(r, level).unwrap_or(0) as usize;
-        let (head, tail) = chain.split_at_mut(dst_start);
-        let src = &head[src_start..];
-        let mut k = 0;
-        for i in 1..r_dst - 1 {
-            let a = 2 * i;
-            let (row_c, row_m, row_p) =
-                (interior_row_start(r_src, a), interior_row_start(r_src, a - 1), interior_row_start(r_src, a + 1));
-            for j in 1..r_dst - i {
-                let b = 2 * j;
-                // Lattice directions (1,0), (−1,0), (0,1), (0,−1), (1,−1), (−1,1).
-                let n = [
-                    src[row_p + b - 1],
-                    src[row_m + b - 1],
-                    src[row_c + b],
-                    src[row_c + b - 2],
-                    src[row_p + b - 2],
-                    src[row_m + b],
-                ];
-                tail[k] = mip_filter(src[row_c + b - 1], &n);
-                k += 1;
-            }
-        }
-    }
-}
-
 /// Worker threads the packer runs on (rayon's global pool).
 pub fn pack_threads() -> usize {
     rayon::current_num_threads()
-}
-
-/// Elements per parallel task.
-const BLOCK: usize = 1024;
-
-/// A run of consecutive element ids and the part of the chain buffers that holds their
-/// chains (`offset` is the global sample index of `chains[0]`).
-struct Block<'a> {
-    ids: std::ops::Range<u32>,
-    offset: usize,
-    chains: &'a mut [Rgba],
-    bytes: &'a mut [u8],
-}
-
-/// Splits one section of the buffers (elements `0..count` laid out in id order from
-/// `section_start`, element `id` at `base(id)` when it has a chain) into blocks of
-/// [`BLOCK`] ids.
-fn split_blocks<'a>(
-    chains: &'a mut [Rgba],
-    bytes: &'a mut [u8],
-    size: usize,
-    section_start: usize,
-    count: u32,
-    base: impl Fn(u32) -> Option<usize>,
-) -> Vec<Block<'a>> {
-    let block_count = (count as usize).div_ceil(BLOCK);
-    let mut starts = vec![section_start + chains.len(); block_count + 1];
-    let mut next = section_start + chains.len();
-    for id in (0..count).rev() {
-        if let Some(b) = base(id) {
-            next = b;
-        }
-        if (id as usize).is_multiple_of(BLOCK) {
-            starts[id as usize / BLOCK] = next;
-        }
-    }
-    let mut blocks = Vec::with_capacity(block_count);
-    let skip = starts.first().copied().unwrap_or(section_start).saturating_sub(section_start);
-    let (_, mut rest_chains) = chains.split_at_mut(skip.min(chains.len()));
-    let (_, mut rest_bytes) = bytes.split_at_mut((skip * size).min(bytes.len()));
-    for b in 0..block_count {
-        let len = starts[b + 1].saturating_sub(starts[b]).min(rest_chains.len());
-        let byte_len = (len * size).min(rest_bytes.len());
-        let (chain_part, chain_tail) = std::mem::take(&mut rest_chains).split_at_mut(len);
-        let (byte_part, byte_tail) = std::mem::take(&mut rest_bytes).split_at_mut(byte_len);
-        rest_chains = chain_tail;
-        rest_bytes = byte_tail;
-        let first = (b * BLOCK) as u32;
-        let end = ((b + 1) * BLOCK).min(count as usize) as u32;
-        blocks.push(Block { ids: first..end, offset: starts[b], chains: chain_part, bytes: byte_part });
-    }
-    blocks
 }
 
 /// The colour buffer's three sections.
@@ -329,54 +206,6 @@ impl Context<'_> {
         let size = self.format.bytes_per_sample();
         let n0 = self.store.edge_samples(edge).len().min(chain.len());
         self.format.encode_slice(&chain[n0..], &mut bytes[n0 * size..]);
-    }
-}
-
-/// The colour buffer while the edge and vertex chains are being built, read through the
-/// sampler's addressing (every level below the one being built is final).
-struct ChainsView<'a> {
-    store: &'a ColorStore,
-    records: &'a [FaceRecord],
-    vertex_levels: u32,
-    vertex_colors: &'a [Rgba],
-    edge_colors: &'a [Rgba],
-    interior_colors: &'a [Rgba],
-    vertex_section: usize,
-    interior_start: usize,
-}
-
-impl ChainsView<'_> {
-    fn at(&self, index: u64) -> Option<Rgba> {
-        let index = usize::try_from(index).ok()?;
-        if index < self.vertex_section {
-            self.vertex_colors.get(index).copied()
-        } else if index < self.interior_start {
-            self.edge_colors.get(index - self.vertex_section).copied()
-        } else {
-            self.interior_colors.get(index - self.interior_start).copied()
-        }
-    }
-}
-
-impl MeshColorSource for ChainsView<'_> {
-    fn face_resolution(&self, face: u32) -> Option<Resolution> {
-        self.store.face_resolution(face)
-    }
-
-    fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
-        let record = self.records.get(face as usize)?;
-        let corners = self.store.topology().face_vertices.get(face as usize)?;
-        self.at(sampler::record_sample_index(record, corners, self.vertex_levels, level, i, j)?)
-    }
-
-    fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution> {
-        Some(self.records.get(face as usize)?.edge(usize::from(k))?.1)
-    }
-
-    fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba> {
-        let record = self.records.get(face as usize)?;
-        let corners = self.store.topology().face_vertices.get(face as usize)?;
-        self.at(sampler::record_edge_index(record, corners, k, level, p)?)
     }
 }
 
@@ -528,6 +357,8 @@ fn coarse_of(table: &(Vec<u32>, Vec<Vec<Rgba>>), edge: u32) -> &[Rgba] {
 }
 
 /// The full pack into `chains` / `bytes` (both zeroed, `layout.sample_count` samples).
+/// Long: three sections split and re-split per pass (level 0, interiors, each level of
+/// edges and vertices, encoding), each pass a few lines of rayon.
 fn build_all(ctx: &Context, chains: &mut [Rgba], bytes: &mut [u8], vertex_edge: &(Vec<u32>, Vec<u32>)) {
     let store = ctx.store;
     let topology = store.topology();
@@ -720,6 +551,8 @@ impl PackCache {
     /// whose inputs changed. Gives exactly the bytes of a full pack of `store`. Returns the
     /// rewritten sample ranges, or `None` when the layout no longer fits (a resolution
     /// changed, or the store is not the one packed): then build a new cache.
+    /// Long: one level loop over the growing sets of edges and vertices it recomputes and
+    /// the buffer sections it borrows; split, the sets would travel through every helper.
     pub fn update(&mut self, store: &ColorStore, dirty: &DirtyElements) -> Option<SampleRanges> {
         let topology = store.topology();
         if !dirty.resized_faces.is_empty()
@@ -925,108 +758,4 @@ impl PackCache {
 /// Packs the store with `positions` (one per vertex) into linear buffers.
 pub fn pack(store: &ColorStore, positions: &[[f32; 3]], format: ColorFormat) -> Result<PackedMesh, PackError> {
     Ok(PackCache::build(store, positions, format)?.into_packed())
-}
-
-/// Unpacks level 0 of a packed mesh into an editable store. The packed data must be in
-/// the canonical layout [`pack`] writes (checked record by record).
-pub fn unpack(packed: &PackedMesh) -> Result<ColorStore, PackError> {
-    unpack_within(packed, &crate::colors::budget::Budget::from_environment())
-}
-
-/// [`unpack`] within `budget`: the store's samples are counted from the face records and
-/// checked before the store is allocated.
-pub fn unpack_within(packed: &PackedMesh, budget: &crate::colors::budget::Budget) -> Result<ColorStore, PackError> {
-    let topology = Topology::build(packed.positions.len() as u32, &packed.indices)?;
-    if packed.face_records.len() != topology.face_count() as usize {
-        return Err(PackError::NotCanonical(format!(
-            "{} face records for {} faces",
-            packed.face_records.len(),
-            topology.face_count()
-        )));
-    }
-    let resolutions = packed
-        .face_records
-        .iter()
-        .enumerate()
-        .map(|(face, record)| {
-            record.resolution().ok_or_else(|| PackError::NotCanonical(format!("face {face} has an invalid resolution")))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let counts = crate::colors::budget::SampleCounts::of_resolutions(&topology, |face| {
-        resolutions.get(face as usize).copied().unwrap_or(Resolution::ONE)
-    });
-    budget.check("the packed mesh", &counts, packed.format)?;
-    let mut store = ColorStore::with_resolutions(topology, resolutions, [0.0; 4])
-        .map_err(|error| PackError::NotCanonical(error.to_string()))?;
-    let layout = PackLayout::of(&store)?;
-    if layout.vertex_levels != packed.vertex_levels || layout.sample_count != packed.sample_count() {
-        return Err(PackError::NotCanonical(format!(
-            "expected {} vertex levels and {} samples, found {} and {}",
-            layout.vertex_levels,
-            layout.sample_count,
-            packed.vertex_levels,
-            packed.sample_count()
-        )));
-    }
-    for (face, record) in packed.face_records.iter().enumerate() {
-        let expected = layout.face_record(&store, face as u32);
-        if *record != expected {
-            return Err(PackError::NotCanonical(format!(
-                "face {face} record {record:?} differs from the canonical {expected:?}"
-            )));
-        }
-    }
-    let read = |index: u64| packed.color(index).unwrap_or([0.0; 4]);
-    let topology = store.topology().clone();
-    for v in 0..topology.vertex_count {
-        store.set(SampleRef::Vertex(v), read(u64::from(v) * u64::from(layout.vertex_levels)));
-    }
-    for edge in 0..topology.edge_count() {
-        let count = store.edge_samples(edge).len() as u32;
-        for offset in 0..count {
-            let color = read(u64::from(layout.edge_base[edge as usize] + offset));
-            store.set(SampleRef::Edge { edge, offset }, color);
-        }
-    }
-    for face in 0..topology.face_count() {
-        let count = store.interior_samples(face).len() as u32;
-        for offset in 0..count {
-            let color = read(u64::from(layout.interior_base[face as usize] + offset));
-            store.set(SampleRef::Interior { face, offset }, color);
-        }
-    }
-    store.take_dirty();
-    Ok(store)
-}
-
-/// A store with its MIP chains evaluated in `f32`, for level-`l` reference sampling.
-#[derive(Debug, Clone)]
-pub struct StoreMips {
-    chains: PackedMesh,
-}
-
-impl StoreMips {
-    /// Evaluates every MIP chain of `store` (no quantisation).
-    pub fn new(store: &ColorStore) -> Result<Self, PackError> {
-        let positions = vec![[0.0f32; 3]; store.topology().vertex_count as usize];
-        Ok(StoreMips { chains: pack(store, &positions, ColorFormat::Rgba32F)? })
-    }
-}
-
-impl MeshColorSource for StoreMips {
-    fn face_resolution(&self, face: u32) -> Option<Resolution> {
-        self.chains.face_resolution(face)
-    }
-
-    fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
-        self.chains.lattice_color(face, level, i, j)
-    }
-
-    fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution> {
-        self.chains.edge_resolution(face, k)
-    }
-
-    fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba> {
-        self.chains.edge_color(face, k, level, p)
-    }
 }
