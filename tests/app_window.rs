@@ -757,3 +757,71 @@ fn sigkill(app: &mut Child) {
     use std::os::unix::process::ExitStatusExt;
     assert_eq!(status.signal(), Some(9), "the app was not killed by SIGKILL: {status}");
 }
+
+/// The number of UI passes the app reports in `MESHPAINT_FRAME_COUNT_FILE` (0 before the first).
+fn frames_run(path: &Path) -> u64 {
+    std::fs::read_to_string(path).ok().and_then(|text| text.trim().parse().ok()).unwrap_or(0)
+}
+
+#[test]
+fn an_idle_editor_renders_no_frames() {
+    let _serial = WINDOW_TESTS.lock().unwrap_or_else(|e| e.into_inner());
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+    let dir = std::env::temp_dir().join(format!("meshpaint_app_idle_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log_path = dir.join("app.log");
+    let count_path = dir.join("frames");
+    let mut processes = Processes { children: Vec::new() };
+    let display = start_xvfb(&mut processes);
+    let asset = crate_path("assets/models/Duck/Duck.glb");
+    let count_env = count_path.to_string_lossy().into_owned();
+    processes.children.push(start_app(
+        &display,
+        &dir,
+        &log_path,
+        &asset,
+        &[("MESHPAINT_FRAME_COUNT_FILE", &count_env), ("MESHPAINT_AUTOSAVE_SECONDS", "3600")],
+    ));
+    let app = processes.children.last_mut().unwrap();
+    wait_for_log(&log_path, "Opened Duck.glb", 0, Duration::from_secs(120), app);
+    let log = wait_for_log(&log_path, "3D view at ", 0, Duration::from_secs(60), app);
+    let rect = view_rect(&log);
+    // The pointer rests over the 3D view, as an artist's would.
+    let (x, y) = (rect.0 + rect.2 / 2, rect.1 + rect.3 / 2);
+    xdotool(&display, &["mousemove", &x.to_string(), &y.to_string()]);
+    assert!(frames_run(&count_path) > 0, "the app reported no frame at all");
+    // At rest the count must stop: find a 2 s window with at most one pass (a pending
+    // hover or fade may take one) within 60 s. A continuous redraw (tens of passes per
+    // window) or any timer below 2 s never finds one, however slow the machine.
+    let started = Instant::now();
+    let mut windows = Vec::new();
+    loop {
+        let before = frames_run(&count_path);
+        std::thread::sleep(Duration::from_secs(2));
+        let after = frames_run(&count_path);
+        windows.push(after - before);
+        if after - before <= 1 {
+            break;
+        }
+        if let Ok(Some(status)) = app.try_wait() {
+            panic!("the app exited ({status}):\n{}", read_log(&log_path));
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "the idle editor kept running UI passes: {windows:?} per 2 s window"
+        );
+    }
+    // And it wakes up for input: a key press is a new frame.
+    let before = frames_run(&count_path);
+    focus_window(&display);
+    xdotool(&display, &["mousemove", &(x + 20).to_string(), &(y + 10).to_string()]);
+    let woke = Instant::now();
+    while frames_run(&count_path) == before {
+        assert!(woke.elapsed() < Duration::from_secs(30), "no frame after the pointer moved");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let status = quit(&display, app);
+    assert!(status.success(), "{status}");
+}

@@ -12,8 +12,9 @@ use meshpaint::colors::layout::{self, Resolution};
 use meshpaint::colors::store::{ColorStore, SampleRef};
 use meshpaint::mesh::topology::Topology;
 use meshpaint::packing::linear::PackedMesh;
-use meshpaint::packing::packer::{PackError, pack, unpack};
+use meshpaint::packing::packer::{PackError, pack};
 use meshpaint::packing::sampler::{Filter, MeshColorSource, packed_sample_index, sample};
+use meshpaint::packing::unpack::unpack;
 
 fn r(value: u64) -> Resolution {
     Resolution::new(value).unwrap()
@@ -361,7 +362,7 @@ fn srgb8_encoding_rounds_to_the_nearest_code_in_encoded_space() {
 
 #[test]
 fn store_mip_sampling_matches_packed_sampling_at_every_level_within_quantisation() {
-    use meshpaint::packing::packer::StoreMips;
+    use meshpaint::packing::unpack::StoreMips;
     let (positions, store) = mixed_octahedron_store(21);
     let mips = StoreMips::new(&store).unwrap();
     let packed8 = pack(&store, &positions, ColorFormat::Rgba8Srgb).unwrap();

@@ -15,7 +15,8 @@ use crate::camera::BoundingSphere;
 use crate::colors::budget::Budget;
 use crate::colors::format::ColorFormat;
 use crate::io::adaptive::ResolutionRule;
-use crate::io::document::{Displayed, Document, Source, SourceKind, open_for_display_within};
+use crate::io::document::{Document, DocumentError, Source, SourceKind};
+use crate::packing::packer::PackCache;
 use crate::paint::picking::{BvhPreset, MeshBvh};
 use crate::render::{BaselineMesh, Gpu, GpuMesh};
 
@@ -52,6 +53,9 @@ pub struct OpenDocument {
     pub packed_bytes: u64,
     /// How long the last repack (store → linear buffers) took.
     pub last_repack: Duration,
+    /// The compact packing with its `f32` chains, for an incremental repack when paint mode
+    /// ends (`None` until a repack made one, or while paint mode holds it).
+    pub pack_cache: Option<PackCache>,
     /// The other views of the document, built the first time they are shown.
     pub alternates: AlternateViews,
 }
@@ -123,7 +127,7 @@ impl OpenDocument {
     }
 }
 
-/// Opens `source` for display ([`open_for_display_within`] `budget`: a mesh at the face
+/// Opens `source` for display (within `budget`: a mesh at the face
 /// resolutions of `rule`, or packed), uploads it when `gpu` is given and builds the picking BVH.
 pub fn load(
     source: &Source,
@@ -132,19 +136,34 @@ pub fn load(
     gpu: Option<&Gpu>,
     job: &JobContext,
 ) -> Result<OpenDocument> {
-    let Displayed { document, packed, pack_time } =
-        open_for_display_within(source, rule, budget, &mut |fraction, stage| job.progress(fraction, stage))?;
+    job.progress(0.05, "reading and importing");
+    let document = Document::open_source_within(source, rule, budget)?;
     let name = source.name();
-    let gpu_mesh = match gpu {
-        Some(gpu) => {
-            job.progress(0.65, "uploading to the GPU");
-            Some(gpu.upload(&packed).with_context(|| format!("uploading {name} to the GPU"))?)
-        }
-        None => None,
-    };
-    job.progress(0.8, "building the picking BVH");
-    let bvh = MeshBvh::build(&document.positions, &document.store.topology().face_vertices, BvhPreset::FastBuild);
+    if document.store.topology().face_count() == 0 {
+        return Err(DocumentError::NoTriangles { path: PathBuf::from(&name) }.into());
+    }
+    job.progress(0.45, "packing colours with MIP chains, building the picking BVH");
+    // The BVH needs only the geometry: it is built while the colours are packed and uploaded.
+    let started = Instant::now();
+    let (packed, bvh) = rayon::join(
+        || -> Result<(PackCache, Duration, Option<GpuMesh>)> {
+            let cache = PackCache::build(&document.store, &document.positions, document.display_format())
+                .with_context(|| format!("packing {name}"))?;
+            let pack_time = started.elapsed();
+            let gpu_mesh = match gpu {
+                Some(gpu) => {
+                    job.progress(0.65, "uploading to the GPU");
+                    Some(gpu.upload(cache.packed()).with_context(|| format!("uploading {name} to the GPU"))?)
+                }
+                None => None,
+            };
+            Ok((cache, pack_time, gpu_mesh))
+        },
+        || MeshBvh::build(&document.positions, &document.store.topology().face_vertices, BvhPreset::FastBuild),
+    );
+    let (cache, pack_time, gpu_mesh) = packed?;
     job.progress(1.0, "done");
+    let packed = cache.packed();
     let document_is_packed = matches!(document.source, SourceKind::Packed(_));
     Ok(OpenDocument {
         bounds: BoundingSphere::of_points(&document.positions),
@@ -165,6 +184,7 @@ pub fn load(
         },
         title: source.title(),
         last_repack: pack_time,
+        pack_cache: Some(cache),
         alternates: AlternateViews::default(),
     })
 }

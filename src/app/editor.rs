@@ -437,12 +437,14 @@ impl Editor {
         open.packed_bytes = repacked.packed_bytes;
         open.samples = open.document.store.sample_count();
         open.last_repack = repacked.pack_time;
+        open.pack_cache = Some(repacked.cache);
         self.gpu_paint_layout = false;
         self.scene_generation += 1;
         self.set_status(
             Severity::Info,
             format!(
-                "Repacked: {} samples with MIP chains in {:.1} ms ({:.2} s with the upload)",
+                "Repacked{}: {} samples with MIP chains in {:.1} ms ({:.2} s with the upload)",
+                if repacked.incremental { " (changed chains only)" } else { "" },
                 thousands(repacked.samples_with_mips),
                 repacked.pack_time.as_secs_f64() * 1000.0,
                 elapsed.as_secs_f64()

@@ -11,7 +11,8 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use crate::colors::layout::Resolution;
-use crate::colors::store::ColorStore;
+use crate::colors::store::{ColorStore, DirtyAccumulator};
+use crate::packing::packer::PackCache;
 use crate::packing::paint_layout::PaintLayout;
 use crate::paint::brush::{
     self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, ResolutionOp, StrokeUpdate,
@@ -53,15 +54,17 @@ impl Editor {
         };
         let started = Instant::now();
         let document = Arc::make_mut(&mut open.document);
-        // Changes from before (none expected) are in the new layout anyway.
-        let _ = document.store.take_dirty();
+        // Changes from before (none expected) are in the new layout anyway; the compact
+        // packing is reused on leaving only if it is still the store's.
+        let unpacked_changes = !document.store.take_dirty().is_empty();
         let layout = PaintLayout::new(&document.store);
+        let mut compact_gpu_mesh = None;
         if let Some(gpu) = &self.gpu {
             let packed = layout.packed(&document.store, &document.positions, open.format);
             match gpu.upload(&packed) {
                 Ok(mesh) => {
                     self.upload_bytes_this_frame += packed.color_bytes() + packed.face_record_bytes();
-                    open.gpu_mesh = Some(mesh);
+                    compact_gpu_mesh = open.gpu_mesh.replace(mesh);
                 }
                 Err(error) => {
                     let text = format!("Cannot enter paint mode: uploading the paint layout failed: {error}");
@@ -86,6 +89,9 @@ impl Editor {
             stroke_upload_bytes: 0,
             stroke_samples_changed: 0,
             upload_failed: false,
+            pack_cache: if unpacked_changes { None } else { open.pack_cache.take() },
+            compact_gpu_mesh,
+            repack_dirty: DirtyAccumulator::new(document.store.topology()),
         });
         self.gpu_paint_layout = true;
         self.mode = Mode::Paint;
@@ -102,10 +108,14 @@ impl Editor {
             return;
         }
         self.end_stroke();
-        self.paint = None;
+        let session = self.paint.take();
         self.mode = Mode::View;
         let Some(open) = &self.document else {
             return;
+        };
+        let (cache, mut dirty, compact_gpu_mesh) = match session {
+            Some(mut session) => (session.pack_cache.take(), session.repack_dirty, session.compact_gpu_mesh.take()),
+            None => (None, DirtyAccumulator::default(), None),
         };
         let document = Arc::clone(&open.document);
         let format = open.format;
@@ -113,14 +123,36 @@ impl Editor {
         let started = self.jobs.start(JobKind::Repack, "Repacking", move |job| {
             job.progress(0.1, "packing colours with MIP chains");
             let started = Instant::now();
-            let packed = document.pack(format).map_err(|error| format!("repacking failed: {error}"))?;
+            let dirty = dirty.take();
+            // Only the chains the session changed when no resolution changed; else all.
+            let patched = cache.filter(|cache| cache.packed().format == format).and_then(|mut cache| {
+                let ranges = cache.update(&document.store, &dirty)?;
+                Some((cache, ranges))
+            });
+            let (cache, ranges) = match patched {
+                Some((cache, ranges)) => (cache, Some(ranges)),
+                None => (
+                    PackCache::build(&document.store, &document.positions, format)
+                        .map_err(|error| format!("repacking failed: {error}"))?,
+                    None,
+                ),
+            };
             let pack_time = started.elapsed();
             job.progress(0.7, "uploading to the GPU");
-            let gpu_mesh = match gpu {
-                Some(gpu) => Some(
-                    gpu.upload(&packed).map_err(|error| format!("uploading the repacked buffers failed: {error}"))?,
-                ),
-                None => None,
+            let packed = cache.packed();
+            let upload_error =
+                |error: crate::render::RenderError| format!("uploading the repacked buffers failed: {error}");
+            let gpu_mesh = match (gpu, compact_gpu_mesh, &ranges) {
+                (Some(gpu), Some(mesh), Some(ranges)) => {
+                    let size = packed.format.bytes_per_sample();
+                    for &(first, count) in ranges {
+                        let bytes = &packed.colors[first as usize * size..(first + count) as usize * size];
+                        mesh.write_samples(&gpu.ctx, first, bytes).map_err(upload_error)?;
+                    }
+                    Some(mesh)
+                }
+                (Some(gpu), _, _) => Some(gpu.upload(packed).map_err(upload_error)?),
+                (None, _, _) => None,
             };
             Ok(JobOutput::Repacked(Box::new(Repacked {
                 document,
@@ -128,6 +160,8 @@ impl Editor {
                 samples_with_mips: packed.sample_count(),
                 packed_bytes: packed.face_record_bytes() + packed.color_bytes(),
                 pack_time,
+                incremental: ranges.is_some(),
+                cache,
             })))
         });
         match started {
@@ -234,6 +268,8 @@ impl Editor {
         };
         let doc = Arc::make_mut(&mut open.document);
         let dirty = doc.store.take_dirty();
+        // Everything the session changed is repacked on leaving, uploaded or not.
+        session.repack_dirty.add(&dirty);
         if dirty.is_empty() || session.upload_failed {
             // After a failed upload the GPU mesh is stale until paint mode ends (the repack
             // uploads everything): reported once, not retried on every change.

@@ -5,8 +5,9 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::colors::store::ColorStore;
+use crate::colors::store::{ColorStore, DirtyAccumulator};
 use crate::io::document::Document;
+use crate::packing::packer::PackCache;
 use crate::packing::paint_layout::PaintLayout;
 use crate::paint::brush::{self, Painter};
 use crate::render::GpuMesh;
@@ -56,6 +57,13 @@ pub struct PaintSession {
     pub upload_failed: bool,
     /// Samples changed by the current (or last) stroke.
     pub stroke_samples_changed: u64,
+    /// The compact packing from before paint mode (`None` when there was none): leaving
+    /// repacks only what [`PaintSession::repack_dirty`] reaches.
+    pub pack_cache: Option<PackCache>,
+    /// The compact buffers on the GPU from before paint mode, patched in place on leaving.
+    pub compact_gpu_mesh: Option<GpuMesh>,
+    /// Every element changed during the session (the union of the dirty sets of all dabs).
+    pub repack_dirty: DirtyAccumulator,
 }
 
 /// The result of a repack job (leaving paint mode).
@@ -71,4 +79,8 @@ pub struct Repacked {
     pub packed_bytes: u64,
     /// How long packing took.
     pub pack_time: Duration,
+    /// Whether only the changed chains were repacked (else a full repack).
+    pub incremental: bool,
+    /// The packing, kept for the next incremental repack.
+    pub cache: PackCache,
 }

@@ -144,6 +144,11 @@ struct Running {
     last_logged_viewport: Option<([i32; 2], [u32; 2])>,
     /// What the 3D view's target holds: it is redrawn only when this changes.
     drawn_view: Option<(crate::render::RenderSettings, super::state::Shown, [u32; 2], u64)>,
+    /// UI passes run so far, and where to write that count after each one
+    /// (`MESHPAINT_FRAME_COUNT_FILE`, for the idle test: at rest the count must not grow).
+    frame_count: (u64, Option<std::path::PathBuf>),
+    /// The window title last set.
+    title: String,
 }
 
 impl Shell {
@@ -226,6 +231,8 @@ impl Shell {
             editor,
             last_logged_viewport: None,
             drawn_view: None,
+            frame_count: (0, std::env::var_os("MESHPAINT_FRAME_COUNT_FILE").map(std::path::PathBuf::from)),
+            title: "meshpaint".to_owned(),
         })
     }
 }
@@ -256,9 +263,12 @@ impl Running {
         let editor = &mut self.editor;
         let full_output = self.egui_ctx.run_ui(raw_input, |ui| editor.ui(ui));
         self.egui_state.handle_platform_output(&self.window, full_output.platform_output);
+        // Compared with what we last set: winit's `Window::title` is always empty on X11,
+        // so comparing with it re-set WM_NAME on every frame.
         let title = self.editor.window_title();
-        if self.window.title() != title {
+        if self.title != title {
             self.window.set_title(&title);
+            self.title = title;
         }
         if self.editor.quit_requested {
             event_loop.exit();
@@ -285,6 +295,11 @@ impl Running {
         }
         if drawn {
             self.editor.frame_stats.record(started.elapsed());
+        }
+        self.frame_count.0 += 1;
+        if let Some(path) = &self.frame_count.1 {
+            // Written in place (not atomically): the test only reads a number that grows.
+            let _ = std::fs::write(path, self.frame_count.0.to_string());
         }
         Ok(repaint_delay)
     }
@@ -412,7 +427,9 @@ impl ApplicationHandler<UserEvent> for Shell {
             return;
         }
         let response = running.egui_state.on_window_event(&running.window, &event);
-        if response.repaint {
+        // egui-winit answers `repaint: true` to RedrawRequested itself: asking for another
+        // redraw then drew frame after frame for ever (the idle editor's busy CPU).
+        if response.repaint && !matches!(event, WindowEvent::RedrawRequested) {
             running.window.request_redraw();
         }
         match event {

@@ -3,12 +3,14 @@
 
 pub mod adaptive;
 pub mod extremes;
+pub mod load;
 pub mod pack;
 pub mod paint;
 pub mod plot;
 pub mod render;
 pub mod trade;
 
+pub use load::{BenchLoadError, bench_load};
 pub use pack::{Timing, bench_pack};
 pub use paint::{PaintBenchOptions, bench_paint};
 pub use render::{BenchRenderError, ModeTiming, RenderBench, bench_render};

@@ -122,3 +122,95 @@ pub fn bench_pack(document: &Document, format: ColorFormat, runs: usize) -> Resu
         memcpy: memcpy_timing,
     })
 }
+
+/// Result of the incremental-repack benchmark: a stroke painted, then leaving paint mode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IncrementalBench {
+    /// Faces the stroke covered (every sample of each: vertices, edges, interior).
+    pub faces_painted: u64,
+    /// Level-0 samples the stroke wrote.
+    pub samples_changed: u64,
+    /// Samples the incremental repack rewrote (MIP levels and neighbours included).
+    pub samples_rewritten: u64,
+    /// Incremental repack timing.
+    pub repack: Timing,
+    /// A full repack of the same store, same run.
+    pub full: Timing,
+    /// Whether the incremental result is byte-equal to the full repack.
+    pub equal_to_full_pack: bool,
+}
+
+impl IncrementalBench {
+    /// As a JSON object.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "faces_painted": self.faces_painted,
+            "samples_changed": self.samples_changed,
+            "samples_rewritten": self.samples_rewritten,
+            "repack": self.repack.to_json(),
+            "full_repack": self.full.to_json(),
+            "speedup": self.full.best_seconds / self.repack.best_seconds.max(1e-12),
+            "equal_to_full_pack": self.equal_to_full_pack,
+        })
+    }
+}
+
+/// Paints every sample of the faces nearest to the middle face's centroid until about
+/// `target_samples` samples changed (a stroke), then times the incremental repack that
+/// leaving paint mode runs, against a full repack of the result.
+pub fn bench_incremental(
+    document: &Document,
+    format: ColorFormat,
+    runs: usize,
+    target_samples: u64,
+) -> Result<IncrementalBench, PackError> {
+    use crate::colors::store::SampleRef;
+    let mut store = document.store.clone();
+    let positions = &document.positions;
+    let topology = store.topology().clone();
+    let mut cache = crate::packing::packer::PackCache::build(&store, positions, format)?;
+    let centroid = |f: usize| {
+        let [a, b, c] = topology.face_vertices[f].map(|v| positions[v as usize]);
+        std::array::from_fn::<f32, 3, _>(|k| (a[k] + b[k] + c[k]) / 3.0)
+    };
+    let middle = centroid(topology.face_vertices.len() / 2);
+    let mut order: Vec<(f32, u32)> = (0..topology.face_vertices.len())
+        .map(|f| {
+            let p = centroid(f);
+            ((0..3).map(|k| (p[k] - middle[k]).powi(2)).sum(), f as u32)
+        })
+        .collect();
+    order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    let (mut samples_changed, mut faces_painted) = (0u64, 0u64);
+    let color = [0.8, 0.1, 0.3, 1.0];
+    for &(_, face) in &order {
+        if samples_changed >= target_samples {
+            break;
+        }
+        faces_painted += 1;
+        for &v in &topology.face_vertices[face as usize] {
+            samples_changed += u64::from(store.set(SampleRef::Vertex(v), color));
+        }
+        for &edge in &topology.face_edges[face as usize] {
+            for offset in 0..store.edge_samples(edge).len() as u32 {
+                samples_changed += u64::from(store.set(SampleRef::Edge { edge, offset }, color));
+            }
+        }
+        for offset in 0..store.interior_samples(face).len() as u32 {
+            samples_changed += u64::from(store.set(SampleRef::Interior { face, offset }, color));
+        }
+    }
+    let dirty = store.take_dirty();
+    // Repeated updates with the same edit redo the same work (the result is the same).
+    let (repack, ranges) = Timing::measure(runs, || cache.update(&store, &dirty));
+    let samples_rewritten = ranges.unwrap_or_default().iter().map(|&(_, n)| n).sum();
+    let (full, packed) = Timing::measure(runs.min(3), || crate::packing::packer::pack(&store, positions, format));
+    Ok(IncrementalBench {
+        faces_painted,
+        samples_changed,
+        samples_rewritten,
+        repack,
+        full,
+        equal_to_full_pack: packed? == *cache.packed(),
+    })
+}

@@ -187,3 +187,24 @@ pub(super) fn open(path: &Path, resolution: ResolutionArg, budget: &Budget) -> R
     }
     Ok(document)
 }
+
+/// [`open`], after midpoint-subdividing a mesh file's scene `subdivide` times (how the
+/// benchmarks reach a million triangles); `subdivide = 0` is [`open`].
+pub(super) fn open_subdivided(
+    path: &Path,
+    resolution: ResolutionArg,
+    subdivide: u32,
+    budget: &Budget,
+) -> Result<Document> {
+    if subdivide == 0 {
+        return open(path, resolution, budget);
+    }
+    let (scene, kind) = meshpaint::io::document::import_scene_within(path, budget)?;
+    let scene = meshpaint::io::subdivide::subdivide_scene(&scene, subdivide, budget)?;
+    let mut document = Document::from_scene_within(scene, resolution.rule()?, path, budget)?;
+    document.source = kind;
+    for warning in &document.warnings {
+        log::warn!(target: LOG_TARGET, "{}: {warning}", path.display());
+    }
+    Ok(document)
+}

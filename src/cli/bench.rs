@@ -7,7 +7,7 @@ use clap::Subcommand;
 
 use meshpaint::colors::format::ColorFormat;
 
-use super::args::{ResolutionArg, ResolutionArg16, budget, open, parse_format};
+use super::args::{ResolutionArg, ResolutionArg16, budget, open, open_subdivided, parse_format};
 
 #[derive(Debug, Subcommand)]
 pub(super) enum BenchCommand {
@@ -23,6 +23,32 @@ pub(super) enum BenchCommand {
         /// Repetitions per measurement (the best and the median are reported).
         #[arg(long, default_value_t = 5)]
         runs: usize,
+        /// Midpoint-subdivide the mesh N times first (each ×4 triangles: Bunny144k 576k at 1,
+        /// 2.3M at 2).
+        #[arg(long, default_value_t = 0)]
+        subdivide: u32,
+        /// Level-0 samples the stroke of the incremental-repack measurement paints.
+        #[arg(long, default_value_t = 100_000)]
+        stroke_samples: u64,
+    },
+    /// Seconds per phase from a mesh file to the first paintable frame (import, weld,
+    /// topology, store, pack, upload, BVH, first frame), total and peak memory.
+    Load {
+        /// A .glb / .gltf / OBJ / PLY / STL file.
+        file: PathBuf,
+        /// Uniform face resolution R.
+        #[arg(short, long, default_value_t = 8)]
+        resolution: u64,
+        /// Midpoint-subdivide the mesh N times after import (each ×4 triangles; not counted
+        /// in the total).
+        #[arg(long, default_value_t = 0)]
+        subdivide: u32,
+        /// Width of the first frame.
+        #[arg(long, default_value_t = 1280)]
+        width: u32,
+        /// Height of the first frame.
+        #[arg(long, default_value_t = 720)]
+        height: u32,
     },
     /// Frame time of the UV baseline and each mesh-colors filter mode (interleaved), GPU memory.
     Render {
@@ -170,22 +196,33 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             println!("{summary}");
             Ok(())
         }
-        BenchCommand::Pack { file, resolution, format, runs } => {
-            let document = open(&file, resolution.into(), &budget(None))?;
+        BenchCommand::Pack { file, resolution, format, runs, subdivide, stroke_samples } => {
+            let document = open_subdivided(&file, resolution.into(), subdivide, &budget(None))?;
             let formats = if format.is_empty() { ColorFormat::ALL.to_vec() } else { format };
             let mut results = Vec::new();
             for format in formats {
                 let result = meshpaint::bench::pack::bench_pack(&document, format, runs)?;
-                results.push(result.to_json());
+                let mut value = result.to_json();
+                let incremental =
+                    meshpaint::bench::pack::bench_incremental(&document, format, runs.max(3), stroke_samples)?;
+                value["incremental_after_stroke"] = incremental.to_json();
+                results.push(value);
             }
             let report = serde_json::json!({
                 "bench": "pack",
                 "file": file.display().to_string(),
+                "subdivide": subdivide,
                 "triangles": document.store.topology().face_count(),
                 "resolution": resolution.resolution,
-                "threads": 1,
+                "threads": meshpaint::packing::packer::pack_threads(),
                 "results": results,
             });
+            println!("{report}");
+            Ok(())
+        }
+        BenchCommand::Load { file, resolution, subdivide, width, height } => {
+            let r = meshpaint::colors::layout::Resolution::new(resolution).context("--resolution")?;
+            let report = meshpaint::bench::bench_load(&file, r, subdivide, &budget(None), width, height)?;
             println!("{report}");
             Ok(())
         }

@@ -137,9 +137,44 @@ impl ColorFormat {
         }
     }
 
+    /// Encodes `color` (clamped) into `out` (`bytes_per_sample` long) and returns what
+    /// decoding those bytes gives, i.e. [`ColorFormat::quantize`] with the encoding done once.
+    #[inline]
+    pub fn encode_quantized(self, color: Rgba, out: &mut [u8]) -> Rgba {
+        let color = clamp_color(color);
+        match self {
+            ColorFormat::Rgba8Srgb => {
+                let tables = srgb_tables();
+                let bytes = tables.encode_rgba8(color);
+                out.copy_from_slice(&bytes);
+                tables.decode_rgba8(bytes)
+            }
+            ColorFormat::Rgba16F => {
+                let halves = color.map(f16::from_f32);
+                for (pair, half) in out.chunks_exact_mut(2).zip(halves) {
+                    pair.copy_from_slice(&half.to_bits().to_le_bytes());
+                }
+                halves.map(f16::to_f32)
+            }
+            ColorFormat::Rgba32F => {
+                for (quad, channel) in out.chunks_exact_mut(4).zip(color) {
+                    quad.copy_from_slice(&channel.to_le_bytes());
+                }
+                color
+            }
+        }
+    }
+
     /// Encodes `colors` (each clamped by [`clamp_color`]) into `out`, which must be exactly
     /// `colors.len() * bytes_per_sample()` long (extra input or output is ignored).
     pub fn encode_slice(self, colors: &[Rgba], out: &mut [u8]) {
+        if self == ColorFormat::Rgba8Srgb {
+            let tables = srgb_tables();
+            for (color, bytes) in colors.iter().zip(out.chunks_exact_mut(4)) {
+                bytes.copy_from_slice(&tables.encode_rgba8(clamp_color(*color)));
+            }
+            return;
+        }
         let size = self.bytes_per_sample();
         for (color, bytes) in colors.iter().zip(out.chunks_exact_mut(size)) {
             let color = &clamp_color(*color);
@@ -174,22 +209,29 @@ pub fn srgb_to_linear(encoded: f32) -> f32 {
 
 fn unorm8(x: f32) -> u8 {
     let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
-    (x * 255.0).round() as u8
+    // Round half away from zero without a libm call: `v − trunc(v)` is exact here.
+    let v = x * 255.0;
+    let t = v as u32;
+    (t + u32::from(v - t as f32 >= 0.5)) as u8
 }
 
 /// Tables for exact, fast RGBA8 sRGB conversion, built once in `f64`.
 struct SrgbTables {
     /// Linear value of each 8-bit code.
     decode: [f32; 256],
-    /// `thresholds[b]`: the linear value halfway (in encoded space) between codes `b`
-    /// and `b + 1`; a linear value encodes to the number of thresholds it reaches.
-    thresholds: [f32; 255],
-    /// A first guess of the code for `linear = k / GUESS_STEPS`, corrected by
-    /// comparing with the thresholds (the answer is exact, the table only makes it fast).
-    guess: Vec<u8>,
+    /// `thresholds[b]` (`b < 255`): the smallest f32 whose exact encoding rounds to code
+    /// `b + 1` or above; a linear value encodes to the number of thresholds it reaches.
+    /// `thresholds[255]` is +∞.
+    thresholds: [f32; 256],
+    /// The code of the smallest f32 of each bucket of f32 bit patterns `bits >> 15` (one
+    /// exponent, the top 8 mantissa bits) in `[0, 1)`. A bucket spans < 0.4 % of its
+    /// values and one sRGB code at least 0.89 %, so at most one threshold falls inside a
+    /// bucket: the code is the bucket's, plus one if the value reaches the next threshold.
+    bucket: Vec<u8>,
 }
 
-const GUESS_STEPS: usize = 16384;
+/// Buckets of `bits >> BUCKET_SHIFT` below 1.0.
+const BUCKET_SHIFT: u32 = 15;
 
 fn srgb_tables() -> &'static SrgbTables {
     static TABLES: std::sync::OnceLock<SrgbTables> = std::sync::OnceLock::new();
@@ -197,35 +239,67 @@ fn srgb_tables() -> &'static SrgbTables {
         let to_linear = |encoded: f64| {
             if encoded <= 0.040_45 { encoded / 12.92 } else { ((encoded + 0.055) / 1.055).powf(2.4) }
         };
-        let thresholds: [f32; 255] = std::array::from_fn(|b| to_linear((b as f64 + 0.5) / 255.0) as f32);
-        let guess = (0..=GUESS_STEPS)
+        // Each threshold is the smallest f32 at or above the exact (f64) boundary, so
+        // "reaches the threshold" is exactly "the f64 formula rounds up" for every f32.
+        let thresholds: [f32; 256] = std::array::from_fn(|b| {
+            if b == 255 {
+                return f32::INFINITY;
+            }
+            let exact = to_linear((b as f64 + 0.5) / 255.0);
+            let mut t = exact as f32;
+            while f64::from(t) < exact {
+                t = t.next_up();
+            }
+            while f64::from(t.next_down()) >= exact {
+                t = t.next_down();
+            }
+            t
+        });
+        let buckets = (1.0f32.to_bits() >> BUCKET_SHIFT) as usize;
+        let bucket = (0..buckets)
             .map(|k| {
-                let linear = k as f32 / GUESS_STEPS as f32;
-                thresholds.partition_point(|&t| t <= linear) as u8
+                let start = f32::from_bits((k as u32) << BUCKET_SHIFT);
+                thresholds.partition_point(|&t| t <= start) as u8
             })
             .collect();
-        SrgbTables { decode: std::array::from_fn(|b| to_linear(b as f64 / 255.0) as f32), thresholds, guess }
+        SrgbTables { decode: std::array::from_fn(|b| to_linear(b as f64 / 255.0) as f32), thresholds, bucket }
     })
 }
 
+impl SrgbTables {
+    /// [`encode_srgb8`] with the tables at hand.
+    #[inline(always)]
+    fn encode(&self, linear: f32) -> u8 {
+        if linear.is_nan() || linear <= 0.0 {
+            return 0;
+        }
+        if linear >= 1.0 {
+            return 255;
+        }
+        let code = self.bucket[(linear.to_bits() >> BUCKET_SHIFT) as usize];
+        code + u8::from(linear >= self.thresholds[usize::from(code)])
+    }
+
+    #[inline(always)]
+    fn encode_rgba8(&self, color: Rgba) -> [u8; 4] {
+        [self.encode(color[0]), self.encode(color[1]), self.encode(color[2]), unorm8(color[3])]
+    }
+
+    #[inline(always)]
+    fn decode_rgba8(&self, bytes: [u8; 4]) -> Rgba {
+        [
+            self.decode[usize::from(bytes[0])],
+            self.decode[usize::from(bytes[1])],
+            self.decode[usize::from(bytes[2])],
+            f32::from(bytes[3]) / 255.0,
+        ]
+    }
+}
+
 /// Encodes one linear channel as an 8-bit sRGB code: the code whose exact encoded value
-/// is nearest (rounding in encoded space), found among precomputed thresholds.
+/// is nearest (rounding in encoded space), from precomputed buckets and thresholds.
 pub fn encode_srgb8(linear: f32) -> u8 {
-    let tables = srgb_tables();
-    if linear.is_nan() || linear <= 0.0 {
-        return 0;
-    }
-    if linear >= 1.0 {
-        return 255;
-    }
-    let mut code = usize::from(tables.guess[(linear * GUESS_STEPS as f32) as usize]);
-    while code < 255 && tables.thresholds[code] <= linear {
-        code += 1;
-    }
-    while code > 0 && tables.thresholds[code - 1] > linear {
-        code -= 1;
-    }
-    code as u8
+    srgb_tables().encode(linear)
 }
 
 /// Decodes an 8-bit sRGB code to a linear channel value.
@@ -235,12 +309,12 @@ pub fn decode_srgb8(code: u8) -> f32 {
 
 /// Encodes a linear colour as RGBA8 with sRGB-encoded RGB and linear alpha.
 pub fn encode_rgba8_srgb(color: Rgba) -> [u8; 4] {
-    [encode_srgb8(color[0]), encode_srgb8(color[1]), encode_srgb8(color[2]), unorm8(color[3])]
+    srgb_tables().encode_rgba8(color)
 }
 
 /// Decodes RGBA8 with sRGB-encoded RGB and linear alpha to a linear colour.
 pub fn decode_rgba8_srgb(bytes: [u8; 4]) -> Rgba {
-    [decode_srgb8(bytes[0]), decode_srgb8(bytes[1]), decode_srgb8(bytes[2]), f32::from(bytes[3]) / 255.0]
+    srgb_tables().decode_rgba8(bytes)
 }
 
 /// `a * (1 - t) + b * t` per channel.

@@ -131,6 +131,59 @@ impl DirtySet {
     }
 }
 
+/// The union of several [`DirtyElements`] (e.g. every dab of a paint session): what an
+/// incremental repack must redo. Adding is O(added), taking O(collected).
+#[derive(Debug, Clone, Default)]
+pub struct DirtyAccumulator {
+    vertices: DirtySet,
+    edges: DirtySet,
+    faces: DirtySet,
+    resized_faces: DirtySet,
+    resized_edges: DirtySet,
+}
+
+impl DirtyAccumulator {
+    /// An empty accumulator for `topology`'s elements.
+    pub fn new(topology: &Topology) -> Self {
+        let (v, e, f) =
+            (topology.vertex_count as usize, topology.edge_count() as usize, topology.face_count() as usize);
+        DirtyAccumulator {
+            vertices: DirtySet::new(v),
+            edges: DirtySet::new(e),
+            faces: DirtySet::new(f),
+            resized_faces: DirtySet::new(f),
+            resized_edges: DirtySet::new(e),
+        }
+    }
+
+    /// Adds `dirty` to the union.
+    pub fn add(&mut self, dirty: &DirtyElements) {
+        let pairs = [
+            (&mut self.vertices, &dirty.vertices),
+            (&mut self.edges, &dirty.edges),
+            (&mut self.faces, &dirty.faces),
+            (&mut self.resized_faces, &dirty.resized_faces),
+            (&mut self.resized_edges, &dirty.resized_edges),
+        ];
+        for (set, ids) in pairs {
+            for &id in ids {
+                set.mark(id);
+            }
+        }
+    }
+
+    /// The union so far (sorted, unique), leaving the accumulator empty.
+    pub fn take(&mut self) -> DirtyElements {
+        DirtyElements {
+            vertices: self.vertices.take(),
+            edges: self.edges.take(),
+            faces: self.faces.take(),
+            resized_faces: self.resized_faces.take(),
+            resized_edges: self.resized_edges.take(),
+        }
+    }
+}
+
 /// The editable mesh-colors store.
 #[derive(Debug, Clone)]
 pub struct ColorStore {
@@ -364,11 +417,64 @@ impl ColorStore {
     }
 
     /// Sets every sample to `color_at(site)`, marking everything dirty.
+    ///
+    /// `color_at` sees the sites in [`ColorStore::for_each_site`]'s order; each colour is
+    /// written in place as [`ColorStore::set`] writes it (clamped, element marked dirty).
     pub fn fill_with(&mut self, mut color_at: impl FnMut(SampleSite) -> Rgba) {
-        let mut writes = Vec::new();
-        self.for_each_site(|site| writes.push((site.sample, color_at(site))));
-        for (sample, color) in writes {
-            self.set(sample, color);
+        use crate::colors::format::clamp_color;
+        let bary = |r: Resolution, (i, j): (u32, u32)| layout::sample_barycentric(r, i, j).map(|w| w as f32);
+        for (v, &face) in self.vertex_owner_face.iter().enumerate() {
+            let Some(corners) = self.topology.face_vertices.get(face as usize) else {
+                continue;
+            };
+            let corner = corners.iter().position(|&c| c == v as u32).unwrap_or(0);
+            let mut barycentric = [0.0; 3];
+            barycentric[corner] = 1.0;
+            let color = color_at(SampleSite { sample: SampleRef::Vertex(v as u32), face, barycentric });
+            self.vertex_colors[v] = clamp_color(color);
+            self.dirty_vertices.mark(v as u32);
+        }
+        for edge in 0..self.topology.edge_count() {
+            let Some(&(face, k)) = self.topology.faces_of_edge(edge).first() else {
+                continue;
+            };
+            let r_edge = self.edge_resolution[edge as usize];
+            let reversed = self.topology.is_reversed(face, usize::from(k));
+            let samples = &mut self.edge_samples[edge as usize];
+            for (offset, slot) in (0..layout::edge_sample_count(r_edge)).zip(samples.iter_mut()) {
+                let position = if reversed { r_edge.get() - 1 - offset } else { offset + 1 };
+                let site = SampleSite {
+                    sample: SampleRef::Edge { edge, offset },
+                    face,
+                    barycentric: bary(r_edge, layout::edge_sample_coords(r_edge, k, position)),
+                };
+                *slot = clamp_color(color_at(site));
+            }
+            if !samples.is_empty() {
+                self.dirty_edges.mark(edge);
+            }
+        }
+        for face in 0..self.topology.face_count() {
+            let r = self.face_resolution[face as usize];
+            let samples = &mut self.interior_samples[face as usize];
+            // Rows i ascending, then j ascending: the storage order (eq. 3.2).
+            let res = r.get();
+            let mut slots = samples.iter_mut();
+            let mut offset = 0u32;
+            for i in 1..res.saturating_sub(1) {
+                for j in 1..res - i {
+                    let Some(slot) = slots.next() else {
+                        break;
+                    };
+                    let site =
+                        SampleSite { sample: SampleRef::Interior { face, offset }, face, barycentric: bary(r, (i, j)) };
+                    *slot = clamp_color(color_at(site));
+                    offset += 1;
+                }
+            }
+            if offset > 0 {
+                self.dirty_faces.mark(face);
+            }
         }
     }
 

@@ -187,6 +187,17 @@ pub enum SourceKind {
     Packed(ColorFormat),
 }
 
+/// How long the phases of [`Document::from_scene_phased`] took.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct OpenPhases {
+    /// Welding the scene into one indexed mesh.
+    pub weld: Duration,
+    /// Building the topology (edges, incidence).
+    pub topology: Duration,
+    /// Allocating and colouring the store (budget check, bake or fill, vertex colours).
+    pub store: Duration,
+}
+
 /// An open mesh with its editable colours.
 #[derive(Debug, Clone)]
 pub struct Document {
@@ -283,7 +294,8 @@ fn fill_with_position_colors(store: &mut ColorStore, positions: &[[f32; 3]]) {
 /// base colour already baked, multiplies it (glTF: COLOR_0 scales the base colour).
 fn apply_vertex_colors(store: &mut ColorStore, vertex_colors: &[[f32; 4]], multiply: bool) {
     let corners = store.topology().face_vertices.clone();
-    let current = store.clone();
+    // The colours before are needed only to multiply (a copy of the whole store otherwise).
+    let current = multiply.then(|| store.clone());
     store.fill_with(|site| {
         let face = corners[site.face as usize];
         let w = site.barycentric;
@@ -296,11 +308,12 @@ fn apply_vertex_colors(store: &mut ColorStore, vertex_colors: &[[f32; 4]], multi
             [_, _, 1.0] => c2,
             _ => std::array::from_fn(|c| w[0] * c0[c] + w[1] * c1[c] + w[2] * c2[c]),
         };
-        if multiply {
-            let base = current.get(site.sample).unwrap_or([1.0; 4]);
-            std::array::from_fn(|c| base[c] * interpolated[c])
-        } else {
-            interpolated
+        match &current {
+            Some(current) => {
+                let base = current.get(site.sample).unwrap_or([1.0; 4]);
+                std::array::from_fn(|c| base[c] * interpolated[c])
+            }
+            None => interpolated,
         }
     });
 }
@@ -438,10 +451,25 @@ impl Document {
         name: &Path,
         budget: &Budget,
     ) -> Result<Self, DocumentError> {
+        Self::from_scene_phased(scene, rule, name, budget, &mut OpenPhases::default())
+    }
+
+    /// [`Document::from_scene_within`], recording how long each phase took in `phases`
+    /// (`meshpaint bench load`).
+    pub fn from_scene_phased(
+        scene: Scene,
+        rule: impl Into<ResolutionRule>,
+        name: &Path,
+        budget: &Budget,
+        phases: &mut OpenPhases,
+    ) -> Result<Self, DocumentError> {
         let rule = rule.into();
         let budget_error = |source| DocumentError::Budget { path: name.to_owned(), source };
         budget.check_triangles("the scene", scene.instanced_triangle_count() as u64).map_err(budget_error)?;
+        let started = Instant::now();
         let welded = weld_scene(&scene);
+        phases.weld = started.elapsed();
+        let started = Instant::now();
         if let Some((vertex, position)) =
             (0u64..).zip(&welded.positions_world).find(|(_, p)| !p.iter().all(|c| c.is_finite()))
         {
@@ -449,6 +477,8 @@ impl Document {
         }
         let topology = Topology::build(welded.positions_world.len() as u32, &welded.triangles)
             .map_err(|source| DocumentError::Topology { path: name.to_owned(), source })?;
+        phases.topology = started.elapsed();
+        let started = Instant::now();
         let resolutions = match rule {
             ResolutionRule::Uniform(r) => {
                 let counts = SampleCounts::uniform_on(&topology, r);
@@ -483,6 +513,7 @@ impl Document {
             .triangle_materials
             .iter()
             .any(|m| m.and_then(|m| scene.materials.get(m as usize)).is_some_and(|m| m.base_color_texture.is_some()));
+        phases.store = started.elapsed();
         Ok(Document {
             textured,
             positions: welded.positions_world,
@@ -502,7 +533,7 @@ impl Document {
     pub fn from_packed_within(packed: &PackedMesh, budget: &Budget) -> Result<Self, PackError> {
         Ok(Document {
             positions: packed.positions.clone(),
-            store: packer::unpack_within(packed, budget)?,
+            store: crate::packing::unpack::unpack_within(packed, budget)?,
             degenerate_triangles_dropped: 0,
             source: SourceKind::Packed(packed.format),
             warnings: Vec::new(),

@@ -89,7 +89,8 @@ impl Topology {
                 half_edges.push((from.min(to), from.max(to), face, k));
             }
         }
-        half_edges.sort_unstable();
+        // Keys are unique (one per face edge), so the parallel sort's order is the total order.
+        rayon::slice::ParallelSliceMut::par_sort_unstable(&mut half_edges[..]);
 
         let mut topology = Topology {
             vertex_count,

@@ -8,16 +8,23 @@
 //! | [`packer`] | store → linear (MIP chains, eq. 2.5/2.6) and linear → store |
 //! | [`paint_layout`] | paint mode: level 0 in blocks with slack; dirty ranges and patched records |
 //! | [`lod`] | the level of detail of trilinear filtering, continuous over the mesh (per-vertex density and normal) |
+//! | [`reference`] | the straightforward serial packer the fast and incremental ones are tested against byte for byte |
+//! | [`unpack`] | linear → store (level 0 of the canonical layout); a store's chains in `f32` for reference sampling |
 //! | [`sampler`] | the CPU reference sampler (nearest, linear, MIP level) on the store and on packed buffers: the truth the GPU is tested against |
 //! | [`file`] | the packed file format (docs/FORMAT.md): writer and hostile-input-proof reader |
 
+pub(crate) mod blocks;
+pub(crate) mod chains_view;
 pub mod file;
 pub mod linear;
 pub mod lod;
+pub(crate) mod mip;
 pub mod packer;
 pub mod paint_layout;
+pub mod reference;
 pub mod sampler;
+pub mod unpack;
 
 pub use linear::{FaceRecord, PackedMesh};
-pub use packer::{PackError, pack};
+pub use packer::{PackCache, PackError, pack};
 pub use paint_layout::PaintLayout;

@@ -28,14 +28,18 @@
 //!   `2 + 2k` (weight `1/(2 + k)`). Equal-resolution faces come first, coarser ones after
 //!   (so meshes of one resolution give the same bytes as before coarser faces counted).
 
+use rayon::prelude::*;
 use thiserror::Error;
 
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::{self, Resolution};
-use crate::colors::store::{ColorStore, SampleRef};
-use crate::mesh::topology::{Topology, TopologyError};
+use crate::colors::store::{ColorStore, DirtyElements};
+use crate::mesh::topology::TopologyError;
+use crate::packing::blocks::{BLOCK, split_blocks};
+use crate::packing::chains_view::ChainsView;
 use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
-use crate::packing::sampler::{self, Filter, MeshColorSource};
+use crate::packing::mip::{interior_row_start, mip_filter, reduce_interior_chain, vertex_edges};
+use crate::packing::sampler::{self, Filter};
 
 /// Errors of packing and unpacking.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -117,199 +121,91 @@ impl PackLayout {
     }
 }
 
-/// `(C + ½ Σ N) / (1 + n/2)`: the thesis' MIP filter with the weights taken.
-fn mip_filter(center: Rgba, neighbours: &[Rgba]) -> Rgba {
-    let mut sum = [0.0f32; 4];
-    for n in neighbours {
-        for c in 0..4 {
-            sum[c] += n[c];
-        }
-    }
-    let norm = 1.0 / (1.0 + 0.5 * neighbours.len() as f32);
-    std::array::from_fn(|c| (center[c] + 0.5 * sum[c]) * norm)
-}
-
-/// For each vertex, its incident edges (CSR).
-fn vertex_edges(topology: &Topology) -> (Vec<u32>, Vec<u32>) {
-    let mut offsets = vec![0u32; topology.vertex_count as usize + 1];
-    for &[a, b] in &topology.edge_vertices {
-        offsets[a as usize + 1] += 1;
-        offsets[b as usize + 1] += 1;
-    }
-    for v in 0..topology.vertex_count as usize {
-        offsets[v + 1] += offsets[v];
-    }
-    let mut fill = offsets.clone();
-    let mut edges = vec![0u32; offsets[topology.vertex_count as usize] as usize];
-    for (edge, &[a, b]) in topology.edge_vertices.iter().enumerate() {
-        for v in [a, b] {
-            edges[fill[v as usize] as usize] = edge as u32;
-            fill[v as usize] += 1;
-        }
-    }
-    (offsets, edges)
-}
-
-/// Start of interior row `i` (`i >= 1`) of a face at resolution `r` (thesis eq. 3.2).
-fn interior_row_start(r: usize, i: usize) -> usize {
-    (i - 1) * (2 * r - 2 - i) / 2
-}
-
-/// Computes one face's whole interior chain in place: `chain` starts with level 0.
-fn reduce_interior_chain(chain: &mut [Rgba], r: Resolution) {
-    for level in 1..=r.log2() {
-        let r_src = (r.get() >> (level - 1)) as usize;
-        let r_dst = r_src / 2;
-        if r_dst < 3 {
-            break; // no interior samples at this level or below
-        }
-        let src_start = layout::interior_level_offset(r, level - 1).unwrap_or(0) as usize;
-        let dst_start = layout::interior_level_offset(r, level).unwrap_or(0) as usize;
-        let (head, tail) = chain.split_at_mut(dst_start);
-        let src = &head[src_start..];
-        let mut k = 0;
-        for i in 1..r_dst - 1 {
-            let a = 2 * i;
-            let (row_c, row_m, row_p) =
-                (interior_row_start(r_src, a), interior_row_start(r_src, a - 1), interior_row_start(r_src, a + 1));
-            for j in 1..r_dst - i {
-                let b = 2 * j;
-                // Lattice directions (1,0), (−1,0), (0,1), (0,−1), (1,−1), (−1,1).
-                let n = [
-                    src[row_p + b - 1],
-                    src[row_m + b - 1],
-                    src[row_c + b],
-                    src[row_c + b - 2],
-                    src[row_p + b - 2],
-                    src[row_m + b],
-                ];
-                tail[k] = mip_filter(src[row_c + b - 1], &n);
-                k += 1;
-            }
-        }
-    }
-}
-
-/// Runs `work` over `items` split into at most `threads` contiguous chunks.
-fn in_parallel<T: Send>(items: &mut [T], threads: usize, work: impl Fn(&mut [T]) + Sync) {
-    let chunk = items.len().div_ceil(threads.max(1)).max(1);
-    std::thread::scope(|scope| {
-        for part in items.chunks_mut(chunk) {
-            let work = &work;
-            scope.spawn(move || work(part));
-        }
-    });
-}
-
-/// Worker threads used by the packer (the machine's parallelism, at most 8).
+/// Worker threads the packer runs on (rayon's global pool).
 pub fn pack_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get()).min(8)
+    rayon::current_num_threads()
 }
 
-/// Computes every element's full MIP chain in linear `f32`.
-fn build_chains(store: &ColorStore, layout: &PackLayout, format: ColorFormat) -> Vec<Rgba> {
-    let topology = store.topology();
-    let threads = pack_threads();
-    let mut colors = vec![[0.0f32; 4]; layout.sample_count as usize];
-    // Level 0, quantised to the output format (so the chain filters what is stored).
-    let levels = layout.vertex_levels as usize;
-    let vertex_section = topology.vertex_count as usize * levels;
-    for v in 0..topology.vertex_count as usize {
-        colors[v * levels] = format.quantize(store.vertex_color(v as u32).unwrap_or([0.0; 4]));
-    }
-    for edge in 0..topology.edge_count() {
-        let base = layout.edge_base[edge as usize] as usize;
-        let samples = store.edge_samples(edge);
-        for (slot, &color) in colors[base..base + samples.len()].iter_mut().zip(samples) {
-            *slot = format.quantize(color);
-        }
-    }
-    // Interiors: each face's chain is contiguous and independent; faces are laid out in
-    // order, so the interior section splits into per-face slices processed in parallel.
-    {
-        let interior_start = layout.interior_base.iter().copied().find(|&b| b != 0).unwrap_or(0) as usize;
-        let interior_start = interior_start.max(vertex_section);
-        let (_, interiors) = colors.split_at_mut(interior_start.min(layout.sample_count as usize));
-        let mut faces: Vec<(u32, &mut [Rgba])> = Vec::with_capacity(topology.face_count() as usize);
-        let mut rest = interiors;
-        for face in 0..topology.face_count() {
-            let r = store.face_resolution(face).unwrap_or(Resolution::ONE);
-            let len = layout::interior_chain_len(r) as usize;
-            let (chain, tail) = std::mem::take(&mut rest).split_at_mut(len);
-            rest = tail;
-            faces.push((face, chain));
-        }
-        in_parallel(&mut faces, threads, |part| {
-            for (face, chain) in part.iter_mut() {
-                let r = store.face_resolution(*face).unwrap_or(Resolution::ONE);
-                let level0 = store.interior_samples(*face);
-                for (slot, &color) in chain.iter_mut().zip(level0) {
-                    *slot = format.quantize(color);
-                }
-                reduce_interior_chain(chain, r);
-            }
-        });
-    }
-    reduce_edges_and_vertices(store, layout, &mut colors, threads);
-    colors
+/// The colour buffer's three sections.
+#[derive(Debug, Clone, Copy)]
+struct Sections {
+    /// Colours per vertex.
+    levels: usize,
+    /// End of the vertex section (`V · levels`).
+    vertex_end: usize,
+    /// End of the edge section (start of the interiors).
+    edge_end: usize,
+    /// Total samples.
+    total: usize,
 }
 
-/// Per-edge data the edge and vertex passes read in their inner loops.
-struct EdgeInfo {
-    log2: u32,
-    base: usize,
-    vertices: [u32; 2],
-    /// Incident faces at the edge's resolution: (interior chain base, face edge, reversed).
-    full_faces: Vec<(usize, u8, bool)>,
-    /// Incident faces coarser than the edge: (face, face edge, reversed).
-    coarse_faces: Vec<(u32, u8, bool)>,
+impl Sections {
+    fn of(store: &ColorStore, layout: &PackLayout) -> Self {
+        let topology = store.topology();
+        let levels = layout.vertex_levels as usize;
+        let vertex_end = topology.vertex_count as usize * levels;
+        let edge_samples: usize = (0..topology.edge_count())
+            .map(|e| store.edge_resolution(e).map_or(0, layout::edge_chain_len) as usize)
+            .sum();
+        Sections { levels, vertex_end, edge_end: vertex_end + edge_samples, total: layout.sample_count as usize }
+    }
 }
 
-/// The colour buffer while the edge and vertex chains are being built, read through the
-/// sampler's addressing (every level below the one being built is final).
-struct ChainsView<'a> {
+/// What the edge and vertex passes read: store, layout, records, sections.
+struct Context<'a> {
     store: &'a ColorStore,
+    layout: &'a PackLayout,
     records: &'a [FaceRecord],
-    vertex_levels: u32,
-    vertex_colors: &'a [Rgba],
-    edge_colors: &'a [Rgba],
-    interior_colors: &'a [Rgba],
-    vertex_section: usize,
-    interior_start: usize,
+    sections: Sections,
+    format: ColorFormat,
 }
 
-impl ChainsView<'_> {
-    fn at(&self, index: u64) -> Option<Rgba> {
-        let index = usize::try_from(index).ok()?;
-        if index < self.vertex_section {
-            self.vertex_colors.get(index).copied()
-        } else if index < self.interior_start {
-            self.edge_colors.get(index - self.vertex_section).copied()
-        } else {
-            self.interior_colors.get(index - self.interior_start).copied()
+impl Context<'_> {
+    fn edge_log2(&self, edge: u32) -> u32 {
+        self.store.edge_resolution(edge).map_or(0, Resolution::log2)
+    }
+
+    /// Whether `edge` has an incident face coarser than itself.
+    fn has_coarse_faces(&self, edge: u32) -> bool {
+        let r_edge = self.store.edge_resolution(edge);
+        self.store.topology().faces_of_edge(edge).iter().any(|&(face, _)| self.store.face_resolution(face) != r_edge)
+    }
+
+    /// Writes level 0 of every vertex in `ids` (block `vertex` chains) and its encoding.
+    fn vertex_level0(&self, v: u32, chain: &mut [Rgba], bytes: &mut [u8]) {
+        let size = self.format.bytes_per_sample();
+        let color = self.store.vertex_color(v).unwrap_or([0.0; 4]);
+        chain[0] = self.format.encode_quantized(color, &mut bytes[..size]);
+    }
+
+    /// Writes level 0 of `edge` from the store and its encoding.
+    fn edge_level0(&self, edge: u32, chain: &mut [Rgba], bytes: &mut [u8]) {
+        let size = self.format.bytes_per_sample();
+        for ((slot, out), &color) in
+            chain.iter_mut().zip(bytes.chunks_exact_mut(size)).zip(self.store.edge_samples(edge))
+        {
+            *slot = self.format.encode_quantized(color, out);
         }
     }
-}
 
-impl MeshColorSource for ChainsView<'_> {
-    fn face_resolution(&self, face: u32) -> Option<Resolution> {
-        self.store.face_resolution(face)
+    /// Builds and encodes `face`'s whole interior chain (level 0 encoded once).
+    fn interior_chain(&self, face: u32, chain: &mut [Rgba], bytes: &mut [u8]) {
+        let size = self.format.bytes_per_sample();
+        let level0 = self.store.interior_samples(face);
+        for ((slot, out), &color) in chain.iter_mut().zip(bytes.chunks_exact_mut(size)).zip(level0) {
+            *slot = self.format.encode_quantized(color, out);
+        }
+        let r = self.store.face_resolution(face).unwrap_or(Resolution::ONE);
+        reduce_interior_chain(chain, r);
+        let n0 = level0.len().min(chain.len());
+        self.format.encode_slice(&chain[n0..], &mut bytes[n0 * size..]);
     }
 
-    fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
-        let record = self.records.get(face as usize)?;
-        let corners = self.store.topology().face_vertices.get(face as usize)?;
-        self.at(sampler::record_sample_index(record, corners, self.vertex_levels, level, i, j)?)
-    }
-
-    fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution> {
-        Some(self.records.get(face as usize)?.edge(usize::from(k))?.1)
-    }
-
-    fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba> {
-        let record = self.records.get(face as usize)?;
-        let corners = self.store.topology().face_vertices.get(face as usize)?;
-        self.at(sampler::record_edge_index(record, corners, k, level, p)?)
+    /// Encodes levels 1.. of an edge chain (level 0 was encoded with the store read).
+    fn encode_edge_upper(&self, edge: u32, chain: &[Rgba], bytes: &mut [u8]) {
+        let size = self.format.bytes_per_sample();
+        let n0 = self.store.edge_samples(edge).len().min(chain.len());
+        self.format.encode_slice(&chain[n0..], &mut bytes[n0 * size..]);
     }
 }
 
@@ -323,185 +219,67 @@ fn inside_neighbours(face_edge: u8, p: usize, rp: usize) -> [(usize, usize); 2] 
     }
 }
 
-/// Edge MIP levels (eq. 2.6 on edges) and vertex MIP levels (eq. 2.5), level by level.
-/// The buffer splits into vertex / edge / interior sections: a pass writes one section
-/// in parallel chunks while reading the others.
-/// Long: one level loop over three borrowed sections (coarse-face neighbours, edges,
-/// vertices in parallel chunks); splitting it would re-split the buffer per helper.
-fn reduce_edges_and_vertices(store: &ColorStore, layout: &PackLayout, colors: &mut [Rgba], threads: usize) {
-    let topology = store.topology();
-    let levels = layout.vertex_levels as usize;
-    let vertex_section = topology.vertex_count as usize * levels;
-    let edges: Vec<EdgeInfo> = (0..topology.edge_count())
-        .map(|edge| {
-            let r_edge = store.edge_resolution(edge).unwrap_or(Resolution::ONE);
-            let full_faces = topology
-                .faces_of_edge(edge)
-                .iter()
-                .filter(|&&(face, _)| store.face_resolution(face) == Some(r_edge))
-                .map(|&(face, k)| {
-                    (layout.interior_base[face as usize] as usize, k, topology.is_reversed(face, usize::from(k)))
-                })
-                .collect();
-            let coarse_faces = topology
-                .faces_of_edge(edge)
-                .iter()
-                .filter(|&&(face, _)| store.face_resolution(face) != Some(r_edge))
-                .map(|&(face, k)| (face, k, topology.is_reversed(face, usize::from(k))))
-                .collect();
-            EdgeInfo {
-                log2: r_edge.log2(),
-                base: layout.edge_base[edge as usize] as usize,
-                vertices: topology.edge_vertices[edge as usize],
-                full_faces,
-                coarse_faces,
+/// What the coarser faces of `edge` show next to its level-`(level − 1)` samples (the seam
+/// rule): for `k` in `1..r_level`, two colours per coarse face.
+fn coarse_neighbours(ctx: &Context, view: &ChainsView, edge: u32, level: u32) -> Vec<Rgba> {
+    let mut out = Vec::new();
+    let log2 = ctx.edge_log2(edge);
+    if log2 < level + 1 {
+        return out;
+    }
+    let r_edge = ctx.store.edge_resolution(edge);
+    let topology = ctx.store.topology();
+    let r_level = 1usize << (log2 - level);
+    let rp = 2 * r_level;
+    for k in 1..r_level {
+        for &(face, face_edge) in topology.faces_of_edge(edge) {
+            if ctx.store.face_resolution(face) == r_edge {
+                continue;
             }
-        })
-        .collect();
-    let edge_section_end = edges
-        .iter()
-        .map(|e| e.base + layout::edge_chain_len(Resolution::from_log2(e.log2).unwrap_or(Resolution::ONE)) as usize)
-        .max()
-        .unwrap_or(vertex_section)
-        .max(vertex_section);
-    let (vertex_colors, rest) = colors.split_at_mut(vertex_section);
-    let (edge_colors, interior_colors) = rest.split_at_mut(edge_section_end - vertex_section);
-    let interior_colors: &[Rgba] = interior_colors;
-    let interior_start = edge_section_end;
-    let (vertex_edge_offsets, vertex_edge_list) = vertex_edges(topology);
-    let records: Vec<FaceRecord> = (0..topology.face_count()).map(|f| layout.face_record(store, f)).collect();
-    for level in 1..levels {
-        let previous = level - 1;
-        let coarse_neighbours = {
-            let view = ChainsView {
-                store,
-                records: &records,
-                vertex_levels: layout.vertex_levels,
-                vertex_colors: &*vertex_colors,
-                edge_colors: &*edge_colors,
-                interior_colors,
-                vertex_section,
-                interior_start,
-            };
-            coarse_neighbours(&view, &edges, level as u32)
-        };
-        // Edges: each edge's chain is its own slice.
-        {
-            let vertex_colors: &[Rgba] = vertex_colors;
-            let mut chains: Vec<(&EdgeInfo, &[Rgba], &mut [Rgba])> = Vec::with_capacity(edges.len());
-            let mut rest: &mut [Rgba] = edge_colors;
-            let mut cursor = vertex_section;
-            for (n, info) in edges.iter().enumerate() {
-                let len = layout::edge_chain_len(Resolution::from_log2(info.log2).unwrap_or(Resolution::ONE)) as usize;
-                if len == 0 {
-                    continue;
-                }
-                let (_, tail) = std::mem::take(&mut rest).split_at_mut(info.base - cursor);
-                let (chain, tail) = tail.split_at_mut(len);
-                rest = tail;
-                cursor = info.base + len;
-                chains.push((info, &coarse_neighbours[n], chain));
+            let reversed = topology.is_reversed(face, usize::from(face_edge));
+            let p = if reversed { rp - 2 * k } else { 2 * k };
+            for (i, j) in inside_neighbours(face_edge, p, rp) {
+                let w = [(rp - i - j) as f32, i as f32, j as f32].map(|w| w / rp as f32);
+                let color = sampler::sample(view, face, w, Filter::Linear, level - 1);
+                out.push(color.unwrap_or([0.0; 4]));
             }
-            in_parallel(&mut chains, threads, |part| {
-                let mut neighbours: Vec<Rgba> = Vec::with_capacity(16);
-                for (info, coarse, chain) in part.iter_mut() {
-                    reduce_edge_level(
-                        info,
-                        coarse,
-                        chain,
-                        level as u32,
-                        vertex_colors,
-                        levels,
-                        interior_colors,
-                        interior_start,
-                        &mut neighbours,
-                    );
-                }
-            });
-        }
-        // Vertices: each vertex's levels are a slice of `levels` colours.
-        {
-            let edge_colors: &[Rgba] = edge_colors;
-            let mut slots: Vec<(u32, &mut [Rgba])> =
-                vertex_colors.chunks_mut(levels).enumerate().map(|(v, s)| (v as u32, s)).collect();
-            in_parallel(&mut slots, threads, |part| {
-                let mut neighbours: Vec<Rgba> = Vec::with_capacity(16);
-                for (v, slot) in part.iter_mut() {
-                    neighbours.clear();
-                    let range =
-                        vertex_edge_offsets[*v as usize] as usize..vertex_edge_offsets[*v as usize + 1] as usize;
-                    for &edge in &vertex_edge_list[range] {
-                        let info = &edges[edge as usize];
-                        if info.log2 < previous as u32 + 1 {
-                            continue; // the edge has no samples at the previous level
-                        }
-                        let r_previous = 1u32 << (info.log2 - previous as u32);
-                        let r_edge = Resolution::from_log2(info.log2).unwrap_or(Resolution::ONE);
-                        let level_start =
-                            info.base + layout::edge_level_offset(r_edge, previous as u32).unwrap_or(0) as usize;
-                        let position = if *v == info.vertices[0] { 1 } else { r_previous - 1 };
-                        neighbours.push(edge_colors[level_start - vertex_section + position as usize - 1]);
-                    }
-                    slot[level] = mip_filter(slot[previous], &neighbours);
-                }
-            });
         }
     }
+    out
 }
 
-/// What coarser faces show next to each edge sample of level `level − 1` (the seam rule):
-/// per edge, for `k` in `1..r_level`, two colours per coarse face.
-fn coarse_neighbours(view: &ChainsView, edges: &[EdgeInfo], level: u32) -> Vec<Vec<Rgba>> {
-    edges
-        .iter()
-        .map(|info| {
-            let mut out = Vec::new();
-            if info.coarse_faces.is_empty() || info.log2 < level + 1 {
-                return out;
-            }
-            let r_level = 1usize << (info.log2 - level);
-            let rp = 2 * r_level;
-            for k in 1..r_level {
-                for &(face, face_edge, reversed) in &info.coarse_faces {
-                    let p = if reversed { rp - 2 * k } else { 2 * k };
-                    for (i, j) in inside_neighbours(face_edge, p, rp) {
-                        let w = [(rp - i - j) as f32, i as f32, j as f32].map(|w| w / rp as f32);
-                        let color = sampler::sample(view, face, w, Filter::Linear, level - 1);
-                        out.push(color.unwrap_or([0.0; 4]));
-                    }
-                }
-            }
-            out
-        })
-        .collect()
-}
-
-/// Level `level` of one edge chain from level `level − 1`.
+/// Level `level` of `edge`'s chain from level `level − 1` (eq. 2.6 on the edge).
 #[allow(clippy::too_many_arguments)]
 fn reduce_edge_level(
-    info: &EdgeInfo,
+    ctx: &Context,
+    edge: u32,
     coarse: &[Rgba],
     chain: &mut [Rgba],
     level: u32,
     vertex_colors: &[Rgba],
-    levels: usize,
     interior_colors: &[Rgba],
-    interior_start: usize,
     neighbours: &mut Vec<Rgba>,
 ) {
-    if info.log2 < level + 1 {
+    let log2 = ctx.edge_log2(edge);
+    if log2 < level + 1 {
         return; // resolution 1 at this level: no edge samples
     }
-    let r_edge = Resolution::from_log2(info.log2).unwrap_or(Resolution::ONE);
-    let r_level = 1u32 << (info.log2 - level);
+    let store = ctx.store;
+    let topology = store.topology();
+    let levels = ctx.sections.levels;
+    let interior_start = ctx.sections.edge_end;
+    let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
+    let r_level = 1u32 << (log2 - level);
     let r_previous = 2 * r_level;
     let previous_start = layout::edge_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
     let level_start = layout::edge_level_offset(r_edge, level).unwrap_or(0) as usize;
-    let [lower, higher] = info.vertices;
+    let [lower, higher] = topology.edge_vertices[edge as usize];
     let lower_color = vertex_colors[lower as usize * levels + level as usize - 1];
     let higher_color = vertex_colors[higher as usize * levels + level as usize - 1];
     let face_level_offset = layout::interior_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
     let rp = r_previous as usize;
+    let faces = topology.faces_of_edge(edge);
+    let coarse_count = faces.iter().filter(|&&(face, _)| store.face_resolution(face) != Some(r_edge)).count();
     for k in 1..r_level {
         let position = 2 * k;
         let at = |p: u32| -> Rgba {
@@ -517,152 +295,467 @@ fn reduce_edge_level(
         neighbours.clear();
         neighbours.push(at(position - 1));
         neighbours.push(at(position + 1));
-        for &(face_base, face_edge, reversed) in &info.full_faces {
+        for &(face, face_edge) in faces {
+            if store.face_resolution(face) != Some(r_edge) {
+                continue;
+            }
+            let reversed = topology.is_reversed(face, usize::from(face_edge));
             let p = if reversed { r_previous - position } else { position } as usize;
-            // The two lattice neighbours strictly inside the face, in LATTICE_DIRECTIONS order.
-            let inside = match face_edge {
-                0 => [(p, 1), (p - 1, 1)],
-                1 => [(rp - p - 1, p), (rp - p, p - 1)],
-                _ => [(1, rp - p), (1, rp - p - 1)],
-            };
+            let face_base = ctx.layout.interior_base[face as usize] as usize;
             let start = face_base - interior_start + face_level_offset;
-            for (i, j) in inside {
+            for (i, j) in inside_neighbours(face_edge, p, rp) {
                 neighbours.push(interior_colors[start + interior_row_start(rp, i) + j - 1]);
             }
         }
         // Coarser faces: what they show at those two points (computed beforehand).
-        let per_k = 2 * info.coarse_faces.len();
+        let per_k = 2 * coarse_count;
         neighbours.extend_from_slice(coarse.get((k as usize - 1) * per_k..k as usize * per_k).unwrap_or(&[]));
         chain[level_start + k as usize - 1] = mip_filter(center, neighbours);
     }
 }
 
+/// Level `level` of vertex `v` (eq. 2.5) from its incident edges' level `level − 1`.
+fn reduce_vertex_level(
+    ctx: &Context,
+    incident: &[u32],
+    v: u32,
+    slot: &mut [Rgba],
+    level: usize,
+    edge_colors: &[Rgba],
+    neighbours: &mut Vec<Rgba>,
+) {
+    let previous = level - 1;
+    neighbours.clear();
+    for &edge in incident {
+        let log2 = ctx.edge_log2(edge);
+        if log2 < previous as u32 + 1 {
+            continue; // the edge has no samples at the previous level
+        }
+        let r_previous = 1u32 << (log2 - previous as u32);
+        let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
+        let level_start = ctx.layout.edge_base[edge as usize] as usize
+            + layout::edge_level_offset(r_edge, previous as u32).unwrap_or(0) as usize;
+        let position = if v == ctx.store.topology().edge_vertices[edge as usize][0] { 1 } else { r_previous - 1 };
+        neighbours.push(edge_colors[level_start - ctx.sections.vertex_end + position as usize - 1]);
+    }
+    slot[level] = mip_filter(slot[previous], neighbours);
+}
+
+/// Sorted edge ids → what their coarse faces show at `level − 1`, for the ids of `edges`
+/// that have coarse faces.
+fn coarse_table(ctx: &Context, view: &ChainsView, edges: &[u32], level: u32) -> (Vec<u32>, Vec<Vec<Rgba>>) {
+    let ids: Vec<u32> = edges.par_iter().copied().filter(|&e| ctx.has_coarse_faces(e)).collect();
+    let values = ids.par_iter().map(|&e| coarse_neighbours(ctx, view, e, level)).collect();
+    (ids, values)
+}
+
+fn coarse_of(table: &(Vec<u32>, Vec<Vec<Rgba>>), edge: u32) -> &[Rgba] {
+    match table.0.binary_search(&edge) {
+        Ok(n) => &table.1[n],
+        Err(_) => &[],
+    }
+}
+
+/// The full pack into `chains` / `bytes` (both zeroed, `layout.sample_count` samples).
+/// Long: three sections split and re-split per pass (level 0, interiors, each level of
+/// edges and vertices, encoding), each pass a few lines of rayon.
+fn build_all(ctx: &Context, chains: &mut [Rgba], bytes: &mut [u8], vertex_edge: &(Vec<u32>, Vec<u32>)) {
+    let store = ctx.store;
+    let topology = store.topology();
+    let layout = ctx.layout;
+    let s = ctx.sections;
+    let size = ctx.format.bytes_per_sample();
+    let (vertex_colors, rest) = chains.split_at_mut(s.vertex_end);
+    let (edge_colors, interior_colors) = rest.split_at_mut(s.edge_end - s.vertex_end);
+    let (vertex_bytes, rest_bytes) = bytes.split_at_mut(s.vertex_end * size);
+    let (edge_bytes, interior_bytes) = rest_bytes.split_at_mut((s.edge_end - s.vertex_end) * size);
+    // Level 0 of vertices and edges (encoded once, here), every interior chain.
+    let levels = s.levels;
+    vertex_colors
+        .par_chunks_mut(levels)
+        .zip(vertex_bytes.par_chunks_mut(levels * size))
+        .enumerate()
+        .for_each(|(v, (chain, out))| ctx.vertex_level0(v as u32, chain, out));
+    let edge_base = |e: u32| {
+        let len = store.edge_resolution(e).map_or(0, layout::edge_chain_len);
+        (len > 0).then(|| layout.edge_base[e as usize] as usize)
+    };
+    let edge_len = |e: u32| store.edge_resolution(e).map_or(0, layout::edge_chain_len) as usize;
+    split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base)
+        .into_par_iter()
+        .for_each(|block| {
+            for e in block.ids.clone() {
+                if let Some(b) = edge_base(e) {
+                    let at = b - block.offset;
+                    let len = edge_len(e);
+                    ctx.edge_level0(e, &mut block.chains[at..at + len], &mut block.bytes[at * size..(at + len) * size]);
+                }
+            }
+        });
+    let interior_base = |f: u32| {
+        let r = store.face_resolution(f).unwrap_or(Resolution::ONE);
+        (layout::interior_chain_len(r) > 0).then(|| layout.interior_base[f as usize] as usize)
+    };
+    let interior_len =
+        |f: u32| layout::interior_chain_len(store.face_resolution(f).unwrap_or(Resolution::ONE)) as usize;
+    split_blocks(interior_colors, interior_bytes, size, s.edge_end, topology.face_count(), interior_base)
+        .into_par_iter()
+        .for_each(|block| {
+            for f in block.ids.clone() {
+                if let Some(b) = interior_base(f) {
+                    let at = b - block.offset;
+                    let len = interior_len(f);
+                    ctx.interior_chain(
+                        f,
+                        &mut block.chains[at..at + len],
+                        &mut block.bytes[at * size..(at + len) * size],
+                    );
+                }
+            }
+        });
+    let interior_colors: &[Rgba] = interior_colors;
+    let all_edges: Vec<u32> = (0..topology.edge_count()).collect();
+    for level in 1..levels {
+        let coarse = {
+            let view = ChainsView {
+                store,
+                records: ctx.records,
+                vertex_levels: layout.vertex_levels,
+                vertex_colors: &*vertex_colors,
+                edge_colors: &*edge_colors,
+                interior_colors,
+                vertex_section: s.vertex_end,
+                interior_start: s.edge_end,
+            };
+            coarse_table(ctx, &view, &all_edges, level as u32)
+        };
+        {
+            let vertex_colors: &[Rgba] = vertex_colors;
+            // The byte halves are not written here: split a throwaway empty buffer.
+            let mut no_bytes: [u8; 0] = [];
+            split_blocks(edge_colors, &mut no_bytes, 0, s.vertex_end, topology.edge_count(), edge_base)
+                .into_par_iter()
+                .for_each(|block| {
+                    let mut neighbours = Vec::with_capacity(16);
+                    for e in block.ids.clone() {
+                        if let Some(b) = edge_base(e) {
+                            let at = b - block.offset;
+                            reduce_edge_level(
+                                ctx,
+                                e,
+                                coarse_of(&coarse, e),
+                                &mut block.chains[at..at + edge_len(e)],
+                                level as u32,
+                                vertex_colors,
+                                interior_colors,
+                                &mut neighbours,
+                            );
+                        }
+                    }
+                });
+        }
+        let edge_colors: &[Rgba] = edge_colors;
+        let (offsets, list) = vertex_edge;
+        vertex_colors.par_chunks_mut(levels).enumerate().with_min_len(BLOCK).for_each_init(
+            || Vec::with_capacity(16),
+            |neighbours, (v, slot)| {
+                let incident = &list[offsets[v] as usize..offsets[v + 1] as usize];
+                reduce_vertex_level(ctx, incident, v as u32, slot, level, edge_colors, neighbours);
+            },
+        );
+    }
+    // Levels 1.. of edges and vertices, encoded once they are final.
+    split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base)
+        .into_par_iter()
+        .for_each(|block| {
+            for e in block.ids.clone() {
+                if let Some(b) = edge_base(e) {
+                    let at = b - block.offset;
+                    let len = edge_len(e);
+                    ctx.encode_edge_upper(
+                        e,
+                        &block.chains[at..at + len],
+                        &mut block.bytes[at * size..(at + len) * size],
+                    );
+                }
+            }
+        });
+    if levels > 1 {
+        vertex_colors.par_chunks(levels).zip(vertex_bytes.par_chunks_mut(levels * size)).for_each(|(chain, out)| {
+            ctx.format.encode_slice(&chain[1..], &mut out[size..]);
+        });
+    }
+}
+
+/// A packed mesh with what an incremental repack needs: its layout, every chain in `f32`
+/// and the vertex → edge incidence. Built by a full pack; [`PackCache::update`] then
+/// recomputes only the chains an edit reaches.
+#[derive(Debug, Clone)]
+pub struct PackCache {
+    layout: PackLayout,
+    sections: Sections,
+    chains: Vec<Rgba>,
+    vertex_edge: (Vec<u32>, Vec<u32>),
+    packed: PackedMesh,
+}
+
+/// Samples an incremental repack rewrote, as sorted, merged `(first, count)` ranges.
+pub type SampleRanges = Vec<(u64, u64)>;
+
+impl PackCache {
+    /// Packs `store` (a full pack) and keeps what an incremental repack needs.
+    pub fn build(store: &ColorStore, positions: &[[f32; 3]], format: ColorFormat) -> Result<Self, PackError> {
+        let topology = store.topology();
+        if positions.len() != topology.vertex_count as usize {
+            return Err(PackError::PositionCount { positions: positions.len(), vertices: topology.vertex_count });
+        }
+        let layout = PackLayout::of(store)?;
+        let sections = Sections::of(store, &layout);
+        let records: Vec<FaceRecord> = (0..topology.face_count())
+            .into_par_iter()
+            .with_min_len(BLOCK)
+            .map(|f| layout.face_record(store, f))
+            .collect();
+        let size = format.bytes_per_sample();
+        let mut chains = vec![[0.0f32; 4]; sections.total];
+        let mut colors = vec![0u8; sections.total * size];
+        let vertex_edge = vertex_edges(topology);
+        {
+            let ctx = Context { store, layout: &layout, records: &records, sections, format };
+            build_all(&ctx, &mut chains, &mut colors, &vertex_edge);
+        }
+        let packed = PackedMesh {
+            positions: positions.to_vec(),
+            indices: topology.face_vertices.clone(),
+            vertex_levels: layout.vertex_levels,
+            face_records: records,
+            format,
+            colors,
+        };
+        Ok(PackCache { layout, sections, chains, vertex_edge, packed })
+    }
+
+    /// The packed mesh.
+    pub fn packed(&self) -> &PackedMesh {
+        &self.packed
+    }
+
+    /// The packed mesh, dropping the rest.
+    pub fn into_packed(self) -> PackedMesh {
+        self.packed
+    }
+
+    /// Brings the packed mesh up to date with the edits in `dirty` (everything changed in
+    /// `store` since this cache was built or last updated): level 0 of the dirty elements,
+    /// the interior chains of dirty faces and, level by level, the edge and vertex chains
+    /// whose inputs changed. Gives exactly the bytes of a full pack of `store`. Returns the
+    /// rewritten sample ranges, or `None` when the layout no longer fits (a resolution
+    /// changed, or the store is not the one packed): then build a new cache.
+    /// Long: one level loop over the growing sets of edges and vertices it recomputes and
+    /// the buffer sections it borrows; split, the sets would travel through every helper.
+    pub fn update(&mut self, store: &ColorStore, dirty: &DirtyElements) -> Option<SampleRanges> {
+        let topology = store.topology();
+        if !dirty.resized_faces.is_empty()
+            || !dirty.resized_edges.is_empty()
+            || topology.face_count() as usize != self.packed.face_records.len()
+            || topology.vertex_count as usize != self.packed.positions.len()
+            || topology.edge_count() as usize != self.layout.edge_base.len()
+        {
+            return None;
+        }
+        let format = self.packed.format;
+        let size = format.bytes_per_sample();
+        let s = self.sections;
+        let levels = s.levels;
+        let layout = &self.layout;
+        let ctx = Context { store, layout, records: &self.packed.face_records, sections: s, format };
+        let chains = &mut self.chains;
+        let bytes = &mut self.packed.colors;
+        let edge_len = |e: u32| store.edge_resolution(e).map_or(0, layout::edge_chain_len) as usize;
+        let interior_len =
+            |f: u32| layout::interior_chain_len(store.face_resolution(f).unwrap_or(Resolution::ONE)) as usize;
+        // Level 0 and whole interior chains.
+        for &v in &dirty.vertices {
+            let at = v as usize * levels;
+            ctx.vertex_level0(v, &mut chains[at..at + levels], &mut bytes[at * size..(at + levels) * size]);
+        }
+        for &e in &dirty.edges {
+            let (at, len) = (layout.edge_base[e as usize] as usize, edge_len(e));
+            if len > 0 {
+                ctx.edge_level0(e, &mut chains[at..at + len], &mut bytes[at * size..(at + len) * size]);
+            }
+        }
+        {
+            let (_, interior_chains) = chains.split_at_mut(s.edge_end);
+            let (_, interior_bytes) = bytes.split_at_mut(s.edge_end * size);
+            let mut faces: Vec<(u32, &mut [Rgba], &mut [u8])> = Vec::with_capacity(dirty.faces.len());
+            let (mut rest_c, mut rest_b, mut cursor) = (interior_chains, interior_bytes, s.edge_end);
+            for &f in &dirty.faces {
+                let len = interior_len(f);
+                if len == 0 {
+                    continue;
+                }
+                let at = layout.interior_base[f as usize] as usize;
+                let (_, c) = std::mem::take(&mut rest_c).split_at_mut(at - cursor);
+                let (_, b) = std::mem::take(&mut rest_b).split_at_mut((at - cursor) * size);
+                let (chain, c_tail) = c.split_at_mut(len);
+                let (out, b_tail) = b.split_at_mut(len * size);
+                rest_c = c_tail;
+                rest_b = b_tail;
+                cursor = at + len;
+                faces.push((f, chain, out));
+            }
+            faces.par_iter_mut().for_each(|(f, chain, out)| ctx.interior_chain(*f, chain, out));
+        }
+        // Which edges and vertices each level recomputes: an edge at level l reads its own
+        // level l − 1, its endpoints', its faces' (interiors, and what coarse faces show,
+        // which may read any element of such a face); a vertex reads its edges'. So a face
+        // is touched when any of its elements changed at a finer level, and every edge of a
+        // touched face is recomputed from there on (cumulative sets, a safe superset).
+        let mut edge_flag = vec![false; topology.edge_count() as usize];
+        let mut vertex_flag = vec![false; topology.vertex_count as usize];
+        let mut face_flag = vec![false; topology.face_count() as usize];
+        let mut edges: Vec<u32> = Vec::new();
+        let mut vertices: Vec<u32> = Vec::new();
+        for &e in &dirty.edges {
+            if !std::mem::replace(&mut edge_flag[e as usize], true) {
+                edges.push(e);
+            }
+        }
+        for &v in &dirty.vertices {
+            if !std::mem::replace(&mut vertex_flag[v as usize], true) {
+                vertices.push(v);
+            }
+        }
+        let (offsets, incident) = &self.vertex_edge;
+        let mut touched: Vec<u32> = Vec::new();
+        for level in 1..levels {
+            // Faces whose elements changed at a finer level (E and V as of level − 1).
+            touched.clear();
+            let mut touch = |face: u32, touched: &mut Vec<u32>| {
+                if !std::mem::replace(&mut face_flag[face as usize], true) {
+                    touched.push(face);
+                }
+            };
+            for &f in &dirty.faces {
+                touch(f, &mut touched);
+            }
+            for &v in &vertices {
+                for &e in &incident[offsets[v as usize] as usize..offsets[v as usize + 1] as usize] {
+                    for &(f, _) in topology.faces_of_edge(e) {
+                        touch(f, &mut touched);
+                    }
+                }
+            }
+            for &e in &edges {
+                for &(f, _) in topology.faces_of_edge(e) {
+                    touch(f, &mut touched);
+                }
+            }
+            for &f in &touched {
+                face_flag[f as usize] = false;
+            }
+            // Vertices read their edges; edges read everything of their faces.
+            let previous_edges = edges.len();
+            for &e in &edges[..previous_edges] {
+                for v in topology.edge_vertices[e as usize] {
+                    if !std::mem::replace(&mut vertex_flag[v as usize], true) {
+                        vertices.push(v);
+                    }
+                }
+            }
+            for &f in &touched {
+                for e in topology.face_edges[f as usize] {
+                    if !std::mem::replace(&mut edge_flag[e as usize], true) {
+                        edges.push(e);
+                    }
+                }
+            }
+            edges.sort_unstable();
+            vertices.sort_unstable();
+            let (vertex_colors, rest) = chains.split_at_mut(s.vertex_end);
+            let (edge_colors, interior_colors) = rest.split_at_mut(s.edge_end - s.vertex_end);
+            let interior_colors: &[Rgba] = interior_colors;
+            let coarse = {
+                let view = ChainsView {
+                    store,
+                    records: ctx.records,
+                    vertex_levels: layout.vertex_levels,
+                    vertex_colors: &*vertex_colors,
+                    edge_colors: &*edge_colors,
+                    interior_colors,
+                    vertex_section: s.vertex_end,
+                    interior_start: s.edge_end,
+                };
+                coarse_table(&ctx, &view, &edges, level as u32)
+            };
+            let mut neighbours = Vec::with_capacity(16);
+            for &e in &edges {
+                let len = edge_len(e);
+                if len == 0 {
+                    continue;
+                }
+                let at = layout.edge_base[e as usize] as usize - s.vertex_end;
+                reduce_edge_level(
+                    &ctx,
+                    e,
+                    coarse_of(&coarse, e),
+                    &mut edge_colors[at..at + len],
+                    level as u32,
+                    vertex_colors,
+                    interior_colors,
+                    &mut neighbours,
+                );
+            }
+            for &v in &vertices {
+                let at = v as usize * levels;
+                let list = &incident[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
+                reduce_vertex_level(
+                    &ctx,
+                    list,
+                    v,
+                    &mut vertex_colors[at..at + levels],
+                    level,
+                    edge_colors,
+                    &mut neighbours,
+                );
+            }
+        }
+        // Encode what changed; report it as ranges.
+        let mut ranges: Vec<(u64, u64)> = Vec::new();
+        for &v in &vertices {
+            let at = v as usize * levels;
+            format.encode_slice(&chains[at + 1..at + levels], &mut bytes[(at + 1) * size..(at + levels) * size]);
+            ranges.push((at as u64, levels as u64));
+        }
+        for &e in &edges {
+            let (at, len) = (layout.edge_base[e as usize] as usize, edge_len(e));
+            if len > 0 {
+                ctx.encode_edge_upper(e, &chains[at..at + len], &mut bytes[at * size..(at + len) * size]);
+                ranges.push((at as u64, len as u64));
+            }
+        }
+        for &f in &dirty.faces {
+            let (at, len) = (layout.interior_base[f as usize] as usize, interior_len(f));
+            if len > 0 {
+                ranges.push((at as u64, len as u64));
+            }
+        }
+        ranges.sort_unstable();
+        let mut merged: SampleRanges = Vec::with_capacity(ranges.len());
+        for (first, count) in ranges {
+            match merged.last_mut() {
+                Some((last_first, last_count)) if *last_first + *last_count >= first => {
+                    *last_count = (*last_count).max(first + count - *last_first);
+                }
+                _ => merged.push((first, count)),
+            }
+        }
+        Some(merged)
+    }
+}
+
 /// Packs the store with `positions` (one per vertex) into linear buffers.
 pub fn pack(store: &ColorStore, positions: &[[f32; 3]], format: ColorFormat) -> Result<PackedMesh, PackError> {
-    let topology = store.topology();
-    if positions.len() != topology.vertex_count as usize {
-        return Err(PackError::PositionCount { positions: positions.len(), vertices: topology.vertex_count });
-    }
-    let layout = PackLayout::of(store)?;
-    let chains = build_chains(store, &layout, format);
-    let size = format.bytes_per_sample();
-    let mut colors = vec![0u8; chains.len() * size];
-    let chunk = chains.len().div_ceil(pack_threads()).max(1);
-    std::thread::scope(|scope| {
-        for (source, out) in chains.chunks(chunk).zip(colors.chunks_mut(chunk * size)) {
-            scope.spawn(move || format.encode_slice(source, out));
-        }
-    });
-    Ok(PackedMesh {
-        positions: positions.to_vec(),
-        indices: topology.face_vertices.clone(),
-        vertex_levels: layout.vertex_levels,
-        face_records: (0..topology.face_count()).map(|f| layout.face_record(store, f)).collect(),
-        format,
-        colors,
-    })
-}
-
-/// Unpacks level 0 of a packed mesh into an editable store. The packed data must be in
-/// the canonical layout [`pack`] writes (checked record by record).
-pub fn unpack(packed: &PackedMesh) -> Result<ColorStore, PackError> {
-    unpack_within(packed, &crate::colors::budget::Budget::from_environment())
-}
-
-/// [`unpack`] within `budget`: the store's samples are counted from the face records and
-/// checked before the store is allocated.
-pub fn unpack_within(packed: &PackedMesh, budget: &crate::colors::budget::Budget) -> Result<ColorStore, PackError> {
-    let topology = Topology::build(packed.positions.len() as u32, &packed.indices)?;
-    if packed.face_records.len() != topology.face_count() as usize {
-        return Err(PackError::NotCanonical(format!(
-            "{} face records for {} faces",
-            packed.face_records.len(),
-            topology.face_count()
-        )));
-    }
-    let resolutions = packed
-        .face_records
-        .iter()
-        .enumerate()
-        .map(|(face, record)| {
-            record.resolution().ok_or_else(|| PackError::NotCanonical(format!("face {face} has an invalid resolution")))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let counts = crate::colors::budget::SampleCounts::of_resolutions(&topology, |face| {
-        resolutions.get(face as usize).copied().unwrap_or(Resolution::ONE)
-    });
-    budget.check("the packed mesh", &counts, packed.format)?;
-    let mut store = ColorStore::with_resolutions(topology, resolutions, [0.0; 4])
-        .map_err(|error| PackError::NotCanonical(error.to_string()))?;
-    let layout = PackLayout::of(&store)?;
-    if layout.vertex_levels != packed.vertex_levels || layout.sample_count != packed.sample_count() {
-        return Err(PackError::NotCanonical(format!(
-            "expected {} vertex levels and {} samples, found {} and {}",
-            layout.vertex_levels,
-            layout.sample_count,
-            packed.vertex_levels,
-            packed.sample_count()
-        )));
-    }
-    for (face, record) in packed.face_records.iter().enumerate() {
-        let expected = layout.face_record(&store, face as u32);
-        if *record != expected {
-            return Err(PackError::NotCanonical(format!(
-                "face {face} record {record:?} differs from the canonical {expected:?}"
-            )));
-        }
-    }
-    let read = |index: u64| packed.color(index).unwrap_or([0.0; 4]);
-    let topology = store.topology().clone();
-    for v in 0..topology.vertex_count {
-        store.set(SampleRef::Vertex(v), read(u64::from(v) * u64::from(layout.vertex_levels)));
-    }
-    for edge in 0..topology.edge_count() {
-        let count = store.edge_samples(edge).len() as u32;
-        for offset in 0..count {
-            let color = read(u64::from(layout.edge_base[edge as usize] + offset));
-            store.set(SampleRef::Edge { edge, offset }, color);
-        }
-    }
-    for face in 0..topology.face_count() {
-        let count = store.interior_samples(face).len() as u32;
-        for offset in 0..count {
-            let color = read(u64::from(layout.interior_base[face as usize] + offset));
-            store.set(SampleRef::Interior { face, offset }, color);
-        }
-    }
-    store.take_dirty();
-    Ok(store)
-}
-
-/// A store with its MIP chains evaluated in `f32`, for level-`l` reference sampling.
-#[derive(Debug, Clone)]
-pub struct StoreMips {
-    chains: PackedMesh,
-}
-
-impl StoreMips {
-    /// Evaluates every MIP chain of `store` (no quantisation).
-    pub fn new(store: &ColorStore) -> Result<Self, PackError> {
-        let positions = vec![[0.0f32; 3]; store.topology().vertex_count as usize];
-        Ok(StoreMips { chains: pack(store, &positions, ColorFormat::Rgba32F)? })
-    }
-}
-
-impl MeshColorSource for StoreMips {
-    fn face_resolution(&self, face: u32) -> Option<Resolution> {
-        self.chains.face_resolution(face)
-    }
-
-    fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
-        self.chains.lattice_color(face, level, i, j)
-    }
-
-    fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution> {
-        self.chains.edge_resolution(face, k)
-    }
-
-    fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba> {
-        self.chains.edge_color(face, k, level, p)
-    }
+    Ok(PackCache::build(store, positions, format)?.into_packed())
 }

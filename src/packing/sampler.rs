@@ -5,7 +5,7 @@
 //! with the seam rule below) at requested MIP level `level`; [`sample_trilinear`] blends
 //! two levels. Sources ([`MeshColorSource`]):
 //! - [`ColorStore`]: level 0, read straight from the editable maps;
-//! - [`crate::packing::packer::StoreMips`]: every level of a store, its MIP chains evaluated in full `f32`
+//! - [`crate::packing::unpack::StoreMips`]: every level of a store, its MIP chains evaluated in full `f32`
 //!   (the packer's filters with RGBA32F, whose quantisation is the identity);
 //! - [`PackedMesh`]: every level of packed buffers in any colour format.
 //!

@@ -1,0 +1,80 @@
+//! The MIP filters of the packer (thesis eq. 2.5 / 2.6) that need no layout: the weighted
+//! filter, one face's interior chain, and the vertex → edge incidence.
+
+use crate::colors::format::Rgba;
+use crate::colors::layout::{self, Resolution};
+use crate::mesh::topology::Topology;
+
+/// `(C + ½ Σ N) / (1 + n/2)`: the thesis' MIP filter with the weights taken.
+#[inline]
+pub(crate) fn mip_filter(center: Rgba, neighbours: &[Rgba]) -> Rgba {
+    let mut sum = [0.0f32; 4];
+    for n in neighbours {
+        for c in 0..4 {
+            sum[c] += n[c];
+        }
+    }
+    let norm = 1.0 / (1.0 + 0.5 * neighbours.len() as f32);
+    std::array::from_fn(|c| (center[c] + 0.5 * sum[c]) * norm)
+}
+
+/// For each vertex, its incident edges (CSR).
+pub(crate) fn vertex_edges(topology: &Topology) -> (Vec<u32>, Vec<u32>) {
+    let mut offsets = vec![0u32; topology.vertex_count as usize + 1];
+    for &[a, b] in &topology.edge_vertices {
+        offsets[a as usize + 1] += 1;
+        offsets[b as usize + 1] += 1;
+    }
+    for v in 0..topology.vertex_count as usize {
+        offsets[v + 1] += offsets[v];
+    }
+    let mut fill = offsets.clone();
+    let mut edges = vec![0u32; offsets[topology.vertex_count as usize] as usize];
+    for (edge, &[a, b]) in topology.edge_vertices.iter().enumerate() {
+        for v in [a, b] {
+            edges[fill[v as usize] as usize] = edge as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    (offsets, edges)
+}
+
+/// Start of interior row `i` (`i >= 1`) of a face at resolution `r` (thesis eq. 3.2).
+pub(crate) fn interior_row_start(r: usize, i: usize) -> usize {
+    (i - 1) * (2 * r - 2 - i) / 2
+}
+
+/// Computes one face's whole interior chain in place: `chain` starts with level 0.
+pub(crate) fn reduce_interior_chain(chain: &mut [Rgba], r: Resolution) {
+    for level in 1..=r.log2() {
+        let r_src = (r.get() >> (level - 1)) as usize;
+        let r_dst = r_src / 2;
+        if r_dst < 3 {
+            break; // no interior samples at this level or below
+        }
+        let src_start = layout::interior_level_offset(r, level - 1).unwrap_or(0) as usize;
+        let dst_start = layout::interior_level_offset(r, level).unwrap_or(0) as usize;
+        let (head, tail) = chain.split_at_mut(dst_start);
+        let src = &head[src_start..];
+        let mut k = 0;
+        for i in 1..r_dst - 1 {
+            let a = 2 * i;
+            let (row_c, row_m, row_p) =
+                (interior_row_start(r_src, a), interior_row_start(r_src, a - 1), interior_row_start(r_src, a + 1));
+            for j in 1..r_dst - i {
+                let b = 2 * j;
+                // Lattice directions (1,0), (−1,0), (0,1), (0,−1), (1,−1), (−1,1).
+                let n = [
+                    src[row_p + b - 1],
+                    src[row_m + b - 1],
+                    src[row_c + b],
+                    src[row_c + b - 2],
+                    src[row_p + b - 2],
+                    src[row_m + b],
+                ];
+                tail[k] = mip_filter(src[row_c + b - 1], &n);
+                k += 1;
+            }
+        }
+    }
+}

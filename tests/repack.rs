@@ -1,0 +1,235 @@
+//! The fast packer and the incremental repack against the straightforward serial packer
+//! (`packing::reference`), byte for byte: mixed resolutions, boundary and non-manifold
+//! edges, every format; random strokes and resolution changes. And the RGBA8 sRGB encoder
+//! against the exact (f64) transfer function on every f32 that matters.
+
+mod common;
+use common::{Rng, icosphere, octahedron};
+use meshpaint::colors::format::{ColorFormat, encode_srgb8};
+use meshpaint::colors::layout::Resolution;
+use meshpaint::colors::store::{ColorStore, DirtyAccumulator, SampleRef};
+use meshpaint::mesh::topology::Topology;
+use meshpaint::packing::packer::{PackCache, pack};
+use meshpaint::packing::reference::pack_reference;
+
+fn r(value: u64) -> Resolution {
+    Resolution::new(value).unwrap()
+}
+
+fn random_store(topology: Topology, resolutions: Vec<Resolution>, seed: u64) -> ColorStore {
+    let mut store = ColorStore::with_resolutions(topology, resolutions, [0.0; 4]).unwrap();
+    let mut rng = Rng(seed);
+    // Values past 1 too (HDR channels), so RGBA8 clamps and 16F rounds.
+    store.fill_with(|_| [rng.unit() * 1.5, rng.unit(), rng.unit() * 0.01, 0.5 + 0.5 * rng.unit()]);
+    store.take_dirty();
+    store
+}
+
+/// Three fins on one edge (non-manifold), one more face, boundary edges elsewhere.
+fn fins() -> (Vec<[f32; 3]>, Topology) {
+    let positions =
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.5, -1.0, 0.0], [0.5, 0.0, 1.0], [1.5, 1.0, 0.0]];
+    let triangles = [[0, 1, 2], [1, 0, 3], [0, 1, 4], [2, 1, 5]];
+    (positions, Topology::build(6, &triangles).unwrap())
+}
+
+/// Meshes of every kind: mixed resolutions (coarse faces next to fine edges), uniform,
+/// non-manifold, and a larger sphere with random resolutions (more than one parallel block).
+fn cases() -> Vec<(&'static str, Vec<[f32; 3]>, ColorStore)> {
+    let mut out = Vec::new();
+    let (positions, topology) = octahedron();
+    out.push(("octahedron mixed", positions, random_store(topology, [1, 2, 4, 8, 16, 4, 1, 32].map(r).to_vec(), 1)));
+    let (positions, topology) = fins();
+    out.push(("fins", positions, random_store(topology, [8, 2, 4, 16].map(r).to_vec(), 2)));
+    let (positions, triangles) = icosphere(3);
+    let topology = Topology::build(positions.len() as u32, &triangles).unwrap();
+    let faces = topology.face_count() as usize;
+    out.push(("icosphere uniform 8", positions.clone(), random_store(topology.clone(), vec![r(8); faces], 3)));
+    let mut rng = Rng(4);
+    let resolutions = (0..faces).map(|_| r(1 << (rng.next() % 5))).collect();
+    out.push(("icosphere random", positions, random_store(topology, resolutions, 5)));
+    out
+}
+
+#[test]
+fn fast_pack_is_byte_equal_to_the_reference_packer() {
+    for (name, positions, store) in cases() {
+        for format in ColorFormat::ALL {
+            let fast = pack(&store, &positions, format).unwrap();
+            let reference = pack_reference(&store, &positions, format).unwrap();
+            assert_eq!(fast.face_records, reference.face_records, "{name} {format:?}");
+            assert_eq!(fast.vertex_levels, reference.vertex_levels, "{name} {format:?}");
+            assert!(fast.colors == reference.colors, "{name} {format:?}: colour bytes differ");
+            assert_eq!(fast, reference, "{name} {format:?}");
+        }
+    }
+}
+
+/// Paints a random "stroke": every sample of a few faces around a random face (their
+/// vertices, edges and interiors), as a brush would.
+fn stroke(store: &mut ColorStore, rng: &mut Rng) {
+    let topology = store.topology().clone();
+    let faces = topology.face_count();
+    let center = (rng.next() % u64::from(faces)) as u32;
+    let count = 1 + rng.next() % 4;
+    let color = [rng.unit(), rng.unit(), rng.unit(), rng.unit()];
+    for n in 0..count as u32 {
+        let face = (center + n * 7) % faces;
+        for &v in &topology.face_vertices[face as usize] {
+            store.set(SampleRef::Vertex(v), color);
+        }
+        for &edge in &topology.face_edges[face as usize] {
+            for offset in 0..store.edge_samples(edge).len() as u32 {
+                store.set(SampleRef::Edge { edge, offset }, [color[0], rng.unit(), color[2], 1.0]);
+            }
+        }
+        for offset in 0..store.interior_samples(face).len() as u32 {
+            store.set(SampleRef::Interior { face, offset }, [rng.unit(), color[1], color[2], 1.0]);
+        }
+    }
+    // Sometimes a single sample only (a tiny dab).
+    if rng.next().is_multiple_of(3) {
+        let v = (rng.next() % u64::from(topology.vertex_count)) as u32;
+        store.set(SampleRef::Vertex(v), [0.25, 0.5, 0.75, 1.0]);
+    }
+}
+
+#[test]
+fn incremental_repack_after_random_strokes_equals_a_full_repack() {
+    for (name, positions, mut store) in cases() {
+        for format in ColorFormat::ALL {
+            let mut rng = Rng(11 + format.code() as u64);
+            let mut cache = PackCache::build(&store, &positions, format).unwrap();
+            let mut accumulated = DirtyAccumulator::new(store.topology());
+            for round in 0..6 {
+                // Several dabs per session, dirty taken after each (as paint mode does).
+                for _ in 0..3 {
+                    stroke(&mut store, &mut rng);
+                    accumulated.add(&store.take_dirty());
+                }
+                let dirty = accumulated.take();
+                let ranges = cache.update(&store, &dirty).expect("no resolution changed");
+                let reference = pack_reference(&store, &positions, format).unwrap();
+                assert!(cache.packed().colors == reference.colors, "{name} {format:?} round {round}: bytes differ");
+                assert_eq!(*cache.packed(), reference, "{name} {format:?} round {round}");
+                // The ranges cover every byte that changed (and stay inside the buffer).
+                let samples = reference.sample_count();
+                assert!(ranges.iter().all(|&(first, count)| count > 0 && first + count <= samples));
+            }
+        }
+    }
+}
+
+#[test]
+fn incremental_ranges_cover_every_changed_sample() {
+    for (name, positions, mut store) in cases() {
+        let format = ColorFormat::Rgba32F;
+        let mut rng = Rng(99);
+        let mut cache = PackCache::build(&store, &positions, format).unwrap();
+        for _ in 0..5 {
+            let before = cache.packed().colors.clone();
+            stroke(&mut store, &mut rng);
+            let ranges = cache.update(&store, &store.clone().take_dirty()).unwrap();
+            store.take_dirty();
+            let size = format.bytes_per_sample();
+            let after = &cache.packed().colors;
+            for sample in 0..(after.len() / size) as u64 {
+                let at = sample as usize * size;
+                if before[at..at + size] != after[at..at + size] {
+                    assert!(
+                        ranges.iter().any(|&(first, count)| (first..first + count).contains(&sample)),
+                        "{name}: sample {sample} changed outside the reported ranges"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_resolution_change_asks_for_a_full_repack_and_that_matches_the_reference() {
+    for (name, positions, mut store) in cases() {
+        let format = ColorFormat::Rgba8Srgb;
+        let mut rng = Rng(21);
+        let mut cache = PackCache::build(&store, &positions, format).unwrap();
+        for _ in 0..4 {
+            let face = (rng.next() % u64::from(store.topology().face_count())) as u32;
+            let old = store.face_resolution(face).unwrap();
+            let new = if old.log2() >= 4 { old.halved().unwrap() } else { old.doubled().unwrap() };
+            store.set_face_resolution(face, new).unwrap();
+            stroke(&mut store, &mut rng);
+            let dirty = store.take_dirty();
+            assert!(cache.update(&store, &dirty).is_none(), "{name}: a resolution change must not be patched");
+            cache = PackCache::build(&store, &positions, format).unwrap();
+            assert_eq!(*cache.packed(), pack_reference(&store, &positions, format).unwrap(), "{name}");
+            // And an R change followed by strokes only: incremental again.
+            stroke(&mut store, &mut rng);
+            let dirty = store.take_dirty();
+            cache.update(&store, &dirty).expect("no resolution changed");
+            assert_eq!(*cache.packed(), pack_reference(&store, &positions, format).unwrap(), "{name}");
+        }
+    }
+}
+
+#[test]
+fn an_empty_edit_changes_nothing() {
+    let (_, positions, store) = cases().remove(0);
+    let mut cache = PackCache::build(&store, &positions, ColorFormat::Rgba8Srgb).unwrap();
+    let before = cache.packed().clone();
+    let mut store = store;
+    let dirty = store.take_dirty();
+    let ranges = cache.update(&store, &dirty).unwrap();
+    assert!(ranges.is_empty());
+    assert_eq!(*cache.packed(), before);
+}
+
+/// The exact code: the f64 transfer function, rounded to nearest; `None` when the value
+/// is within f64 noise of a rounding boundary (no f32 lands there in practice).
+fn exact_srgb8(linear: f32) -> Option<u8> {
+    let x = f64::from(linear).clamp(0.0, 1.0);
+    let encoded = if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
+    let scaled = encoded * 255.0;
+    if (scaled - scaled.floor() - 0.5).abs() < 1e-9 {
+        return None;
+    }
+    Some((scaled + 0.5).floor() as u8)
+}
+
+#[test]
+fn srgb8_lookup_equals_the_exact_formula_on_every_f32_that_matters() {
+    // Every 61st f32 bit pattern in [0, 1] (17 M values, all exponents and mantissas) …
+    let one = 1.0f32.to_bits();
+    let mut checked = 0u64;
+    let mut check = |x: f32| {
+        if let Some(want) = exact_srgb8(x) {
+            assert_eq!(encode_srgb8(x), want, "{x:e} ({:#010x})", x.to_bits());
+            checked += 1;
+        }
+    };
+    for bits in (0..=one).step_by(61) {
+        check(f32::from_bits(bits));
+    }
+    // … and every f32 within 64 ulps of each of the 255 rounding boundaries, where a table
+    // could be off by one (the boundaries themselves from the f64 inverse function).
+    for b in 0..255u32 {
+        let encoded = (f64::from(b) + 0.5) / 255.0;
+        let boundary = if encoded <= 0.040_45 { encoded / 12.92 } else { ((encoded + 0.055) / 1.055).powf(2.4) };
+        let mut x = boundary as f32;
+        for _ in 0..64 {
+            x = x.next_down();
+        }
+        for _ in 0..128 {
+            check(x);
+            x = x.next_up();
+        }
+    }
+    assert!(checked > 17_000_000, "{checked}");
+    // Alpha: linear 8-bit unorm, rounded half away from zero, on the same stride.
+    for bits in (0..=one).step_by(61).chain([0.5f32 / 255.0, 1.5 / 255.0, 254.5 / 255.0].map(f32::to_bits)) {
+        let a = f32::from_bits(bits);
+        let want = (a * 255.0).round() as u8;
+        assert_eq!(meshpaint::colors::format::encode_rgba8_srgb([0.0, 0.0, 0.0, a])[3], want, "alpha {a:e}");
+    }
+    assert_eq!(encode_srgb8(1.0), 255);
+    assert_eq!(encode_srgb8(0.0), 0);
+}
