@@ -10,7 +10,7 @@
 //! |---|---|---|
 //! | 5 | [`window`] | winit event loop, surface, egui-winit / egui-wgpu, offscreen 3D view, redraw scheduling |
 //! | 4 | [`input`] | all input: shortcuts ([`input::SHORTCUTS`]), 3D-view navigation, [`input::perform`] (every [`Action`]) |
-//! | 3 | [`panels`], [`paint`], [`autosave_ui`] | the `*_ui` panels; paint-mode commands (strokes, live GPU upload, undo / redo, tool panel); autosave tick and recovery dialog |
+//! | 3 | [`panels`], [`paint`], [`optimize_ui`], [`autosave_ui`] | the `*_ui` panels; paint-mode commands (strokes, live GPU upload, undo / redo, tool panel); Optimize on a worker thread; autosave tick and recovery dialog |
 //! | 2 | [`editor`] | the editor: document, camera, view settings, mode, status, jobs (applied by [`jobs::JobKind`]) |
 //! | 1 | [`document`], [`autosave`], [`paint_session`] | the open document (store and GPU mesh side by side; open, save, export work); autosave state; paint-mode state |
 //! | 0 | [`state`], [`jobs`], [`text`], [`file_dialog`], [`import_settings`] | shared small types and [`Action`]s; one background job at a time with progress; number / error text; an egui file browser; the open dialog's resolution choice |
@@ -29,6 +29,7 @@ pub mod file_dialog;
 pub mod import_settings;
 pub mod input;
 pub mod jobs;
+pub mod optimize_ui;
 pub mod paint;
 pub mod paint_session;
 pub mod panels;

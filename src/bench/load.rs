@@ -65,8 +65,7 @@ pub fn bench_load(
     let (scene, kind) = import_scene_within(path, &budget)?;
     let import = started.elapsed();
     let subdivide_started = Instant::now();
-    let scene =
-        if subdivide > 0 { crate::io::subdivide::subdivide_scene(&scene, subdivide, &budget)? } else { scene };
+    let scene = if subdivide > 0 { crate::io::subdivide::subdivide_scene(&scene, subdivide, &budget)? } else { scene };
     let subdivide_time = subdivide_started.elapsed();
     let mut phases = OpenPhases::default();
     let mut document = Document::from_scene_phased(scene, resolution, path, &budget, &mut phases)?;
