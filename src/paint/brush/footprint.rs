@@ -3,6 +3,7 @@
 
 use glam::DVec3;
 
+use crate::paint::occlusion::DepthMap;
 use crate::paint::picking::MeshBvh;
 
 use super::settings::Falloff;
@@ -24,6 +25,26 @@ pub(super) trait Coverage {
     fn covers(&self, corners: &[DVec3], mask: u8) -> bool;
 }
 
+/// How a dab tests occlusion: the depth map of each sphere's eye where one was built
+/// ([`DepthMap::visible`]), the BVH ray ([`visible`], the reference) where the map cannot
+/// tell or there is none.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Occlusion<'a> {
+    pub(super) bvh: &'a MeshBvh,
+    pub(super) maps: [Option<&'a DepthMap>; 2],
+}
+
+impl Occlusion<'_> {
+    /// Whether `point` is visible from `eye`, the eye of sphere `k`.
+    #[inline]
+    fn visible(&self, k: usize, eye: DVec3, point: DVec3) -> bool {
+        if let Some(seen) = self.maps.get(k).copied().flatten().and_then(|map| map.visible(point)) {
+            return seen;
+        }
+        visible(self.bvh, eye, point)
+    }
+}
+
 /// The brush spheres of one dab (one, or two with mirror).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Footprint<'a> {
@@ -34,7 +55,7 @@ pub(super) struct Footprint<'a> {
     inv_radius: f64,
     strength: f32,
     falloff: Falloff,
-    occlusion: Option<&'a MeshBvh>,
+    occlusion: Option<Occlusion<'a>>,
 }
 
 impl<'a> Footprint<'a> {
@@ -47,7 +68,7 @@ impl<'a> Footprint<'a> {
         radius: f64,
         strength: f32,
         falloff: Falloff,
-        occlusion: Option<&'a MeshBvh>,
+        occlusion: Option<Occlusion<'a>>,
     ) -> Self {
         Footprint {
             centers,
@@ -87,8 +108,8 @@ impl<'a> Footprint<'a> {
             if w <= best {
                 continue;
             }
-            if let Some(bvh) = self.occlusion
-                && !visible(bvh, self.eyes[k], p)
+            if let Some(occlusion) = &self.occlusion
+                && !occlusion.visible(k, self.eyes[k], p)
             {
                 continue;
             }

@@ -1,9 +1,9 @@
 //! The colour brush's kernels: every stored sample of a dab's faces blended once (interior
 //! rows per face, each shared edge and vertex once), written through the [`StoreWriter`].
 //!
-//! The interior, edge and vertex loops share one per-sample step, [`blend_sample`]; the
-//! interior rows and the edge walk share `Kernel::row`. Both inline into the loops (the hot
-//! path: no allocation, no hashing, an undo bit test per write).
+//! The interior rows and the edge walk share `Kernel::row`, which updates one run of an
+//! element's samples in place ([`ElementWriter::update_run`]: one look-up per run, an undo
+//! bit test per write; the hot path allocates nothing and hashes nothing).
 
 use glam::DVec3;
 
@@ -67,34 +67,6 @@ struct ElementCounts {
     changed: u64,
 }
 
-/// Blends sample `index` of the element `out` writes at weight `weight` (> 0). Erase to base
-/// takes the base colour from `base_same[index]` when the base holds the element at the same
-/// resolution, else from `base_other(store, old)`.
-#[inline(always)]
-fn blend_sample(
-    out: &mut ElementWriter,
-    op: &PaintOp,
-    index: u32,
-    weight: f32,
-    base_same: Option<&[Rgba]>,
-    base_other: impl FnOnce(&ColorStore, Rgba) -> Rgba,
-    counts: &mut ElementCounts,
-) {
-    let Some(old) = out.get(index) else {
-        return;
-    };
-    counts.covered += 1;
-    let base = match (op.blend, base_same) {
-        (BlendMode::EraseToBase, Some(base)) => base.get(index as usize).copied().unwrap_or(old),
-        (BlendMode::EraseToBase, None) => base_other(out.store(), old),
-        _ => old,
-    };
-    let new = op.blend.blend(old, op.color, base, weight);
-    if out.write(index, old, new) {
-        counts.changed += 1;
-    }
-}
-
 /// One lattice row of an element: the points `a + b·k` for `k` in `ks`, stored at index
 /// `first + k − 1`.
 #[derive(Debug, Clone, Copy)]
@@ -113,8 +85,9 @@ struct Kernel<'a, C> {
 }
 
 impl<C: Coverage> Kernel<'_, C> {
-    /// Blends the samples of `row` with a positive weight; `base_other(store, k, old)` as in
-    /// [`blend_sample`].
+    /// Blends the samples of `row` with a positive weight, in place (one run of the
+    /// element); `base_other(store, k, old)` is the base colour of point `k` when the base
+    /// holds the element at another resolution (Erase to base).
     #[inline(always)]
     fn row(
         &self,
@@ -125,14 +98,39 @@ impl<C: Coverage> Kernel<'_, C> {
         counts: &mut ElementCounts,
     ) {
         let (k0, k1) = row.ks;
-        for k in k0..=k1 {
+        if k0 > k1 || row.first + k0 == 0 {
+            return;
+        }
+        let op = self.op;
+        // Erase to a base at another resolution reads the store: its colours come first.
+        let others: Vec<Rgba> = if op.blend == BlendMode::EraseToBase && base_same.is_none() {
+            (k0..=k1)
+                .map(|k| {
+                    let old = out.get(row.first + k - 1).unwrap_or_default();
+                    base_other(out.store(), k, old)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let first = row.first + k0 - 1;
+        let mut covered = 0;
+        let changed = out.update_run(first, k1 - k0 + 1, |index, old| {
+            let k = index - first + k0;
             let w = self.coverage.weight(row.a + row.b * f64::from(k), mask);
             if w <= 0.0 {
-                continue;
+                return None;
             }
-            let index = row.first + k - 1;
-            blend_sample(out, self.op, index, w, base_same, |store, old| base_other(store, k, old), counts);
-        }
+            covered += 1;
+            let base = match (op.blend, base_same) {
+                (BlendMode::EraseToBase, Some(base)) => base.get(index as usize).copied().unwrap_or(old),
+                (BlendMode::EraseToBase, None) => others.get((k - k0) as usize).copied().unwrap_or(old),
+                _ => old,
+            };
+            Some(op.blend.blend(old, op.color, base, w))
+        });
+        counts.covered += covered;
+        counts.changed += changed;
     }
 
     /// Paints the interior samples of `face` (mask `mask`).
@@ -205,8 +203,15 @@ impl<C: Coverage> Kernel<'_, C> {
         let w = self.coverage.weight(position(self.positions, v), mask);
         if w > 0.0 {
             let op = self.op;
-            let base_other = |_: &ColorStore, old: Rgba| op.base.and_then(|base| base.vertex_color(v)).unwrap_or(old);
-            blend_sample(&mut writer.element(Element::Vertices), op, v, w, None, base_other, &mut counts);
+            let mut out = writer.element(Element::Vertices);
+            counts.covered = u64::from(out.get(v).is_some());
+            counts.changed = out.update_run(v, 1, |_, old| {
+                let base = match op.blend {
+                    BlendMode::EraseToBase => op.base.and_then(|base| base.vertex_color(v)).unwrap_or(old),
+                    _ => old,
+                };
+                Some(op.blend.blend(old, op.color, base, w))
+            });
         }
         counts
     }
