@@ -34,6 +34,8 @@ use crate::camera::OrbitCamera;
 pub const DEPTH_TOLERANCE_PX: f64 = 1.0;
 /// Depth tolerance relative to the depth (covers the `f32` storage of `1 / z`).
 pub const DEPTH_TOLERANCE_RELATIVE: f64 = 1e-5;
+/// The largest screen box [`DepthMap::region_visible`] reads, pixels.
+pub const MAX_REGION_PIXELS: f64 = 256.0;
 /// The largest map built (pixels); a larger viewport falls back to rays.
 pub const MAX_PIXELS: u64 = 1 << 26;
 
@@ -186,6 +188,76 @@ impl DepthMap {
         }
         let tolerance = z * (DEPTH_TOLERANCE_PX / self.focal + DEPTH_TOLERANCE_RELATIVE);
         Some(z <= 1.0 / f64::from(farthest) + tolerance)
+    }
+
+    /// Whether every point of the segment or triangle with these corners passes
+    /// [`DepthMap::visible`], when that is certain from the map alone: all corners in front
+    /// of the near plane, the pixels any point's four can be inside the map, and at each of
+    /// them the map no nearer than the element allows. For a triangle that is its plane's
+    /// `1 / z` there (affine on screen; the points' own `1 / z` are convex combinations of
+    /// it at their four pixels), for a segment or point the farthest corner, both less the
+    /// tolerance at the nearest corner. Lets a brush skip the per-sample test on faces
+    /// nothing covers. Boxes over [`MAX_REGION_PIXELS`] give `false`.
+    pub fn region_visible(&self, corners: &[DVec3]) -> bool {
+        let mut screen = [[0.0f64; 3]; 3];
+        let (mut min_x, mut max_x, mut min_y, mut max_y) =
+            (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+        let (mut z_min, mut z_max) = (f64::INFINITY, 0.0f64);
+        for (k, &corner) in corners.iter().enumerate() {
+            let d = corner - self.eye;
+            let z = d.dot(self.forward);
+            if !(z >= self.near) {
+                return false;
+            }
+            let inv_z = 1.0 / z;
+            // Coordinates with pixel centres at integers.
+            let x = f64::from(self.width) * 0.5 + self.focal * d.dot(self.right) * inv_z - 0.5;
+            let y = f64::from(self.height) * 0.5 - self.focal * d.dot(self.up) * inv_z - 0.5;
+            if let Some(slot) = screen.get_mut(k) {
+                *slot = [x, y, inv_z];
+            }
+            (min_x, max_x, min_y, max_y) = (min_x.min(x), max_x.max(x), min_y.min(y), max_y.max(y));
+            (z_min, z_max) = (z_min.min(z), z_max.max(z));
+        }
+        let (i0, i1, j0, j1) = (min_x.floor(), max_x.floor() + 1.0, min_y.floor(), max_y.floor() + 1.0);
+        if !(i0 >= 0.0 && j0 >= 0.0 && i1 < f64::from(self.width) && j1 < f64::from(self.height)) {
+            return false;
+        }
+        if (i1 - i0 + 1.0) * (j1 - j0 + 1.0) > MAX_REGION_PIXELS {
+            return false;
+        }
+        let e = DEPTH_TOLERANCE_PX / self.focal + DEPTH_TOLERANCE_RELATIVE;
+        // The allowed map value at pixel (x, y): an affine bound on `1 / z` (α x + β y + γ),
+        // divided by (1 − e).
+        let (alpha, beta, gamma) = if corners.len() == 3 {
+            let [a, b, c] = screen;
+            let det = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+            if !(det.abs() > 1e-9) {
+                return false;
+            }
+            let alpha = ((b[2] - a[2]) * (c[1] - a[1]) - (c[2] - a[2]) * (b[1] - a[1])) / det;
+            let beta = ((c[2] - a[2]) * (b[0] - a[0]) - (b[2] - a[2]) * (c[0] - a[0])) / det;
+            (alpha, beta, a[2] - alpha * a[0] - beta * a[1])
+        } else {
+            (0.0, 0.0, 1.0 / z_max)
+        };
+        let scale = if corners.len() == 3 { 1.0 / (1.0 - e) } else { 1.0 / (1.0 - e * z_min / z_max) };
+        if !(scale.is_finite() && scale > 0.0) {
+            return false;
+        }
+        let w = self.width as usize;
+        for j in j0 as usize..=j1 as usize {
+            let Some(row) = self.inv_depth.get(j * w + i0 as usize..=j * w + i1 as usize) else {
+                return false;
+            };
+            for (i, &inv) in (i0 as usize..).zip(row) {
+                let plane = alpha * i as f64 + beta * j as f64 + gamma;
+                if !(plane > 0.0) || f64::from(inv) > plane * scale {
+                    return false;
+                }
+            }
+        }
+        true
     }
 
     fn view_vertex(&self, p: [f32; 3]) -> ViewVertex {

@@ -131,6 +131,7 @@ fn blur_face<C: Coverage>(
     let [p0, p1, p2] = corners.map(|v| position(positions, v));
     let inv = 1.0 / f64::from(res);
     let (e1, e2) = ((p1 - p0) * inv, (p2 - p0) * inv);
+    let unoccluded = coverage.unoccluded(&[p0, p1, p2], all);
     let mut out = writer.element(Element::Interior(face));
     for i in 0..=res {
         let a = p0 + e1 * f64::from(i);
@@ -151,7 +152,8 @@ fn blur_face<C: Coverage>(
             if mask == 0 {
                 continue;
             }
-            let weight = coverage.weight(a + e2 * f64::from(j), mask);
+            let p = a + e2 * f64::from(j);
+            let weight = if unoccluded { coverage.weight_unoccluded(p, mask) } else { coverage.weight(p, mask) };
             if weight <= 0.0 {
                 continue;
             }

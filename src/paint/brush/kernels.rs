@@ -92,10 +92,30 @@ impl<C: Coverage> Kernel<'_, C> {
     fn row(
         &self,
         out: &mut ElementWriter,
+        (row, mask, unoccluded): (Row, u8, bool),
+        base_same: Option<&[Rgba]>,
+        base_other: impl Fn(&ColorStore, u32, Rgba) -> Rgba,
+        counts: &mut ElementCounts,
+    ) {
+        if unoccluded {
+            self.row_with(out, (row, mask), base_same, base_other, counts, |p, mask| {
+                self.coverage.weight_unoccluded(p, mask)
+            });
+        } else {
+            self.row_with(out, (row, mask), base_same, base_other, counts, |p, mask| self.coverage.weight(p, mask));
+        }
+    }
+
+    /// [`Kernel::row`] with the weight function `weight`.
+    #[inline(always)]
+    fn row_with(
+        &self,
+        out: &mut ElementWriter,
         (row, mask): (Row, u8),
         base_same: Option<&[Rgba]>,
         base_other: impl Fn(&ColorStore, u32, Rgba) -> Rgba,
         counts: &mut ElementCounts,
+        weight: impl Fn(DVec3, u8) -> f32,
     ) {
         let (k0, k1) = row.ks;
         if k0 > k1 || row.first + k0 == 0 {
@@ -117,7 +137,7 @@ impl<C: Coverage> Kernel<'_, C> {
         let mut covered = 0;
         let changed = out.update_run(first, k1 - k0 + 1, |index, old| {
             let k = index - first + k0;
-            let w = self.coverage.weight(row.a + row.b * f64::from(k), mask);
+            let w = weight(row.a + row.b * f64::from(k), mask);
             if w <= 0.0 {
                 return None;
             }
@@ -150,6 +170,7 @@ impl<C: Coverage> Kernel<'_, C> {
         let (e1, e2) = ((p1 - p0) * inv, (p2 - p0) * inv);
         let base_same = op.base.and_then(|b| (b.face_resolution(face) == Some(r)).then(|| b.interior_samples(face)));
         let whole = self.coverage.covers(&[p0, p1, p2], mask);
+        let unoccluded = self.coverage.unoccluded(&[p0, p1, p2], mask);
         let mut out = writer.element(Element::Interior(face));
         for i in 1..res - 1 {
             let a = p0 + e1 * f64::from(i);
@@ -160,7 +181,7 @@ impl<C: Coverage> Kernel<'_, C> {
             };
             let row = Row { a, b: e2, ks, first: (i - 1) * (2 * res - 2 - i) / 2 };
             let base_other = |_: &ColorStore, j: u32, old: Rgba| op.base_on_face(face, r, i, j, old);
-            self.row(&mut out, (row, mask), base_same, base_other, &mut counts);
+            self.row(&mut out, (row, mask, unoccluded), base_same, base_other, &mut counts);
         }
         counts
     }
@@ -193,7 +214,8 @@ impl<C: Coverage> Kernel<'_, C> {
         let base_other = |store: &ColorStore, k: u32, old: Rgba| base_on_edge(op, store, edge, r, k, old);
         let mut counts = ElementCounts::default();
         let row = Row { a, b, ks, first: 0 };
-        self.row(&mut writer.element(Element::Edge(edge)), (row, mask), base_same, base_other, &mut counts);
+        let unoccluded = self.coverage.unoccluded(&[a, end], mask);
+        self.row(&mut writer.element(Element::Edge(edge)), (row, mask, unoccluded), base_same, base_other, &mut counts);
         counts
     }
 

@@ -62,15 +62,22 @@
 //!    corners on the fly; each lattice row's intersection with the sphere is solved in closed
 //!    form so rows are only walked where the sphere is.
 //! 4. A sample at distance `d` gets weight `w = strength · falloff(d / radius)` (the largest
-//!    over the spheres that see it); with occlusion on, only if the segment from the eye to
-//!    the sample hits nothing before the sample ([`MeshBvh::cast`]).
+//!    over the spheres that see it); with occlusion on, only if nothing lies between the eye
+//!    and the sample: tested against a depth map of the view
+//!    ([`crate::paint::occlusion::DepthMap`], rasterised once per view and kept by the
+//!    [`Painter`]; hidden means something is nearer by more than one pixel width at the
+//!    sample's depth, and within about a pixel of a silhouette a hidden sample may count as
+//!    visible), and with the segment from the eye to the sample cast into the BVH
+//!    ([`visible`], the reference) where the map cannot tell (off screen, behind the near
+//!    plane).
 //! 5. Blending is in linear light: `new = old · (1 − w) + target · w` with target = the brush
 //!    colour (Mix), `old + colour` (Add, RGB), `old × colour` (Multiply, RGB) or the base
 //!    snapshot's colour at the sample (Erase to base).
 //!
 //! The blur brush moves each sample towards the mean of its lattice neighbours (the six
 //! neighbours in every face whose lattice contains it, at that face's resolution) by `w`,
-//! computed from the colours before the dab. The resolution brush raises, lowers or sets `R`
+//! computed from the colours before the dab (each face's lattice gathered once, shared
+//! samples summed per element; `blur.rs`). The resolution brush raises, lowers or sets `R`
 //! of every face whose triangle intersects the brush sphere, each face at most once per
 //! stroke, resampling as [`ColorStore::set_face_resolution`] defines.
 //!
