@@ -170,7 +170,7 @@ impl DepthMap {
     pub fn visible(&self, point: DVec3) -> Option<bool> {
         let d = point - self.eye;
         let z = d.dot(self.forward);
-        if !(z >= self.near) {
+        if z.is_nan() || z < self.near {
             return None;
         }
         let inv_z = 1.0 / z;
@@ -206,7 +206,7 @@ impl DepthMap {
         for (k, &corner) in corners.iter().enumerate() {
             let d = corner - self.eye;
             let z = d.dot(self.forward);
-            if !(z >= self.near) {
+            if z.is_nan() || z < self.near {
                 return false;
             }
             let inv_z = 1.0 / z;
@@ -232,7 +232,7 @@ impl DepthMap {
         let (alpha, beta, gamma) = if corners.len() == 3 {
             let [a, b, c] = screen;
             let det = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
-            if !(det.abs() > 1e-9) {
+            if det.is_nan() || det.abs() <= 1e-9 {
                 return false;
             }
             let alpha = ((b[2] - a[2]) * (c[1] - a[1]) - (c[2] - a[2]) * (b[1] - a[1])) / det;
@@ -252,7 +252,7 @@ impl DepthMap {
             };
             for (i, &inv) in (i0 as usize..).zip(row) {
                 let plane = alpha * i as f64 + beta * j as f64 + gamma;
-                if !(plane > 0.0) || f64::from(inv) > plane * scale {
+                if plane.is_nan() || plane <= 0.0 || f64::from(inv) > plane * scale {
                     return false;
                 }
             }

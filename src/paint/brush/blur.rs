@@ -165,8 +165,8 @@ fn blur_face<C: Coverage>(
                     continue;
                 }
                 let color = grid[grid_index(res, ni as u32, nj as u32)];
-                for c in 0..4 {
-                    sum[c] += color[c];
+                for (total, channel) in sum.iter_mut().zip(color) {
+                    *total += channel;
                 }
                 count += 1;
             }
@@ -187,8 +187,8 @@ fn blur_face<C: Coverage>(
                 _ => continue,
             };
             if let Some(acc) = scratch.blur_acc.get_mut(slot) {
-                for c in 0..4 {
-                    acc.sum[c] += sum[c];
+                for (total, channel) in acc.sum.iter_mut().zip(sum) {
+                    *total += channel;
                 }
                 acc.count += count;
                 acc.weight = acc.weight.max(weight);
