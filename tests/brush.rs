@@ -1031,6 +1031,16 @@ fn bench_paint_reports_every_measurement() {
     assert!(report["occlusion_depth_map"]["build_seconds"].as_f64().unwrap() > 0.0);
     assert_eq!(report["occlusion_depth_map"]["maps_built"], 1);
     assert!(report["threads"].as_u64().unwrap() >= 1);
+    // `--subdivide 1`: four times the triangles, the same rows.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_meshpaint"))
+        .args(["bench", "paint", input.to_str().unwrap(), "-r", "2", "--subdivide", "1", "--dabs", "1"])
+        .args(["--dab-samples", "1000", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let subdivided: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(subdivided["triangles"].as_u64().unwrap(), 4 * report["triangles"].as_u64().unwrap());
+    assert!(subdivided["headline"]["samples_per_second_best"].as_f64().unwrap() > 0.0);
     assert!(report["repack_rgba8"]["timing"]["best_seconds"].as_f64().unwrap() > 0.0);
     assert!(report["pick_latency"]["best_seconds"].as_f64().unwrap() > 0.0);
 }
