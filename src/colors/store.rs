@@ -76,6 +76,18 @@ pub enum StoreElement {
     Interior(u32),
 }
 
+impl StoreElement {
+    /// The sample at `index` of this element.
+    #[inline(always)]
+    pub fn sample(self, index: u32) -> SampleRef {
+        match self {
+            StoreElement::Vertices => SampleRef::Vertex(index),
+            StoreElement::Edge(edge) => SampleRef::Edge { edge, offset: index },
+            StoreElement::Interior(face) => SampleRef::Interior { face, offset: index },
+        }
+    }
+}
+
 /// A sample together with where it lies: barycentric coordinates in one face that
 /// contains it. Shared samples are reported once, in their *owner* face: the lowest
 /// face id among those containing them (the rule texture conversion uses across seams).

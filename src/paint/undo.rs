@@ -51,7 +51,7 @@ use thiserror::Error;
 use crate::colors::budget::{Budget, BudgetError};
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::Resolution;
-use crate::colors::store::{ColorStore, SampleRef, StoreElement, StoreError};
+use crate::colors::store::{ColorStore, SampleRef, StoreError};
 
 /// The default memory cap of an [`UndoHistory`]: 512 MiB.
 pub const DEFAULT_CAP_BYTES: usize = 512 << 20;
@@ -319,39 +319,8 @@ impl SeenSamples {
     }
 }
 
-/// One element's samples, as [`StoreWriter::element`] writes them: the vertex colours
-/// (index = vertex id), or the samples of one edge or face interior (index = storage offset).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Element {
-    /// Every vertex colour.
-    Vertices,
-    /// The samples of an edge.
-    Edge(u32),
-    /// The interior samples of a face.
-    Interior(u32),
-}
-
-impl Element {
-    /// The store's name of this element.
-    #[inline(always)]
-    fn store_element(self) -> StoreElement {
-        match self {
-            Element::Vertices => StoreElement::Vertices,
-            Element::Edge(edge) => StoreElement::Edge(edge),
-            Element::Interior(face) => StoreElement::Interior(face),
-        }
-    }
-
-    /// The sample at `index` of this element.
-    #[inline(always)]
-    pub fn sample(self, index: u32) -> SampleRef {
-        match self {
-            Element::Vertices => SampleRef::Vertex(index),
-            Element::Edge(edge) => SampleRef::Edge { edge, offset: index },
-            Element::Interior(face) => SampleRef::Interior { face, offset: index },
-        }
-    }
-}
+/// One element's samples, as [`StoreWriter::element`] writes them (the store's element).
+pub use crate::colors::store::StoreElement as Element;
 
 /// Records first writes to the samples of one element (or to vertices) in the open step;
 /// recording is a bit test and, the first time, a push. Only [`ElementWriter`] records.
@@ -389,16 +358,10 @@ impl SampleLog<'_> {
 }
 /// The open step's current block of sample writes (started after the last resolution
 /// change), or `None` without an open step.
-/// A new block starts in `spare` (an empty buffer kept from an earlier step, see
-/// [`SPARE_CAP_BYTES`]).
-fn current_samples<'a>(
-    open: &'a mut Option<Step>,
-    spare: &mut Vec<(SampleRef, Rgba)>,
-) -> Option<&'a mut Vec<(SampleRef, Rgba)>> {
+fn current_samples(open: &mut Option<Step>) -> Option<&mut Vec<(SampleRef, Rgba)>> {
     let step = open.as_mut()?;
     if !matches!(step.changes.last(), Some(Change::Samples(_))) {
-        spare.clear();
-        step.changes.push(Change::Samples(std::mem::take(spare)));
+        step.changes.push(Change::Samples(Vec::new()));
     }
     match step.changes.last_mut() {
         Some(Change::Samples(list)) => Some(list),
@@ -418,13 +381,7 @@ pub struct UndoHistory {
     dropped_steps: u64,
     /// The budget undo and redo check resolution changes against, with the document's format.
     budget: Option<(Budget, ColorFormat)>,
-    /// An empty sample buffer whose memory is already paged in, for the next step's first
-    /// block (the first dab of a stroke then records without page faults).
-    spare: Vec<(SampleRef, Rgba)>,
 }
-
-/// The largest buffer kept as [`UndoHistory`]'s spare (bigger ones are freed at once).
-pub const SPARE_CAP_BYTES: usize = 64 << 20;
 
 impl Default for UndoHistory {
     fn default() -> Self {
@@ -444,7 +401,6 @@ impl UndoHistory {
             generation: 0,
             dropped_steps: 0,
             budget: None,
-            spare: Vec::new(),
         }
     }
 
@@ -538,13 +494,7 @@ impl UndoHistory {
         step.changes.retain(|change| !matches!(change, Change::Samples(list) if list.is_empty()));
         for change in &mut step.changes {
             if let Change::Samples(list) = change {
-                // The step keeps an exact copy; the grown buffer becomes the next spare.
-                let exact = list.to_vec();
-                let grown = std::mem::replace(list, exact);
-                if grown.capacity() * SAMPLE_RECORD_BYTES <= SPARE_CAP_BYTES && grown.capacity() > self.spare.capacity()
-                {
-                    self.spare = grown;
-                }
+                list.shrink_to_fit();
             }
         }
         step.recount();
@@ -600,7 +550,7 @@ impl UndoHistory {
     fn element_log(&mut self, element: Element, sample_count: usize) -> SampleLog<'_> {
         let (is_edge, id) = match element {
             Element::Vertices => {
-                return match current_samples(&mut self.open, &mut self.spare) {
+                return match current_samples(&mut self.open) {
                     Some(list) => SampleLog { element, bits: &mut self.seen.vertex_bits, list: Some(list) },
                     None => SampleLog::off(element),
                 };
@@ -613,7 +563,7 @@ impl UndoHistory {
             return SampleLog::off(element);
         }
         let slot = self.seen.slot(is_edge, id, sample_count);
-        match current_samples(&mut self.open, &mut self.spare) {
+        match current_samples(&mut self.open) {
             Some(list) => SampleLog { element, bits: &mut self.seen.slots[slot], list: Some(list) },
             None => SampleLog::off(element),
         }
@@ -817,15 +767,12 @@ impl ElementWriter<'_> {
     }
 
     /// Updates the run of `len` samples from `first` in place ([`ColorStore::update_run`]):
-    /// `update(index, old)` gives the new colour or `None`; a new colour bit-identical to
-    /// the old one is not written, and the old colour of each written sample is recorded on
-    /// its first write in the step. `update` must return stored colours (clamped, as
-    /// [`crate::colors::format::clamp_color`] leaves them) for the identity test to be exact.
-    /// Returns the number of samples changed.
+    /// `update(index, old)` gives the new (clamped) colour or `None`; a bit-identical one is
+    /// not written; old colours are recorded on first write. Returns the samples changed.
     #[inline(always)]
     pub fn update_run(&mut self, first: u32, len: u32, mut update: impl FnMut(u32, Rgba) -> Option<Rgba>) -> u64 {
         let log = &mut self.log;
-        self.store.update_run(log.element.store_element(), first, len, |index, old| {
+        self.store.update_run(log.element, first, len, |index, old| {
             let new = update(index, old)?;
             if !differs(new, old) {
                 return None;

@@ -109,23 +109,7 @@ fn blur_face<C: Coverage>(
     if all == 0 {
         return;
     }
-    // Gather the lattice.
-    grid.clear();
-    let interior = store.interior_samples(face);
-    for i in 0..=res {
-        for j in 0..=res - i {
-            let interior_point = i >= 1 && j >= 1 && i + j < res;
-            if interior_point && j == 1 {
-                let first = ((i - 1) * (2 * res - 2 - i) / 2) as usize;
-                let row = interior.get(first..first + (res - 1 - i) as usize).unwrap_or(&[]);
-                grid.extend_from_slice(row);
-            }
-            if !interior_point {
-                grid.push(store.face_sample(face, i, j).unwrap_or([0.0; 4]));
-            }
-        }
-    }
-    if grid.len() != grid_index(res, res, 0) + 1 {
+    if !gather_lattice(store, face, res, grid) {
         return;
     }
     let [p0, p1, p2] = corners.map(|v| position(positions, v));
@@ -195,6 +179,28 @@ fn blur_face<C: Coverage>(
             }
         }
     }
+}
+
+/// Gathers the whole lattice of `face` (resolution `res`) into `grid` ([`grid_index`]
+/// order): interior rows copied, boundary points read from the edges and vertices. `false`
+/// when the store does not hold what the face's resolution says.
+fn gather_lattice(store: &ColorStore, face: u32, res: u32, grid: &mut Vec<Rgba>) -> bool {
+    grid.clear();
+    let interior = store.interior_samples(face);
+    for i in 0..=res {
+        for j in 0..=res - i {
+            let interior_point = i >= 1 && j >= 1 && i + j < res;
+            if interior_point && j == 1 {
+                let first = ((i - 1) * (2 * res - 2 - i) / 2) as usize;
+                let row = interior.get(first..first + (res - 1 - i) as usize).unwrap_or(&[]);
+                grid.extend_from_slice(row);
+            }
+            if !interior_point {
+                grid.push(store.face_sample(face, i, j).unwrap_or([0.0; 4]));
+            }
+        }
+    }
+    grid.len() == grid_index(res, res, 0) + 1
 }
 
 /// Writes the accumulated edge and vertex samples (every mean was taken before any of them
