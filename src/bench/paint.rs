@@ -1,5 +1,6 @@
 //! `meshpaint bench paint`: BVH presets, pick latency, dab throughput per brush size and
-//! tool, the bytes each dab uploads and the repack time, on the editor's own code paths.
+//! tool, the bytes each dab uploads and the repack time, on the editor's own code paths; `headline` is the editor's defaults
+//! (occlusion and backface culling on) on the largest brush.
 //!
 //! Upload bytes come from [`PaintLayout::sync`] and [`PaintLayout::encode_range`], exactly
 //! what the editor's paint mode sends to the GPU after a dab (samples and patched face
@@ -47,9 +48,26 @@ impl Default for PaintBenchOptions {
     }
 }
 
+/// The rows measured per brush size: (name, tool, backface culling, occlusion, one undo
+/// step per dab). Each is named after what it enables; `occlusion` is the editor's default.
+pub const ROWS: [(&str, Tool, bool, bool, bool); 7] = [
+    ("occlusion", Tool::Paint, true, true, false),
+    ("occlusion_first_dab", Tool::Paint, true, true, true),
+    ("paint", Tool::Paint, false, false, false),
+    ("first_dab", Tool::Paint, false, false, true),
+    ("culling", Tool::Paint, true, false, false),
+    ("blur", Tool::Blur, false, false, false),
+    ("blur_occlusion", Tool::Blur, true, true, false),
+];
+
+/// The row the headline reports: the editor's defaults.
+pub const HEADLINE_ROW: &str = "occlusion";
+
 /// Measures picking and painting on `document` (see `meshpaint bench paint`): BVH build and
 /// pick time per preset, dab time and throughput for brushes covering the target sample
-/// counts, bytes a dab would upload, and the repack time. One thread. Returns JSON.
+/// counts (every row of [`ROWS`]; `headline` repeats [`HEADLINE_ROW`] on the largest brush),
+/// bytes a dab would upload, the occlusion depth map's build time, and the repack time.
+/// Returns JSON.
 pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<serde_json::Value, BrushError> {
     let positions = &document.positions;
     let triangles = &document.store.topology().face_vertices;
@@ -61,13 +79,16 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
     // Pick latency through the whole cursor path (pixel → ray → BVH), default preset.
     let bvh = reference;
     let mut store = document.store.clone();
-    let base = document.store.clone();
-    let view = PaintView { positions, bvh: &bvh, camera: &camera, viewport_px: options.viewport_px, base: Some(&base) };
+    // The base snapshot is the document's own store (the bench paints a copy).
+    let base = &document.store;
+    let view = PaintView { positions, bvh: &bvh, camera: &camera, viewport_px: options.viewport_px, base: Some(base) };
     let centre_px = [f64::from(width) * 0.5, f64::from(height) * 0.5];
     let (pick_timing, hit) = Timing::measure(options.picks.max(1), || view.pick(centre_px));
     let center = hit.map(|hit| DVec3::from_array(hit.position_world)).unwrap_or(DVec3::from_array(camera.target));
 
     let mut painter = Painter::new(positions);
+    // The occlusion depth map of the view, built once per view (timed apart from the dabs).
+    let (depth_timing, built) = Timing::measure(1, || painter.prepare_occlusion(&view, &store, false));
     let mut brushes = Vec::new();
     let scene_radius = camera.scene_radius.max(1e-12);
     for &target in &options.target_samples {
@@ -76,18 +97,7 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
             "radius_px": radius / view.world_per_px_at(center).max(f64::MIN_POSITIVE) });
         let (query, faces) = Timing::measure(options.dabs.max(5), || view.bvh.faces_in_sphere(center, radius));
         row["sphere_query"] = serde_json::json!({ "faces": faces.len(), "timing": query.to_json() });
-        // (name, tool, culling, occlusion, one undo step per dab)
-        let variants = [
-            ("paint_first_dab", Tool::Paint, false, false, true),
-            ("paint_in_stroke", Tool::Paint, false, false, false),
-            ("paint_culling_in_stroke", Tool::Paint, true, false, false),
-            ("paint_culling_occlusion_in_stroke", Tool::Paint, true, true, false),
-            ("blur_in_stroke", Tool::Blur, false, false, false),
-        ];
-        for (name, tool, culling, occlusion, step_per_dab) in variants {
-            if (occlusion || tool == Tool::Blur) && target > 20_000 {
-                continue;
-            }
+        for &(name, tool, culling, occlusion, step_per_dab) in &ROWS {
             let settings = BrushSettings {
                 tool,
                 blend: BlendMode::Mix,
@@ -103,14 +113,32 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
         }
         brushes.push(row);
     }
+    // The headline: the editor's defaults on the largest brush.
+    let headline = brushes.last().map_or(serde_json::Value::Null, |row| {
+        let dab = &row[HEADLINE_ROW];
+        serde_json::json!({
+            "row": HEADLINE_ROW,
+            "what": "paint with the editor's defaults (occlusion and backface culling on), in a stroke",
+            "target_samples": row["target_samples"],
+            "samples_per_second_best": dab["samples_per_second_best"],
+            "samples_per_second_median": dab["samples_per_second_median"],
+        })
+    });
     let (pack_timing, packed) = Timing::measure(options.pack_runs, || document.pack(ColorFormat::Rgba8Srgb));
     let packed_bytes = packed.map(|p| p.face_record_bytes() + p.color_bytes()).unwrap_or(0);
     Ok(serde_json::json!({
         "bench": "paint",
         "triangles": document.store.topology().face_count(),
         "samples": document.store.sample_count(),
-        "threads": 1,
+        "threads": rayon::current_num_threads(),
         "viewport_px": options.viewport_px,
+        "headline": headline,
+        "occlusion_depth_map": {
+            "build_seconds": depth_timing.best_seconds,
+            "maps_built": built,
+            "pixels": u64::from(width) * u64::from(height),
+            "tolerance_px": crate::paint::occlusion::DEPTH_TOLERANCE_PX,
+        },
         "bvh_presets": presets,
         "pick_latency": pick_timing.to_json(),
         "brushes": brushes,

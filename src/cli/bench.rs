@@ -126,6 +126,13 @@ pub(super) enum BenchCommand {
         /// Timed dabs per brush size.
         #[arg(long, default_value_t = 30)]
         dabs: usize,
+        /// Split every triangle into four this many times before measuring (Bunny144k:
+        /// 1 → 576 184 triangles, 2 → 2 304 736), the way to reach a million triangles.
+        #[arg(long, default_value_t = 0)]
+        subdivide: u32,
+        /// Target footprints, samples per dab (default 1000, 10000, 100000).
+        #[arg(long, value_delimiter = ',')]
+        dab_samples: Vec<u64>,
         /// Print compact JSON (default: indented JSON).
         #[arg(long)]
         json: bool,
@@ -226,12 +233,23 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             println!("{report}");
             Ok(())
         }
-        BenchCommand::Paint { file, resolution, dabs, json } => {
-            let document = open(&file, resolution, &budget(None))?;
-            let options = meshpaint::bench::PaintBenchOptions { dabs, ..Default::default() };
+        BenchCommand::Paint { file, resolution, dabs, subdivide, dab_samples, json } => {
+            let document = if subdivide == 0 {
+                open(&file, resolution, &budget(None))?
+            } else {
+                let budget = budget(None);
+                let (scene, _) = meshpaint::io::document::import_scene_within(&file, &budget)?;
+                let scene = meshpaint::io::subdivide::subdivide_scene(&scene, subdivide, &budget)?;
+                meshpaint::io::document::Document::from_scene_within(scene, resolution.rule()?, &file, &budget)?
+            };
+            let mut options = meshpaint::bench::PaintBenchOptions { dabs, ..Default::default() };
+            if !dab_samples.is_empty() {
+                options.target_samples = dab_samples;
+            }
             let mut report = meshpaint::bench::bench_paint(&document, &options)?;
             report["file"] = file.display().to_string().into();
             report["resolution"] = resolution.resolution.into();
+            report["subdivide"] = subdivide.into();
             if json {
                 println!("{report}");
             } else {

@@ -319,29 +319,8 @@ impl SeenSamples {
     }
 }
 
-/// One element's samples, as [`StoreWriter::element`] writes them: the vertex colours
-/// (index = vertex id), or the samples of one edge or face interior (index = storage offset).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Element {
-    /// Every vertex colour.
-    Vertices,
-    /// The samples of an edge.
-    Edge(u32),
-    /// The interior samples of a face.
-    Interior(u32),
-}
-
-impl Element {
-    /// The sample at `index` of this element.
-    #[inline(always)]
-    pub fn sample(self, index: u32) -> SampleRef {
-        match self {
-            Element::Vertices => SampleRef::Vertex(index),
-            Element::Edge(edge) => SampleRef::Edge { edge, offset: index },
-            Element::Interior(face) => SampleRef::Interior { face, offset: index },
-        }
-    }
-}
+/// One element's samples, as [`StoreWriter::element`] writes them (the store's element).
+pub use crate::colors::store::StoreElement as Element;
 
 /// Records first writes to the samples of one element (or to vertices) in the open step;
 /// recording is a bit test and, the first time, a push. Only [`ElementWriter`] records.
@@ -785,5 +764,21 @@ impl ElementWriter<'_> {
         }
         self.log.record(index, old);
         self.store.set(self.log.element.sample(index), new)
+    }
+
+    /// Updates the run of `len` samples from `first` in place ([`ColorStore::update_run`]):
+    /// `update(index, old)` gives the new (clamped) colour or `None`; a bit-identical one is
+    /// not written; old colours are recorded on first write. Returns the samples changed.
+    #[inline(always)]
+    pub fn update_run(&mut self, first: u32, len: u32, mut update: impl FnMut(u32, Rgba) -> Option<Rgba>) -> u64 {
+        let log = &mut self.log;
+        self.store.update_run(log.element, first, len, |index, old| {
+            let new = update(index, old)?;
+            if !differs(new, old) {
+                return None;
+            }
+            log.record(index, old);
+            Some(new)
+        })
     }
 }

@@ -1,14 +1,33 @@
 //! The blur brush: each covered sample moves towards the mean of its lattice neighbours
 //! (the six neighbours in every face whose lattice contains it, at that face's resolution)
 //! by its weight, all means taken before any write (Jacobi).
+//!
+//! Per face of the dab, the face's whole lattice is gathered once into a local grid
+//! (interior rows copied from the face's storage, the boundary read from its edges and
+//! vertices), and each covered point sums its neighbours from the grid: no per-neighbour
+//! store look-up. A face's interior is only ever read by the face itself, so its new
+//! colours are written at once; samples on edges and vertices belong to several faces, so
+//! their sums are accumulated per element (one slot per edge sample and vertex, found
+//! through a per-dab element → slot table) and written after every face was gathered.
 
-use crate::colors::store::ColorStore;
-use crate::paint::undo::StoreWriter;
+use crate::colors::format::Rgba;
+use crate::colors::store::{ColorStore, SampleRef};
+use crate::paint::undo::{Element, StoreWriter};
 
 use super::footprint::Coverage;
 use super::kernels::DabStats;
-use super::scratch::{BlurTerm, Scratch, accumulate_masks, face_elements, position};
+use super::scratch::{BlurAcc, Scratch, accumulate_masks, face_elements, position, visit_mask};
 use super::settings::BlendMode;
+
+/// The six lattice neighbours `(di, dj)`.
+const NEIGHBOURS: [(i64, i64); 6] = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, -1), (-1, 1)];
+
+/// Index of lattice point `(i, j)` in a face grid of resolution `res` (row `i` holds
+/// `res + 1 − i` points).
+#[inline(always)]
+fn grid_index(res: u32, i: u32, j: u32) -> usize {
+    (i * (res + 1) - i * i.saturating_sub(1) / 2 + j) as usize
+}
 
 /// The blur dab over `scratch.faces` (masks in `scratch.face_masks`).
 pub(super) fn blur_faces<C: Coverage>(
@@ -17,122 +36,205 @@ pub(super) fn blur_faces<C: Coverage>(
     writer: &mut StoreWriter,
     scratch: &mut Scratch,
 ) -> DabStats {
-    let mut terms = std::mem::take(&mut scratch.blur);
-    terms.clear();
-    collect_terms(coverage, positions, writer.store(), scratch, &mut terms);
     let mut stats = DabStats { faces: scratch.faces.len() as u32, ..DabStats::default() };
-    write_terms(writer, &mut terms, &mut stats);
-    scratch.blur = terms;
+    let stamp = accumulate_masks(writer.store(), scratch);
+    assign_slots(writer.store(), scratch, stamp);
+    let faces = std::mem::take(&mut scratch.faces);
+    let masks = std::mem::take(&mut scratch.face_masks);
+    let mut grid = std::mem::take(&mut scratch.blur_grid);
+    for (&face, &face_mask) in faces.iter().zip(&masks) {
+        blur_face(coverage, positions, writer, scratch, (face, face_mask), &mut grid, &mut stats);
+    }
+    scratch.blur_grid = grid;
+    scratch.faces = faces;
+    scratch.face_masks = masks;
+    write_shared(writer, scratch, &mut stats);
     stats
 }
 
-/// Pushes one [`BlurTerm`] per covered sample and face (a shared sample gets one per face
-/// whose lattice contains it).
-fn collect_terms<C: Coverage>(
-    coverage: &C,
-    positions: &[[f32; 3]],
-    store: &ColorStore,
-    scratch: &mut Scratch,
-    terms: &mut Vec<BlurTerm>,
-) {
-    let stamp = accumulate_masks(store, scratch);
-    const NEIGHBOURS: [(i64, i64); 6] = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, -1), (-1, 1)];
-    for (&face, &face_mask) in scratch.faces.iter().zip(&scratch.face_masks) {
-        let Some((r, corners, edges)) = face_elements(store, face) else {
+/// Gives every edge and vertex of the dab's faces its accumulator slots (an edge one per
+/// stored sample), zeroed.
+fn assign_slots(store: &ColorStore, scratch: &mut Scratch, stamp: u32) {
+    scratch.blur_acc.clear();
+    scratch.blur_edges.clear();
+    scratch.blur_vertices.clear();
+    let topology = store.topology();
+    for &face in &scratch.faces {
+        let (Some(edges), Some(corners)) =
+            (topology.face_edges.get(face as usize), topology.face_vertices.get(face as usize))
+        else {
             continue;
         };
-        let res = r.get();
-        let [p0, p1, p2] = corners.map(|v| position(positions, v));
-        let inv = 1.0 / f64::from(res);
-        let (e1, e2) = ((p1 - p0) * inv, (p2 - p0) * inv);
-        // The mask of a lattice point: its element's (accumulated for shared elements).
-        let vertex_mask = |k: usize| {
-            let v = corners[k] as usize;
-            if scratch.vertex_stamp[v] == stamp { scratch.vertex_mask[v] } else { 0 }
-        };
-        let edge_mask = |k: usize| {
-            let e = edges[k] as usize;
-            if scratch.edge_stamp[e] == stamp { scratch.edge_mask[e] } else { 0 }
-        };
-        let all =
-            face_mask | vertex_mask(0) | vertex_mask(1) | vertex_mask(2) | edge_mask(0) | edge_mask(1) | edge_mask(2);
-        if all == 0 {
-            continue;
+        for &edge in edges {
+            // The mask stays readable after the visit (`edge_mask`); the stamp moves on.
+            if scratch.edge_stamp[edge as usize] == stamp {
+                visit_mask(&mut scratch.edge_stamp, &scratch.edge_mask, edge, stamp);
+                scratch.edge_slot[edge as usize] = scratch.blur_acc.len() as u32;
+                let count = store.edge_samples(edge).len();
+                scratch.blur_acc.resize(scratch.blur_acc.len() + count, BlurAcc::default());
+                scratch.blur_edges.push(edge);
+            }
         }
-        for i in 0..=res {
-            let a = p0 + e1 * f64::from(i);
-            let Some((j0, j1)) = coverage.row_range(a, e2, 0, res - i, all) else {
-                continue;
-            };
-            for j in j0..=j1 {
-                let mask = match (i, j) {
-                    (0, 0) => vertex_mask(0),
-                    (i, 0) if i == res => vertex_mask(1),
-                    (0, j) if j == res => vertex_mask(2),
-                    (_, 0) => edge_mask(0),
-                    (i, j) if i + j == res => edge_mask(1),
-                    (0, _) => edge_mask(2),
-                    _ => face_mask,
-                };
-                if mask == 0 {
-                    continue;
-                }
-                let weight = coverage.weight(a + e2 * f64::from(j), mask);
-                if weight <= 0.0 {
-                    continue;
-                }
-                let Some(sample) = store.face_sample_ref(face, i, j) else {
-                    continue;
-                };
-                let mut sum = [0.0f32; 4];
-                let mut count = 0;
-                for (di, dj) in NEIGHBOURS {
-                    let (ni, nj) = (i64::from(i) + di, i64::from(j) + dj);
-                    if ni < 0 || nj < 0 || ni + nj > i64::from(res) {
-                        continue;
-                    }
-                    if let Some(color) = store.face_sample(face, ni as u32, nj as u32) {
-                        for c in 0..4 {
-                            sum[c] += color[c];
-                        }
-                        count += 1;
-                    }
-                }
-                terms.push(BlurTerm { sample, sum, count, weight });
+        for &v in corners {
+            if scratch.vertex_stamp[v as usize] == stamp {
+                visit_mask(&mut scratch.vertex_stamp, &scratch.vertex_mask, v, stamp);
+                scratch.vertex_slot[v as usize] = scratch.blur_acc.len() as u32;
+                scratch.blur_acc.push(BlurAcc::default());
+                scratch.blur_vertices.push(v);
             }
         }
     }
 }
 
-/// Merges the terms of the faces sharing a sample, then writes each sample once (every mean
-/// was taken before any write).
-fn write_terms(writer: &mut StoreWriter, terms: &mut [BlurTerm], stats: &mut DabStats) {
-    terms.sort_unstable_by_key(|term| term.sample);
-    let mut k = 0;
-    while k < terms.len() {
-        let mut merged = terms[k];
-        let mut next = k + 1;
-        while next < terms.len() && terms[next].sample == merged.sample {
-            let term = terms[next];
-            for c in 0..4 {
-                merged.sum[c] += term.sum[c];
-            }
-            merged.count += term.count;
-            merged.weight = merged.weight.max(term.weight);
-            next += 1;
-        }
-        k = next;
-        let Some(old) = writer.store().get(merged.sample) else {
+/// One face: gathers its lattice, writes its covered interior samples and accumulates its
+/// covered boundary samples.
+fn blur_face<C: Coverage>(
+    coverage: &C,
+    positions: &[[f32; 3]],
+    writer: &mut StoreWriter,
+    scratch: &mut Scratch,
+    (face, face_mask): (u32, u8),
+    grid: &mut Vec<Rgba>,
+    stats: &mut DabStats,
+) {
+    let store = writer.store();
+    let Some((r, corners, edges)) = face_elements(store, face) else {
+        return;
+    };
+    let res = r.get();
+    // The mask of a boundary point: its element's (accumulated over the dab's faces).
+    let vertex_mask = |k: usize| scratch.vertex_mask[corners[k] as usize];
+    let edge_mask = |k: usize| scratch.edge_mask[edges[k] as usize];
+    let all = face_mask | vertex_mask(0) | vertex_mask(1) | vertex_mask(2) | edge_mask(0) | edge_mask(1) | edge_mask(2);
+    if all == 0 {
+        return;
+    }
+    if !gather_lattice(store, face, res, grid) {
+        return;
+    }
+    let [p0, p1, p2] = corners.map(|v| position(positions, v));
+    let inv = 1.0 / f64::from(res);
+    let (e1, e2) = ((p1 - p0) * inv, (p2 - p0) * inv);
+    let unoccluded = coverage.unoccluded(&[p0, p1, p2], all);
+    let mut out = writer.element(Element::Interior(face));
+    for i in 0..=res {
+        let a = p0 + e1 * f64::from(i);
+        let Some((j0, j1)) = coverage.row_range(a, e2, 0, res - i, all) else {
             continue;
         };
-        stats.samples_covered += 1;
-        if merged.count == 0 {
-            continue;
+        for j in j0..=j1 {
+            let interior_point = i >= 1 && j >= 1 && i + j < res;
+            let mask = match (i, j) {
+                _ if interior_point => face_mask,
+                (0, 0) => vertex_mask(0),
+                (i, 0) if i == res => vertex_mask(1),
+                (0, j) if j == res => vertex_mask(2),
+                (_, 0) => edge_mask(0),
+                (i, j) if i + j == res => edge_mask(1),
+                _ => edge_mask(2),
+            };
+            if mask == 0 {
+                continue;
+            }
+            let p = a + e2 * f64::from(j);
+            let weight = if unoccluded { coverage.weight_unoccluded(p, mask) } else { coverage.weight(p, mask) };
+            if weight <= 0.0 {
+                continue;
+            }
+            let mut sum = [0.0f32; 4];
+            let mut count = 0;
+            for (di, dj) in NEIGHBOURS {
+                let (ni, nj) = (i64::from(i) + di, i64::from(j) + dj);
+                if ni < 0 || nj < 0 || ni + nj > i64::from(res) {
+                    continue;
+                }
+                let color = grid[grid_index(res, ni as u32, nj as u32)];
+                for (total, channel) in sum.iter_mut().zip(color) {
+                    *total += channel;
+                }
+                count += 1;
+            }
+            if interior_point {
+                stats.samples_covered += 1;
+                let old = grid[grid_index(res, i, j)];
+                let mean = sum.map(|s| s / count as f32);
+                let new = BlendMode::Mix.blend(old, mean, old, weight);
+                let index = (i - 1) * (2 * res - 2 - i) / 2 + (j - 1);
+                if out.write(index, old, new) {
+                    stats.samples_changed += 1;
+                }
+                continue;
+            }
+            let slot = match out.store().face_sample_ref(face, i, j) {
+                Some(SampleRef::Vertex(v)) => scratch.vertex_slot[v as usize] as usize,
+                Some(SampleRef::Edge { edge, offset }) => (scratch.edge_slot[edge as usize] + offset) as usize,
+                _ => continue,
+            };
+            if let Some(acc) = scratch.blur_acc.get_mut(slot) {
+                for (total, channel) in acc.sum.iter_mut().zip(sum) {
+                    *total += channel;
+                }
+                acc.count += count;
+                acc.weight = acc.weight.max(weight);
+            }
         }
-        let mean = merged.sum.map(|s| s / merged.count as f32);
-        let new = BlendMode::Mix.blend(old, mean, old, merged.weight);
-        if writer.set(merged.sample, new) {
-            stats.samples_changed += 1;
+    }
+}
+
+/// Gathers the whole lattice of `face` (resolution `res`) into `grid` ([`grid_index`]
+/// order): interior rows copied, boundary points read from the edges and vertices. `false`
+/// when the store does not hold what the face's resolution says.
+fn gather_lattice(store: &ColorStore, face: u32, res: u32, grid: &mut Vec<Rgba>) -> bool {
+    grid.clear();
+    let interior = store.interior_samples(face);
+    for i in 0..=res {
+        for j in 0..=res - i {
+            let interior_point = i >= 1 && j >= 1 && i + j < res;
+            if interior_point && j == 1 {
+                let first = ((i - 1) * (2 * res - 2 - i) / 2) as usize;
+                let row = interior.get(first..first + (res - 1 - i) as usize).unwrap_or(&[]);
+                grid.extend_from_slice(row);
+            }
+            if !interior_point {
+                grid.push(store.face_sample(face, i, j).unwrap_or([0.0; 4]));
+            }
+        }
+    }
+    grid.len() == grid_index(res, res, 0) + 1
+}
+
+/// Writes the accumulated edge and vertex samples (every mean was taken before any of them
+/// is written).
+fn write_shared(writer: &mut StoreWriter, scratch: &Scratch, stats: &mut DabStats) {
+    // (element, index of its first sample's slot, samples)
+    let edges = scratch.blur_edges.iter().map(|&edge| (Element::Edge(edge), None, scratch.edge_slot[edge as usize]));
+    let vertices = scratch.blur_vertices.iter().map(|&v| (Element::Vertices, Some(v), scratch.vertex_slot[v as usize]));
+    for (element, vertex, first) in edges.chain(vertices) {
+        let count = match (element, vertex) {
+            (Element::Edge(edge), _) => writer.store().edge_samples(edge).len() as u32,
+            _ => 1,
+        };
+        let mut out = writer.element(element);
+        for k in 0..count {
+            let Some(acc) = scratch.blur_acc.get((first + k) as usize) else {
+                continue;
+            };
+            if acc.weight <= 0.0 {
+                continue;
+            }
+            let index = vertex.unwrap_or(k);
+            let Some(old) = out.get(index) else {
+                continue;
+            };
+            stats.samples_covered += 1;
+            if acc.count == 0 {
+                continue;
+            }
+            let mean = acc.sum.map(|s| s / acc.count as f32);
+            let new = BlendMode::Mix.blend(old, mean, old, acc.weight);
+            if out.write(index, old, new) {
+                stats.samples_changed += 1;
+            }
         }
     }
 }

@@ -3,6 +3,7 @@
 
 use glam::DVec3;
 
+use crate::paint::occlusion::DepthMap;
 use crate::paint::picking::MeshBvh;
 
 use super::settings::Falloff;
@@ -22,6 +23,37 @@ pub(super) trait Coverage {
     /// Whether every point of the segment or triangle with these corners is inside a sphere
     /// in `mask` (its rows then need no [`Coverage::row_range`]).
     fn covers(&self, corners: &[DVec3], mask: u8) -> bool;
+    /// Whether occlusion cannot hide any point of the segment or triangle with these
+    /// corners from the spheres in `mask`: [`Coverage::weight_unoccluded`] then equals
+    /// [`Coverage::weight`] there.
+    fn unoccluded(&self, _corners: &[DVec3], _mask: u8) -> bool {
+        false
+    }
+    /// [`Coverage::weight`] without the occlusion test (for points of an element
+    /// [`Coverage::unoccluded`] cleared).
+    fn weight_unoccluded(&self, p: DVec3, mask: u8) -> f32 {
+        self.weight(p, mask)
+    }
+}
+
+/// How a dab tests occlusion: the depth map of each sphere's eye where one was built
+/// ([`DepthMap::visible`]), the BVH ray ([`visible`], the reference) where the map cannot
+/// tell or there is none.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Occlusion<'a> {
+    pub(super) bvh: &'a MeshBvh,
+    pub(super) maps: [Option<&'a DepthMap>; 2],
+}
+
+impl Occlusion<'_> {
+    /// Whether `point` is visible from `eye`, the eye of sphere `k`.
+    #[inline]
+    fn visible(&self, k: usize, eye: DVec3, point: DVec3) -> bool {
+        if let Some(seen) = self.maps.get(k).copied().flatten().and_then(|map| map.visible(point)) {
+            return seen;
+        }
+        visible(self.bvh, eye, point)
+    }
 }
 
 /// The brush spheres of one dab (one, or two with mirror).
@@ -34,7 +66,7 @@ pub(super) struct Footprint<'a> {
     inv_radius: f64,
     strength: f32,
     falloff: Falloff,
-    occlusion: Option<&'a MeshBvh>,
+    occlusion: Option<Occlusion<'a>>,
 }
 
 impl<'a> Footprint<'a> {
@@ -47,7 +79,7 @@ impl<'a> Footprint<'a> {
         radius: f64,
         strength: f32,
         falloff: Falloff,
-        occlusion: Option<&'a MeshBvh>,
+        occlusion: Option<Occlusion<'a>>,
     ) -> Self {
         Footprint {
             centers,
@@ -71,9 +103,9 @@ impl<'a> Footprint<'a> {
         self.strength * self.falloff.weight_of_squared((d2 * self.inv_radius * self.inv_radius) as f32)
     }
 
-    /// [`Coverage::weight`] with mirror or occlusion.
+    /// [`Coverage::weight`] with mirror or occlusion (`occlusion`: whether to test it).
     #[inline(never)]
-    fn weight_general(&self, p: DVec3, mask: u8) -> f32 {
+    fn weight_general(&self, p: DVec3, mask: u8, occlusion: bool) -> f32 {
         let mut best = 0.0f32;
         for k in 0..self.count {
             if mask & (1 << k) == 0 {
@@ -87,8 +119,8 @@ impl<'a> Footprint<'a> {
             if w <= best {
                 continue;
             }
-            if let Some(bvh) = self.occlusion
-                && !visible(bvh, self.eyes[k], p)
+            if let Some(test) = self.occlusion.as_ref().filter(|_| occlusion)
+                && !test.visible(k, self.eyes[k], p)
             {
                 continue;
             }
@@ -141,7 +173,26 @@ impl Coverage for Footprint<'_> {
         if self.count == 1 && self.occlusion.is_none() {
             return if mask & 1 != 0 { self.weight_single(p) } else { 0.0 };
         }
-        self.weight_general(p, mask)
+        self.weight_general(p, mask, true)
+    }
+
+    #[inline]
+    fn unoccluded(&self, corners: &[DVec3], mask: u8) -> bool {
+        let Some(occlusion) = &self.occlusion else {
+            return true;
+        };
+        (0..self.count).all(|k| {
+            mask & (1 << k) == 0
+                || occlusion.maps.get(k).copied().flatten().is_some_and(|map| map.region_visible(corners))
+        })
+    }
+
+    #[inline(always)]
+    fn weight_unoccluded(&self, p: DVec3, mask: u8) -> f32 {
+        if self.count == 1 {
+            return if mask & 1 != 0 { self.weight_single(p) } else { 0.0 };
+        }
+        self.weight_general(p, mask, false)
     }
 
     #[inline]
@@ -166,6 +217,10 @@ impl Coverage for Everywhere {
     }
 
     fn covers(&self, _: &[DVec3], _: u8) -> bool {
+        true
+    }
+
+    fn unoccluded(&self, _: &[DVec3], _: u8) -> bool {
         true
     }
 }

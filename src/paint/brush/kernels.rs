@@ -1,9 +1,9 @@
 //! The colour brush's kernels: every stored sample of a dab's faces blended once (interior
 //! rows per face, each shared edge and vertex once), written through the [`StoreWriter`].
 //!
-//! The interior, edge and vertex loops share one per-sample step, [`blend_sample`]; the
-//! interior rows and the edge walk share `Kernel::row`. Both inline into the loops (the hot
-//! path: no allocation, no hashing, an undo bit test per write).
+//! The interior rows and the edge walk share `Kernel::row`, which updates one run of an
+//! element's samples in place ([`ElementWriter::update_run`]: one look-up per run, an undo
+//! bit test per write; the hot path allocates nothing and hashes nothing).
 
 use glam::DVec3;
 
@@ -67,34 +67,6 @@ struct ElementCounts {
     changed: u64,
 }
 
-/// Blends sample `index` of the element `out` writes at weight `weight` (> 0). Erase to base
-/// takes the base colour from `base_same[index]` when the base holds the element at the same
-/// resolution, else from `base_other(store, old)`.
-#[inline(always)]
-fn blend_sample(
-    out: &mut ElementWriter,
-    op: &PaintOp,
-    index: u32,
-    weight: f32,
-    base_same: Option<&[Rgba]>,
-    base_other: impl FnOnce(&ColorStore, Rgba) -> Rgba,
-    counts: &mut ElementCounts,
-) {
-    let Some(old) = out.get(index) else {
-        return;
-    };
-    counts.covered += 1;
-    let base = match (op.blend, base_same) {
-        (BlendMode::EraseToBase, Some(base)) => base.get(index as usize).copied().unwrap_or(old),
-        (BlendMode::EraseToBase, None) => base_other(out.store(), old),
-        _ => old,
-    };
-    let new = op.blend.blend(old, op.color, base, weight);
-    if out.write(index, old, new) {
-        counts.changed += 1;
-    }
-}
-
 /// One lattice row of an element: the points `a + b·k` for `k` in `ks`, stored at index
 /// `first + k − 1`.
 #[derive(Debug, Clone, Copy)]
@@ -113,26 +85,72 @@ struct Kernel<'a, C> {
 }
 
 impl<C: Coverage> Kernel<'_, C> {
-    /// Blends the samples of `row` with a positive weight; `base_other(store, k, old)` as in
-    /// [`blend_sample`].
+    /// Blends the samples of `row` with a positive weight, in place (one run of the
+    /// element); `base_other(store, k, old)` is the base colour of point `k` when the base
+    /// holds the element at another resolution (Erase to base).
     #[inline(always)]
     fn row(
+        &self,
+        out: &mut ElementWriter,
+        (row, mask, unoccluded): (Row, u8, bool),
+        base_same: Option<&[Rgba]>,
+        base_other: impl Fn(&ColorStore, u32, Rgba) -> Rgba,
+        counts: &mut ElementCounts,
+    ) {
+        if unoccluded {
+            self.row_with(out, (row, mask), base_same, base_other, counts, |p, mask| {
+                self.coverage.weight_unoccluded(p, mask)
+            });
+        } else {
+            self.row_with(out, (row, mask), base_same, base_other, counts, |p, mask| self.coverage.weight(p, mask));
+        }
+    }
+
+    /// [`Kernel::row`] with the weight function `weight`.
+    #[inline(always)]
+    fn row_with(
         &self,
         out: &mut ElementWriter,
         (row, mask): (Row, u8),
         base_same: Option<&[Rgba]>,
         base_other: impl Fn(&ColorStore, u32, Rgba) -> Rgba,
         counts: &mut ElementCounts,
+        weight: impl Fn(DVec3, u8) -> f32,
     ) {
         let (k0, k1) = row.ks;
-        for k in k0..=k1 {
-            let w = self.coverage.weight(row.a + row.b * f64::from(k), mask);
-            if w <= 0.0 {
-                continue;
-            }
-            let index = row.first + k - 1;
-            blend_sample(out, self.op, index, w, base_same, |store, old| base_other(store, k, old), counts);
+        if k0 > k1 || row.first + k0 == 0 {
+            return;
         }
+        let op = self.op;
+        // Erase to a base at another resolution reads the store: its colours come first.
+        let others: Vec<Rgba> = if op.blend == BlendMode::EraseToBase && base_same.is_none() {
+            (k0..=k1)
+                .map(|k| {
+                    let old = out.get(row.first + k - 1).unwrap_or_default();
+                    base_other(out.store(), k, old)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let first = row.first + k0 - 1;
+        let mut covered = 0;
+        let changed = out.update_run(first, k1 - k0 + 1, |index, old| {
+            let k = index - first + k0;
+            let w = weight(row.a + row.b * f64::from(k), mask);
+            if w <= 0.0 {
+                return None;
+            }
+            covered += 1;
+            let base = match (op.blend, base_same) {
+                (BlendMode::EraseToBase, Some(base)) => base.get(index as usize).copied().unwrap_or(old),
+                (BlendMode::EraseToBase, None) => others.get((k - k0) as usize).copied().unwrap_or(old),
+                _ => old,
+            };
+            Some(op.blend.blend(old, op.color, base, w))
+        });
+        counts.covered += covered;
+        counts.changed += changed;
     }
 
     /// Paints the interior samples of `face` (mask `mask`).
@@ -152,6 +170,7 @@ impl<C: Coverage> Kernel<'_, C> {
         let (e1, e2) = ((p1 - p0) * inv, (p2 - p0) * inv);
         let base_same = op.base.and_then(|b| (b.face_resolution(face) == Some(r)).then(|| b.interior_samples(face)));
         let whole = self.coverage.covers(&[p0, p1, p2], mask);
+        let unoccluded = self.coverage.unoccluded(&[p0, p1, p2], mask);
         let mut out = writer.element(Element::Interior(face));
         for i in 1..res - 1 {
             let a = p0 + e1 * f64::from(i);
@@ -162,7 +181,7 @@ impl<C: Coverage> Kernel<'_, C> {
             };
             let row = Row { a, b: e2, ks, first: (i - 1) * (2 * res - 2 - i) / 2 };
             let base_other = |_: &ColorStore, j: u32, old: Rgba| op.base_on_face(face, r, i, j, old);
-            self.row(&mut out, (row, mask), base_same, base_other, &mut counts);
+            self.row(&mut out, (row, mask, unoccluded), base_same, base_other, &mut counts);
         }
         counts
     }
@@ -195,7 +214,8 @@ impl<C: Coverage> Kernel<'_, C> {
         let base_other = |store: &ColorStore, k: u32, old: Rgba| base_on_edge(op, store, edge, r, k, old);
         let mut counts = ElementCounts::default();
         let row = Row { a, b, ks, first: 0 };
-        self.row(&mut writer.element(Element::Edge(edge)), (row, mask), base_same, base_other, &mut counts);
+        let unoccluded = self.coverage.unoccluded(&[a, end], mask);
+        self.row(&mut writer.element(Element::Edge(edge)), (row, mask, unoccluded), base_same, base_other, &mut counts);
         counts
     }
 
@@ -205,8 +225,15 @@ impl<C: Coverage> Kernel<'_, C> {
         let w = self.coverage.weight(position(self.positions, v), mask);
         if w > 0.0 {
             let op = self.op;
-            let base_other = |_: &ColorStore, old: Rgba| op.base.and_then(|base| base.vertex_color(v)).unwrap_or(old);
-            blend_sample(&mut writer.element(Element::Vertices), op, v, w, None, base_other, &mut counts);
+            let mut out = writer.element(Element::Vertices);
+            counts.covered = u64::from(out.get(v).is_some());
+            counts.changed = out.update_run(v, 1, |_, old| {
+                let base = match op.blend {
+                    BlendMode::EraseToBase => op.base.and_then(|base| base.vertex_color(v)).unwrap_or(old),
+                    _ => old,
+                };
+                Some(op.blend.blend(old, op.color, base, w))
+            });
         }
         counts
     }

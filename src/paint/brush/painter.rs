@@ -13,11 +13,12 @@ use crate::paint::undo::{StepSummary, StoreWriter, UndoHistory};
 
 use super::blur::blur_faces;
 use super::error::BrushError;
-use super::footprint::Footprint;
+use super::footprint::{Footprint, Occlusion};
 use super::kernels::{DabStats, PaintOp, paint_faces};
 use super::scratch::{Scratch, position};
 use super::settings::{BlendMode, BrushRadius, BrushSettings, ResolutionOp, Tool, resolution_for_brush};
 use crate::colors::layout::Resolution;
+use crate::paint::occlusion::DepthMap;
 
 /// Smallest distance between dabs along a stroke, pixels.
 pub const MIN_SPACING_PX: f64 = 0.25;
@@ -100,6 +101,9 @@ pub struct Painter {
     budget: Option<(Budget, ColorFormat)>,
     /// The sample counts during a resolution stroke (built at its first resize).
     tracker: Option<SampleTracker>,
+    /// Occlusion depth maps of the view and of its mirror (built on the first dab that needs
+    /// them after the view changed, see [`crate::paint::occlusion`]).
+    depth_maps: [Option<DepthMap>; 2],
 }
 
 impl Painter {
@@ -119,7 +123,34 @@ impl Painter {
             scratch: Scratch::default(),
             budget: None,
             tracker: None,
+            depth_maps: [None, None],
         }
+    }
+
+    /// Makes sure the occlusion depth maps for `view` exist (the view's, and the mirrored
+    /// view's when `mirror` is on), building those missing or built for another view.
+    /// Returns how many were built. Dabs with occlusion call this themselves; it is public so
+    /// a caller can build the maps ahead (e.g. when the view stops moving) and so the
+    /// benchmark can time the build apart from the dabs.
+    pub fn prepare_occlusion(&mut self, view: &PaintView, store: &ColorStore, mirror: bool) -> usize {
+        let triangles = &store.topology().face_vertices;
+        let eye = view.camera.eye();
+        let target = DVec3::from_array(view.camera.target);
+        let plane = self.mirror_plane_x;
+        let mirrored = |p: DVec3| DVec3::new(2.0 * plane - p.x, p.y, p.z);
+        let eyes = [(eye, target), (mirrored(eye), mirrored(target))];
+        let mut built = 0;
+        for (k, &(eye, target)) in eyes.iter().enumerate().take(if mirror { 2 } else { 1 }) {
+            let current = self.depth_maps[k]
+                .as_ref()
+                .is_some_and(|map| map.is_for(view.positions, triangles, view.camera, eye, target, view.viewport_px));
+            if !current {
+                self.depth_maps[k] =
+                    DepthMap::build(view.positions, triangles, view.camera, eye, target, view.viewport_px);
+                built += 1;
+            }
+        }
+        built
     }
 
     /// The budget the resolution brush checks each face's change against before making it
@@ -298,6 +329,27 @@ impl Painter {
         if !(radius_world.is_finite() && radius_world > 0.0 && center.is_finite()) {
             return Ok(DabStats::default());
         }
+        let occlusion = settings.occlusion && matches!(settings.tool, Tool::Paint | Tool::Blur);
+        if occlusion {
+            self.prepare_occlusion(view, writer.store(), settings.mirror_x);
+        }
+        // The maps are lent to the dab (which needs `&mut self`) and put back after it.
+        let maps = std::mem::take(&mut self.depth_maps);
+        let result = self.dab_with_maps(settings, view, writer, center, radius_world, occlusion.then_some(&maps));
+        self.depth_maps = maps;
+        result
+    }
+
+    /// [`Painter::dab_with`] with the occlusion depth maps (`None`: no occlusion).
+    fn dab_with_maps(
+        &mut self,
+        settings: &BrushSettings,
+        view: &PaintView,
+        writer: &mut StoreWriter,
+        center: DVec3,
+        radius_world: f64,
+        maps: Option<&[Option<DepthMap>; 2]>,
+    ) -> Result<DabStats, BrushError> {
         let store = writer.store();
         self.scratch.fit(store);
         let eye = view.camera.eye();
@@ -310,7 +362,10 @@ impl Painter {
             radius_world,
             settings.strength,
             settings.falloff,
-            settings.occlusion.then_some(view.bvh),
+            maps.map(|maps| Occlusion {
+                bvh: view.bvh,
+                maps: [maps[0].as_ref(), maps[1].as_ref().filter(|_| count == 2)],
+            }),
         );
         // The faces of both spheres, sorted and unique.
         let mut faces = view.bvh.faces_in_sphere(center, radius_world);

@@ -1,12 +1,12 @@
 //! Per-mesh scratch reused across dabs (no allocation per sample): the faces of the dab and
 //! their sphere masks, per-element stamps that visit each shared vertex and edge once, the
-//! blur terms, and the resolution brush's per-stroke face marks.
+//! blur accumulators, and the resolution brush's per-stroke face marks.
 
 use glam::DVec3;
 
 use crate::colors::format::Rgba;
 use crate::colors::layout::Resolution;
-use crate::colors::store::{ColorStore, SampleRef};
+use crate::colors::store::ColorStore;
 
 /// Per-element scratch, sized to the mesh, reused across dabs (no allocation per sample).
 #[derive(Debug, Clone, Default)]
@@ -19,7 +19,15 @@ pub(super) struct Scratch {
     pub(super) edge_mask: Vec<u8>,
     /// Even; `stamp` marks "mask accumulated in this dab", `stamp + 1` "processed".
     stamp: u32,
-    pub(super) blur: Vec<BlurTerm>,
+    /// Blur: accumulator slots of the dab's edge samples and vertices, the element → first
+    /// slot tables (valid for the elements listed in `blur_edges` / `blur_vertices`), and
+    /// the lattice grid of the face being blurred.
+    pub(super) blur_acc: Vec<BlurAcc>,
+    pub(super) edge_slot: Vec<u32>,
+    pub(super) vertex_slot: Vec<u32>,
+    pub(super) blur_edges: Vec<u32>,
+    pub(super) blur_vertices: Vec<u32>,
+    pub(super) blur_grid: Vec<Rgba>,
     /// Resolution tool: the stroke number in which each face was last changed.
     pub(super) face_stroke: Vec<u32>,
     pub(super) stroke: u32,
@@ -38,6 +46,8 @@ impl Scratch {
             self.vertex_mask = vec![0; v];
             self.edge_stamp = vec![0; e];
             self.edge_mask = vec![0; e];
+            self.vertex_slot = vec![0; v];
+            self.edge_slot = vec![0; e];
             self.face_stroke = vec![0; f];
             self.face_flipped = Vec::new();
             self.stamp = 0;
@@ -75,10 +85,10 @@ impl Scratch {
     }
 }
 
-/// One sample's blur contribution from one face.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct BlurTerm {
-    pub(super) sample: SampleRef,
+/// The blur sums of one shared sample over the faces of a dab: neighbour colours, their
+/// count, and the largest weight.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct BlurAcc {
     pub(super) sum: Rgba,
     pub(super) count: u32,
     pub(super) weight: f32,
