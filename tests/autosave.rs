@@ -85,6 +85,22 @@ fn the_autosaver_saves_changes_at_most_one_interval_old() {
     assert_eq!(saver.saved_generation(), 4);
 }
 
+/// `due_at` is the first instant `is_due` says yes: what an idle editor wakes up for.
+#[test]
+fn the_autosaver_says_when_the_next_save_falls_due() {
+    let interval = Duration::from_secs(60);
+    let mut saver = Autosaver::new(interval, 0);
+    let t0 = Instant::now();
+    assert_eq!(saver.due_at(0), None, "nothing unsaved");
+    assert!(!saver.is_due(t0, 1));
+    let due = saver.due_at(1).expect("a change is pending");
+    assert_eq!(due, t0 + interval, "one interval after the first unsaved change");
+    assert!(!saver.is_due(due - Duration::from_millis(1), 1) && saver.is_due(due, 1));
+    saver.mark_saved(due, 1);
+    assert_eq!(saver.due_at(1), None);
+    assert_eq!(saver.due_at(2), Some(due + interval), "after a save: one interval after it");
+}
+
 /// What the soak helper wrote for generation `g`: vertex 0 is `[g, 0, 0, 1]`, and interior
 /// sample `offset` of every 7th face is `[s, 0.5, 1 − s, 1]` with `s = ((g + offset) % 17) / 16`.
 fn check_generation(store: &ColorStore, what: &str) -> u64 {

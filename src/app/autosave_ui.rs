@@ -13,19 +13,22 @@ use super::jobs::JobKind;
 use super::state::Severity;
 
 impl Editor {
-    /// Starts an autosave when one is due (called every frame).
-    pub fn autosave_tick(&mut self) {
+    /// Starts an autosave when one is due (called every frame). Returns how long until the
+    /// next one falls due, when one is pending: the editor draws no frame at rest, so the UI
+    /// asks to be woken then.
+    pub fn autosave_tick(&mut self) -> Option<Duration> {
         let stroking = self.paint.as_ref().is_some_and(|p| p.painter.is_stroking());
         if !self.autosave.enabled || self.jobs.is_busy() || stroking || self.autosave.offer.is_some() {
-            return;
+            return None;
         }
         let (Some(open), Some(path)) = (&self.document, self.autosave.recovery_path.clone()) else {
-            return;
+            return None;
         };
         self.autosave.autosaver.interval = Duration::from_secs(u64::from(self.autosave.interval_seconds.max(1)));
         let generation = self.edit_generation;
-        if !self.autosave.autosaver.is_due(Instant::now(), generation) {
-            return;
+        let now = Instant::now();
+        if !self.autosave.autosaver.is_due(now, generation) {
+            return self.autosave.autosaver.due_at(generation).map(|at| at.saturating_duration_since(now));
         }
         let document = std::sync::Arc::clone(&open.document);
         let started = self.jobs.start(JobKind::Autosave, "Autosave", move |job| {
@@ -39,6 +42,7 @@ impl Editor {
         if let Err(message) = started {
             log::warn!("{message}");
         }
+        None
     }
 
     /// Autosave settings (file panel).

@@ -17,8 +17,12 @@ impl Editor {
     pub fn ui(&mut self, ui: &mut egui::Ui) {
         self.upload_bytes_last_frame = std::mem::take(&mut self.upload_bytes_this_frame);
         self.poll_jobs();
-        self.autosave_tick();
+        let autosave_due = self.autosave_tick();
         let ctx = ui.ctx().clone();
+        if let Some(after) = autosave_due {
+            // Nothing else wakes an idle editor: the autosave asks for the frame it needs.
+            ctx.request_repaint_after(after);
+        }
         input::global_input(self, &ctx);
         egui::Panel::top("menu bar").show(ui, |ui| self.menu_bar_ui(ui));
         egui::Panel::bottom("status line").show(ui, |ui| self.status_line_ui(ui));

@@ -235,6 +235,16 @@ impl Autosaver {
         now.saturating_duration_since(reference) >= self.interval
     }
 
+    /// When an autosave of the colours at `generation` falls due (`None` when nothing is
+    /// unsaved, or before [`Autosaver::is_due`] has seen the first unsaved change): the time
+    /// an idle editor must wake up at, since nothing else redraws it.
+    pub fn due_at(&self, generation: u64) -> Option<Instant> {
+        if generation == self.saved_generation {
+            return None;
+        }
+        Some(self.last_save.or(self.first_unsaved_change)? + self.interval)
+    }
+
     /// Records that the colours at `generation` were saved at `now`.
     pub fn mark_saved(&mut self, now: Instant, generation: u64) {
         self.saved_generation = generation;
