@@ -226,8 +226,18 @@ fn the_command_line_writes_glb_and_png_and_reports_faces_without_uvs() {
     let (ok, stderr) = export(&[&s(&mpk), "--uvs", &s(&duck), "-o", &s(&from_packed), "--texture", "128"]);
     assert!(ok, "{stderr}");
     let (a, b) = (image::open(&png).unwrap().to_rgba8(), image::open(&from_packed).unwrap().to_rgba8());
-    let worst = a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
-    assert!(worst <= 1, "the packed file's bake differs by {worst} (RGBA8 quantisation allows 1)");
+    // Each packed sample is within half an 8-bit step of the document's (sRGB-encoded); the
+    // bake interpolates samples in linear light, and where the result is darker than the
+    // samples it mixes the sRGB curve is steeper, so that half step can grow a little; the
+    // texel's own rounding adds one. So: at most 2 steps, and more than 1 only rarely.
+    let diffs: Vec<u8> = a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| x.abs_diff(*y)).collect();
+    let worst = diffs.iter().copied().max().unwrap();
+    let over_one = diffs.iter().filter(|&&d| d > 1).count();
+    assert!(
+        worst <= 2 && over_one * 1000 <= diffs.len(),
+        "the packed file's bake differs by up to {worst}, {over_one} of {} channels by more than 1",
+        diffs.len()
+    );
     // The Duck's two sides share their UVs: the command says so.
     assert!(stderr.contains("texels lie in the UVs of two or more faces"), "{stderr}");
     // UVs of another mesh are refused.
