@@ -823,5 +823,5 @@ fn an_idle_editor_renders_no_frames() {
         std::thread::sleep(Duration::from_millis(50));
     }
     let status = quit(&display, app);
-    assert!(status.success(), "{status}");
+    assert!(status.success(), "{status}:\n{}", read_log(&log_path));
 }
