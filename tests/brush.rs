@@ -187,19 +187,29 @@ fn a_stroke_changes_exactly_the_samples_inside_its_dabs() {
 
 #[test]
 fn each_shared_sample_is_updated_once_per_dab() {
+    each_shared_sample_is_updated_once(4, 0.7, 100);
+}
+
+/// The same with a dab of more than 8192 samples (the kernels compute it in parallel chunks).
+#[test]
+fn each_shared_sample_is_updated_once_in_a_large_dab() {
+    each_shared_sample_is_updated_once(16, 1.5, 20_000);
+}
+
+fn each_shared_sample_is_updated_once(resolution: u64, radius: f64, min_covered: u64) {
     // Add with constant weight 1: a sample updated twice would get the colour twice.
-    let scene = Scene::new(icosphere(2), 4, [0.0, 0.0, 0.0, 1.0], 0.0, 0.0);
+    let scene = Scene::new(icosphere(2), resolution, [0.0, 0.0, 0.0, 1.0], 0.0, 0.0);
     let mut store = scene.store.clone();
     let mut painter = Painter::new(&scene.positions);
     let add = [0.25, 0.125, 0.0625, 0.0];
     painter.set_settings(BrushSettings { blend: BlendMode::Add, ..plain(Tool::Paint, add, BrushRadius::default()) });
     let mut history = UndoHistory::default();
     let center = DVec3::from_array(scene.positions[0].map(f64::from));
-    let stats = painter.dab_at(&scene.view(None), &mut store, &mut history, center, 0.7).unwrap();
+    let stats = painter.dab_at(&scene.view(None), &mut store, &mut history, center, radius).unwrap();
     let mut covered = 0;
     for (sample, p, _) in scene.sites() {
         let now = store.get(sample).unwrap();
-        if (p - center).length() < 0.7 {
+        if (p - center).length() < radius {
             covered += 1;
             assert_eq!(now, [0.25, 0.125, 0.0625, 1.0], "{sample:?}");
         } else {
@@ -208,6 +218,7 @@ fn each_shared_sample_is_updated_once_per_dab() {
     }
     assert_eq!(stats.samples_covered, covered);
     assert_eq!(stats.samples_changed, covered);
+    assert!(covered > min_covered, "{covered} samples covered");
 }
 
 /// The falloff curves' closed forms, written independently of the library.
@@ -629,10 +640,22 @@ fn blur_moves_samples_towards_their_neighbour_mean() {
 /// colours, one dab; equal within float rounding, everything else bit-identical.
 #[test]
 fn blur_matches_a_brute_force_blur_on_mixed_resolutions() {
+    blur_against_brute_force(4, 0.55, 500);
+}
+
+/// The same with a dab of more than 8192 samples (computed in parallel chunks of faces).
+#[test]
+fn blur_matches_a_brute_force_blur_in_a_large_dab() {
+    blur_against_brute_force(5, 1.2, 10_000);
+}
+
+/// The blur of one dab (R from 2 to `2^levels` at random, sphere radius `radius` on the unit
+/// icosphere) against the brute force; at least `min_terms` samples covered.
+fn blur_against_brute_force(levels: u64, radius: f64, min_terms: usize) {
     let (positions, triangles) = icosphere(2);
     let topology = Topology::build(positions.len() as u32, &triangles).unwrap();
     let mut rng = Rng(11);
-    let resolutions: Vec<Resolution> = (0..triangles.len()).map(|_| r(1 << (1 + rng.next() % 4))).collect();
+    let resolutions: Vec<Resolution> = (0..triangles.len()).map(|_| r(1 << (1 + rng.next() % levels))).collect();
     let mut store = ColorStore::with_resolutions(topology, resolutions, GREY).unwrap();
     store.fill_with(|_| rng.opaque_color());
     let bvh = MeshBvh::build(&positions, &triangles, BvhPreset::FastBuild);
@@ -640,7 +663,7 @@ fn blur_matches_a_brute_force_blur_on_mixed_resolutions() {
     let view =
         PaintView { positions: &positions, bvh: &bvh, camera: &camera, viewport_px: [WIDTH, HEIGHT], base: None };
     let before = store.clone();
-    let (center, radius, strength) = (DVec3::new(0.3, 0.5, 0.8).normalize(), 0.55, 0.7f32);
+    let (center, strength) = (DVec3::new(0.3, 0.5, 0.8).normalize(), 0.7f32);
     let mut painter = Painter::new(&positions);
     painter.set_settings(BrushSettings {
         strength,
@@ -708,7 +731,7 @@ fn blur_matches_a_brute_force_blur_on_mixed_resolutions() {
         }
     }
     assert_eq!(stats.samples_covered, terms.len() as u64);
-    assert!(terms.len() > 500 && shared > 100, "{} samples, {shared} on edges or vertices", terms.len());
+    assert!(terms.len() > min_terms && shared > 100, "{} samples, {shared} on edges or vertices", terms.len());
     // Undo restores every sample bit for bit.
     assert!(history.undo(&mut store).unwrap());
     let mut all = Vec::new();

@@ -5,19 +5,34 @@
 //! Per face of the dab, the face's whole lattice is gathered once into a local grid
 //! (interior rows copied from the face's storage, the boundary read from its edges and
 //! vertices), and each covered point sums its neighbours from the grid: no per-neighbour
-//! store look-up. A face's interior is only ever read by the face itself, so its new
-//! colours are written at once; samples on edges and vertices belong to several faces, so
-//! their sums are accumulated per element (one slot per edge sample and vertex, found
-//! through a per-dab element → slot table) and written after every face was gathered.
+//! store look-up. The faces are computed in parallel (rayon over chunks of faces, reading
+//! the store only). A face's interior is only ever read by the face itself, so its new
+//! colours are final; samples on edges and vertices belong to several faces, so each face
+//! returns its sums for them, which are accumulated per element (one slot per edge sample
+//! and vertex, found through a per-dab element → slot table). Then everything is written,
+//! in the faces' order, through the [`StoreWriter`].
+
+use rayon::prelude::*;
 
 use crate::colors::format::Rgba;
 use crate::colors::store::{ColorStore, SampleRef};
 use crate::paint::undo::{Element, StoreWriter};
 
 use super::footprint::Coverage;
-use super::kernels::DabStats;
+use super::kernels::{DabStats, PARALLEL_MIN_SAMPLES, Runs};
 use super::scratch::{BlurAcc, Scratch, accumulate_masks, face_elements, position, visit_mask};
 use super::settings::BlendMode;
+
+/// Faces per parallel task.
+const CHUNK: usize = 32;
+
+/// What one chunk of faces computes: the new interior colours, and the neighbour sums of
+/// covered boundary points `(accumulator slot, sum, count, weight)`.
+#[derive(Debug, Default)]
+struct FaceSums {
+    interiors: Runs,
+    shared: Vec<(u32, Rgba, u32, f32)>,
+}
 
 /// The six lattice neighbours `(di, dj)`.
 const NEIGHBOURS: [(i64, i64); 6] = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, -1), (-1, 1)];
@@ -30,7 +45,7 @@ fn grid_index(res: u32, i: u32, j: u32) -> usize {
 }
 
 /// The blur dab over `scratch.faces` (masks in `scratch.face_masks`).
-pub(super) fn blur_faces<C: Coverage>(
+pub(super) fn blur_faces<C: Coverage + Sync>(
     coverage: &C,
     positions: &[[f32; 3]],
     writer: &mut StoreWriter,
@@ -39,15 +54,36 @@ pub(super) fn blur_faces<C: Coverage>(
     let mut stats = DabStats { faces: scratch.faces.len() as u32, ..DabStats::default() };
     let stamp = accumulate_masks(writer.store(), scratch);
     assign_slots(writer.store(), scratch, stamp);
-    let faces = std::mem::take(&mut scratch.faces);
-    let masks = std::mem::take(&mut scratch.face_masks);
-    let mut grid = std::mem::take(&mut scratch.blur_grid);
-    for (&face, &face_mask) in faces.iter().zip(&masks) {
-        blur_face(coverage, positions, writer, scratch, (face, face_mask), &mut grid, &mut stats);
+    let store = writer.store();
+    let tables = &*scratch;
+    let compute = |faces: &[(u32, u8)]| {
+        let mut sums = FaceSums::default();
+        let mut grid = Vec::new();
+        for &face in faces {
+            blur_face(coverage, positions, store, tables, face, &mut grid, &mut sums);
+        }
+        sums
+    };
+    let faces: Vec<(u32, u8)> = scratch.faces.iter().copied().zip(scratch.face_masks.iter().copied()).collect();
+    let samples: u64 = faces.iter().map(|&(face, _)| store.interior_samples(face).len() as u64).sum();
+    let parts: Vec<FaceSums> = if samples < PARALLEL_MIN_SAMPLES {
+        vec![compute(&faces)]
+    } else {
+        faces.par_chunks(CHUNK).map(compute).collect()
+    };
+    for part in &parts {
+        stats.samples_covered += part.interiors.len();
+        stats.samples_changed += part.interiors.write(writer);
+        for &(slot, sum, count, weight) in &part.shared {
+            if let Some(acc) = scratch.blur_acc.get_mut(slot as usize) {
+                for (total, channel) in acc.sum.iter_mut().zip(sum) {
+                    *total += channel;
+                }
+                acc.count += count;
+                acc.weight = acc.weight.max(weight);
+            }
+        }
     }
-    scratch.blur_grid = grid;
-    scratch.faces = faces;
-    scratch.face_masks = masks;
     write_shared(writer, scratch, &mut stats);
     stats
 }
@@ -86,18 +122,17 @@ fn assign_slots(store: &ColorStore, scratch: &mut Scratch, stamp: u32) {
     }
 }
 
-/// One face: gathers its lattice, writes its covered interior samples and accumulates its
-/// covered boundary samples.
+/// One face: gathers its lattice, computes its covered interior samples' new colours and
+/// the neighbour sums of its covered boundary points.
 fn blur_face<C: Coverage>(
     coverage: &C,
     positions: &[[f32; 3]],
-    writer: &mut StoreWriter,
-    scratch: &mut Scratch,
+    store: &ColorStore,
+    scratch: &Scratch,
     (face, face_mask): (u32, u8),
     grid: &mut Vec<Rgba>,
-    stats: &mut DabStats,
+    out: &mut FaceSums,
 ) {
-    let store = writer.store();
     let Some((r, corners, edges)) = face_elements(store, face) else {
         return;
     };
@@ -116,7 +151,6 @@ fn blur_face<C: Coverage>(
     let inv = 1.0 / f64::from(res);
     let (e1, e2) = ((p1 - p0) * inv, (p2 - p0) * inv);
     let unoccluded = coverage.unoccluded(&[p0, p1, p2], all);
-    let mut out = writer.element(Element::Interior(face));
     for i in 0..=res {
         let a = p0 + e1 * f64::from(i);
         let Some((j0, j1)) = coverage.row_range(a, e2, 0, res - i, all) else {
@@ -141,44 +175,58 @@ fn blur_face<C: Coverage>(
             if weight <= 0.0 {
                 continue;
             }
-            let mut sum = [0.0f32; 4];
-            let mut count = 0;
-            for (di, dj) in NEIGHBOURS {
-                let (ni, nj) = (i64::from(i) + di, i64::from(j) + dj);
-                if ni < 0 || nj < 0 || ni + nj > i64::from(res) {
-                    continue;
-                }
-                let color = grid[grid_index(res, ni as u32, nj as u32)];
-                for (total, channel) in sum.iter_mut().zip(color) {
-                    *total += channel;
-                }
-                count += 1;
-            }
+            let (sum, count) =
+                if interior_point { interior_sum(grid, res, i, j) } else { boundary_sum(grid, res, i, j) };
             if interior_point {
-                stats.samples_covered += 1;
                 let old = grid[grid_index(res, i, j)];
                 let mean = sum.map(|s| s / count as f32);
                 let new = BlendMode::Mix.blend(old, mean, old, weight);
                 let index = (i - 1) * (2 * res - 2 - i) / 2 + (j - 1);
-                if out.write(index, old, new) {
-                    stats.samples_changed += 1;
-                }
+                out.interiors.push(Element::Interior(face), index, new);
                 continue;
             }
-            let slot = match out.store().face_sample_ref(face, i, j) {
-                Some(SampleRef::Vertex(v)) => scratch.vertex_slot[v as usize] as usize,
-                Some(SampleRef::Edge { edge, offset }) => (scratch.edge_slot[edge as usize] + offset) as usize,
+            let slot = match store.face_sample_ref(face, i, j) {
+                Some(SampleRef::Vertex(v)) => scratch.vertex_slot[v as usize],
+                Some(SampleRef::Edge { edge, offset }) => scratch.edge_slot[edge as usize] + offset,
                 _ => continue,
             };
-            if let Some(acc) = scratch.blur_acc.get_mut(slot) {
-                for (total, channel) in acc.sum.iter_mut().zip(sum) {
-                    *total += channel;
-                }
-                acc.count += count;
-                acc.weight = acc.weight.max(weight);
-            }
+            out.shared.push((slot, sum, count, weight));
         }
     }
+}
+
+/// The sum of the six neighbours of interior point `(i, j)` (all inside the lattice).
+#[inline(always)]
+fn interior_sum(grid: &[Rgba], res: u32, i: u32, j: u32) -> (Rgba, u32) {
+    let (below, here, above) = (grid_index(res, i - 1, 0), grid_index(res, i, 0), grid_index(res, i + 1, 0));
+    let j = j as usize;
+    let mut sum = [0.0f32; 4];
+    // The order of `NEIGHBOURS` (the same sums, bit for bit).
+    for index in [above + j, below + j, here + j + 1, here + j - 1, above + j - 1, below + j + 1] {
+        let color = grid[index];
+        for (total, channel) in sum.iter_mut().zip(color) {
+            *total += channel;
+        }
+    }
+    (sum, 6)
+}
+
+/// The sum and count of the neighbours of boundary point `(i, j)` inside the lattice.
+fn boundary_sum(grid: &[Rgba], res: u32, i: u32, j: u32) -> (Rgba, u32) {
+    let mut sum = [0.0f32; 4];
+    let mut count = 0;
+    for (di, dj) in NEIGHBOURS {
+        let (ni, nj) = (i64::from(i) + di, i64::from(j) + dj);
+        if ni < 0 || nj < 0 || ni + nj > i64::from(res) {
+            continue;
+        }
+        let color = grid[grid_index(res, ni as u32, nj as u32)];
+        for (total, channel) in sum.iter_mut().zip(color) {
+            *total += channel;
+        }
+        count += 1;
+    }
+    (sum, count)
 }
 
 /// Gathers the whole lattice of `face` (resolution `res`) into `grid` ([`grid_index`]

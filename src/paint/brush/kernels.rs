@@ -1,9 +1,12 @@
 //! The colour brush's kernels: every stored sample of a dab's faces blended once (interior
 //! rows per face, each shared edge and vertex once), written through the [`StoreWriter`].
 //!
-//! The interior rows and the edge walk share `Kernel::row`, which updates one run of an
-//! element's samples in place ([`ElementWriter::update_run`]: one look-up per run, an undo
-//! bit test per write; the hot path allocates nothing and hashes nothing).
+//! A dab runs in two passes. The first lists the dab's elements (each face interior, and
+//! each shared edge and vertex once) and computes their new colours in parallel (rayon over
+//! chunks of the list, reading the store only: no element's new colour depends on another
+//! element's). The second writes them in list order through the [`StoreWriter`], which
+//! records the undo step: one look-up per run of consecutive samples
+//! ([`ElementWriter::update_run`]), an undo bit test per write.
 
 use glam::DVec3;
 
@@ -11,7 +14,9 @@ use crate::colors::format::Rgba;
 use crate::colors::layout::{self, Resolution};
 use crate::colors::store::ColorStore;
 use crate::packing::sampler::{self, Filter};
-use crate::paint::undo::{Element, ElementWriter, StoreWriter};
+use rayon::prelude::*;
+
+use crate::paint::undo::{Element, StoreWriter};
 
 use super::footprint::Coverage;
 use super::scratch::{Scratch, accumulate_masks, position, visit_mask};
@@ -60,13 +65,6 @@ impl PaintOp<'_> {
     }
 }
 
-/// Counts of one element's update.
-#[derive(Debug, Clone, Copy, Default)]
-struct ElementCounts {
-    covered: u64,
-    changed: u64,
-}
-
 /// One lattice row of an element: the points `a + b·k` for `k` in `ks`, stored at index
 /// `first + k − 1`.
 #[derive(Debug, Clone, Copy)]
@@ -77,6 +75,46 @@ struct Row {
     first: u32,
 }
 
+/// New colours of part of a dab: runs `(element, first index, length)` of consecutive
+/// samples, their colours concatenated in `colors`.
+#[derive(Debug, Default)]
+pub(super) struct Runs {
+    runs: Vec<(Element, u32, u32)>,
+    colors: Vec<Rgba>,
+}
+
+impl Runs {
+    /// Appends the new colour of sample `index` of `element`.
+    #[inline(always)]
+    pub(super) fn push(&mut self, element: Element, index: u32, color: Rgba) {
+        match self.runs.last_mut() {
+            Some((last, first, len)) if *last == element && *first + *len == index => *len += 1,
+            _ => self.runs.push((element, index, 1)),
+        }
+        self.colors.push(color);
+    }
+
+    /// Samples listed.
+    pub(super) fn len(&self) -> u64 {
+        self.colors.len() as u64
+    }
+
+    /// Writes the new colours through `writer` (in order, recording the undo step). Returns
+    /// the samples that changed.
+    pub(super) fn write(&self, writer: &mut StoreWriter) -> u64 {
+        let mut changed = 0;
+        let mut offset = 0usize;
+        for &(element, first, len) in &self.runs {
+            let colors = &self.colors[offset..offset + len as usize];
+            offset += len as usize;
+            changed += writer
+                .element(element)
+                .update_run(first, len, |index, _| colors.get((index - first) as usize).copied());
+        }
+        changed
+    }
+}
+
 /// A paint dab's kernel: where it reaches, what it writes, and the mesh's positions.
 struct Kernel<'a, C> {
     coverage: &'a C,
@@ -85,24 +123,25 @@ struct Kernel<'a, C> {
 }
 
 impl<C: Coverage> Kernel<'_, C> {
-    /// Blends the samples of `row` with a positive weight, in place (one run of the
-    /// element); `base_other(store, k, old)` is the base colour of point `k` when the base
-    /// holds the element at another resolution (Erase to base).
+    /// The new colours of the samples of `row` with a positive weight (`current`: the
+    /// element's stored samples; `base_other(k, old)` is the base colour of point `k` when
+    /// the base holds the element at another resolution, for Erase to base).
     #[inline(always)]
     fn row(
         &self,
-        out: &mut ElementWriter,
+        (element, current, out): (Element, &[Rgba], &mut Runs),
         (row, mask, unoccluded): (Row, u8, bool),
         base_same: Option<&[Rgba]>,
-        base_other: impl Fn(&ColorStore, u32, Rgba) -> Rgba,
-        counts: &mut ElementCounts,
+        base_other: impl Fn(u32, Rgba) -> Rgba,
     ) {
         if unoccluded {
-            self.row_with(out, (row, mask), base_same, base_other, counts, |p, mask| {
+            self.row_with((element, current, out), (row, mask), base_same, base_other, |p, mask| {
                 self.coverage.weight_unoccluded(p, mask)
             });
         } else {
-            self.row_with(out, (row, mask), base_same, base_other, counts, |p, mask| self.coverage.weight(p, mask));
+            self.row_with((element, current, out), (row, mask), base_same, base_other, |p, mask| {
+                self.coverage.weight(p, mask)
+            });
         }
     }
 
@@ -110,11 +149,10 @@ impl<C: Coverage> Kernel<'_, C> {
     #[inline(always)]
     fn row_with(
         &self,
-        out: &mut ElementWriter,
+        (element, current, out): (Element, &[Rgba], &mut Runs),
         (row, mask): (Row, u8),
         base_same: Option<&[Rgba]>,
-        base_other: impl Fn(&ColorStore, u32, Rgba) -> Rgba,
-        counts: &mut ElementCounts,
+        base_other: impl Fn(u32, Rgba) -> Rgba,
         weight: impl Fn(DVec3, u8) -> f32,
     ) {
         let (k0, k1) = row.ks;
@@ -122,48 +160,34 @@ impl<C: Coverage> Kernel<'_, C> {
             return;
         }
         let op = self.op;
-        // Erase to a base at another resolution reads the store: its colours come first.
-        let others: Vec<Rgba> = if op.blend == BlendMode::EraseToBase && base_same.is_none() {
-            (k0..=k1)
-                .map(|k| {
-                    let old = out.get(row.first + k - 1).unwrap_or_default();
-                    base_other(out.store(), k, old)
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
-        let first = row.first + k0 - 1;
-        let mut covered = 0;
-        let changed = out.update_run(first, k1 - k0 + 1, |index, old| {
-            let k = index - first + k0;
+        for k in k0..=k1 {
+            let index = row.first + k - 1;
+            let Some(&old) = current.get(index as usize) else {
+                break;
+            };
             let w = weight(row.a + row.b * f64::from(k), mask);
             if w <= 0.0 {
-                return None;
+                continue;
             }
-            covered += 1;
             let base = match (op.blend, base_same) {
                 (BlendMode::EraseToBase, Some(base)) => base.get(index as usize).copied().unwrap_or(old),
-                (BlendMode::EraseToBase, None) => others.get((k - k0) as usize).copied().unwrap_or(old),
+                (BlendMode::EraseToBase, None) => base_other(k, old),
                 _ => old,
             };
-            Some(op.blend.blend(old, op.color, base, w))
-        });
-        counts.covered += covered;
-        counts.changed += changed;
+            out.push(element, index, op.blend.blend(old, op.color, base, w));
+        }
     }
 
-    /// Paints the interior samples of `face` (mask `mask`).
-    fn interior(&self, writer: &mut StoreWriter, face: u32, mask: u8) -> ElementCounts {
-        let (op, mut counts) = (self.op, ElementCounts::default());
-        let store = writer.store();
+    /// The new interior colours of `face` (mask `mask`).
+    fn interior(&self, store: &ColorStore, face: u32, mask: u8, out: &mut Runs) {
+        let op = self.op;
         let (Some(r), Some(corners)) = (store.face_resolution(face), store.topology().face_vertices.get(face as usize))
         else {
-            return counts;
+            return;
         };
         let res = r.get();
         if res < 3 {
-            return counts;
+            return;
         }
         let [p0, p1, p2] = corners.map(|v| position(self.positions, v));
         let inv = 1.0 / f64::from(res);
@@ -171,7 +195,7 @@ impl<C: Coverage> Kernel<'_, C> {
         let base_same = op.base.and_then(|b| (b.face_resolution(face) == Some(r)).then(|| b.interior_samples(face)));
         let whole = self.coverage.covers(&[p0, p1, p2], mask);
         let unoccluded = self.coverage.unoccluded(&[p0, p1, p2], mask);
-        let mut out = writer.element(Element::Interior(face));
+        let current = store.interior_samples(face);
         for i in 1..res - 1 {
             let a = p0 + e1 * f64::from(i);
             let range =
@@ -180,23 +204,21 @@ impl<C: Coverage> Kernel<'_, C> {
                 continue;
             };
             let row = Row { a, b: e2, ks, first: (i - 1) * (2 * res - 2 - i) / 2 };
-            let base_other = |_: &ColorStore, j: u32, old: Rgba| op.base_on_face(face, r, i, j, old);
-            self.row(&mut out, (row, mask, unoccluded), base_same, base_other, &mut counts);
+            let base_other = |j: u32, old: Rgba| op.base_on_face(face, r, i, j, old);
+            self.row((Element::Interior(face), current, out), (row, mask, unoccluded), base_same, base_other);
         }
-        counts
     }
 
-    /// Paints the samples of `edge` (at the edge's resolution).
-    fn edge(&self, writer: &mut StoreWriter, edge: u32, mask: u8) -> ElementCounts {
-        let store = writer.store();
+    /// The new colours of the samples of `edge` (at the edge's resolution).
+    fn edge(&self, store: &ColorStore, edge: u32, mask: u8, out: &mut Runs) {
         let (Some(r), Some(&[lo, hi])) =
             (store.edge_resolution(edge), store.topology().edge_vertices.get(edge as usize))
         else {
-            return ElementCounts::default();
+            return;
         };
         let res = r.get();
         if res < 2 {
-            return ElementCounts::default();
+            return;
         }
         let (a, end) = (position(self.positions, lo), position(self.positions, hi));
         let b = (end - a) / f64::from(res);
@@ -206,36 +228,32 @@ impl<C: Coverage> Kernel<'_, C> {
             self.coverage.row_range(a, b, 1, res - 1, mask)
         };
         let Some(ks) = range else {
-            return ElementCounts::default();
+            return;
         };
         let op = self.op;
         let base_same =
             op.base.and_then(|base| (base.edge_resolution(edge) == Some(r)).then(|| base.edge_samples(edge)));
-        let base_other = |store: &ColorStore, k: u32, old: Rgba| base_on_edge(op, store, edge, r, k, old);
-        let mut counts = ElementCounts::default();
+        let base_other = |k: u32, old: Rgba| base_on_edge(op, store, edge, r, k, old);
         let row = Row { a, b, ks, first: 0 };
         let unoccluded = self.coverage.unoccluded(&[a, end], mask);
-        self.row(&mut writer.element(Element::Edge(edge)), (row, mask, unoccluded), base_same, base_other, &mut counts);
-        counts
+        let current = store.edge_samples(edge);
+        self.row((Element::Edge(edge), current, out), (row, mask, unoccluded), base_same, base_other);
     }
 
-    /// Paints vertex `v` (mask `mask`).
-    fn vertex(&self, writer: &mut StoreWriter, v: u32, mask: u8) -> ElementCounts {
-        let mut counts = ElementCounts::default();
+    /// The new colour of vertex `v` (mask `mask`).
+    fn vertex(&self, store: &ColorStore, v: u32, mask: u8, out: &mut Runs) {
         let w = self.coverage.weight(position(self.positions, v), mask);
+        let Some(old) = store.vertex_color(v) else {
+            return;
+        };
         if w > 0.0 {
             let op = self.op;
-            let mut out = writer.element(Element::Vertices);
-            counts.covered = u64::from(out.get(v).is_some());
-            counts.changed = out.update_run(v, 1, |_, old| {
-                let base = match op.blend {
-                    BlendMode::EraseToBase => op.base.and_then(|base| base.vertex_color(v)).unwrap_or(old),
-                    _ => old,
-                };
-                Some(op.blend.blend(old, op.color, base, w))
-            });
+            let base = match op.blend {
+                BlendMode::EraseToBase => op.base.and_then(|base| base.vertex_color(v)).unwrap_or(old),
+                _ => old,
+            };
+            out.push(Element::Vertices, v, op.blend.blend(old, op.color, base, w));
         }
-        counts
     }
 }
 
@@ -259,28 +277,32 @@ fn base_on_edge(op: &PaintOp, store: &ColorStore, edge: u32, r: Resolution, k: u
     sampler::sample(base, face, bary, Filter::Linear, 0).unwrap_or(fallback)
 }
 
-/// Paints every sample of the faces in `scratch.faces` (masks in `scratch.face_masks`), each
-/// shared vertex and edge once.
-pub(super) fn paint_faces<C: Coverage>(
-    coverage: &C,
-    op: &PaintOp,
-    positions: &[[f32; 3]],
-    writer: &mut StoreWriter,
-    scratch: &mut Scratch,
-) -> DabStats {
-    let kernel = Kernel { coverage, op, positions };
-    let stamp = accumulate_masks(writer.store(), scratch);
-    let mut stats = DabStats { faces: scratch.faces.len() as u32, ..DabStats::default() };
-    let mut add = |counts: ElementCounts| {
-        stats.samples_covered += counts.covered;
-        stats.samples_changed += counts.changed;
-    };
-    let faces = std::mem::take(&mut scratch.faces);
-    for (&face, &mask) in faces.iter().zip(&scratch.face_masks) {
+/// One entry of a dab's work list: an element and the mask of the spheres that reach it.
+#[derive(Debug, Clone, Copy)]
+enum Item {
+    Interior(u32),
+    Edge(u32),
+    Vertex(u32),
+}
+
+/// Samples below which a dab computes on the calling thread (handing work to rayon costs
+/// more than it saves).
+pub(super) const PARALLEL_MIN_SAMPLES: u64 = 8192;
+/// Work-list entries per parallel task.
+const CHUNK: usize = 64;
+
+/// The dab's work list: each face interior with a mask, and each shared edge and vertex
+/// once (the serial order of the faces), with the samples they hold.
+fn work_list(store: &ColorStore, scratch: &mut Scratch) -> (Vec<(Item, u8)>, u64) {
+    let stamp = accumulate_masks(store, scratch);
+    let topology = store.topology();
+    let mut work = Vec::with_capacity(scratch.faces.len() * 3);
+    let mut samples = 0u64;
+    for (&face, &mask) in scratch.faces.iter().zip(&scratch.face_masks) {
         if mask != 0 {
-            add(kernel.interior(writer, face, mask));
+            work.push((Item::Interior(face), mask));
+            samples += store.interior_samples(face).len() as u64;
         }
-        let topology = writer.store().topology();
         let Some((&edges, &corners)) =
             topology.face_edges.get(face as usize).zip(topology.face_vertices.get(face as usize))
         else {
@@ -289,16 +311,53 @@ pub(super) fn paint_faces<C: Coverage>(
         for edge in edges {
             let mask = visit_mask(&mut scratch.edge_stamp, &scratch.edge_mask, edge, stamp);
             if mask != 0 {
-                add(kernel.edge(writer, edge, mask));
+                work.push((Item::Edge(edge), mask));
+                samples += store.edge_samples(edge).len() as u64;
             }
         }
         for v in corners {
             let mask = visit_mask(&mut scratch.vertex_stamp, &scratch.vertex_mask, v, stamp);
             if mask != 0 {
-                add(kernel.vertex(writer, v, mask));
+                work.push((Item::Vertex(v), mask));
+                samples += 1;
             }
         }
     }
-    scratch.faces = faces;
+    (work, samples)
+}
+
+/// Paints every sample of the faces in `scratch.faces` (masks in `scratch.face_masks`), each
+/// shared vertex and edge once.
+pub(super) fn paint_faces<C: Coverage + Sync>(
+    coverage: &C,
+    op: &PaintOp,
+    positions: &[[f32; 3]],
+    writer: &mut StoreWriter,
+    scratch: &mut Scratch,
+) -> DabStats {
+    let kernel = Kernel { coverage, op, positions };
+    let (work, samples) = work_list(writer.store(), scratch);
+    let store = writer.store();
+    let compute = |chunk: &[(Item, u8)]| {
+        let mut out = Runs::default();
+        for &(item, mask) in chunk {
+            match item {
+                Item::Interior(face) => kernel.interior(store, face, mask, &mut out),
+                Item::Edge(edge) => kernel.edge(store, edge, mask, &mut out),
+                Item::Vertex(v) => kernel.vertex(store, v, mask, &mut out),
+            }
+        }
+        out
+    };
+    let parts: Vec<Runs> = if samples < PARALLEL_MIN_SAMPLES {
+        vec![compute(&work)]
+    } else {
+        work.par_chunks(CHUNK).map(compute).collect()
+    };
+    let mut stats = DabStats { faces: scratch.faces.len() as u32, ..DabStats::default() };
+    for part in &parts {
+        stats.samples_covered += part.len();
+        stats.samples_changed += part.write(writer);
+    }
     stats
 }

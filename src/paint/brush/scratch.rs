@@ -20,14 +20,12 @@ pub(super) struct Scratch {
     /// Even; `stamp` marks "mask accumulated in this dab", `stamp + 1` "processed".
     stamp: u32,
     /// Blur: accumulator slots of the dab's edge samples and vertices, the element → first
-    /// slot tables (valid for the elements listed in `blur_edges` / `blur_vertices`), and
-    /// the lattice grid of the face being blurred.
+    /// slot tables (valid for the elements listed in `blur_edges` / `blur_vertices`).
     pub(super) blur_acc: Vec<BlurAcc>,
     pub(super) edge_slot: Vec<u32>,
     pub(super) vertex_slot: Vec<u32>,
     pub(super) blur_edges: Vec<u32>,
     pub(super) blur_vertices: Vec<u32>,
-    pub(super) blur_grid: Vec<Rgba>,
     /// Resolution tool: the stroke number in which each face was last changed.
     pub(super) face_stroke: Vec<u32>,
     pub(super) stroke: u32,
