@@ -1,7 +1,8 @@
 //! Paint mode's partial uploads checked on the GPU itself: after random edits and random
-//! resolution changes, the editor's upload path (PaintLayout::sync → write_samples at the
-//! dirty ranges and write_face_records for moved blocks, or a full upload when the layout
-//! grew) must leave the GPU's colour atlas and face records such that every lattice point of
+//! resolution changes, the editor's upload path (PaintLayout::sync → EncodedBuffer::apply →
+//! write_paint_upload: the dirty ranges merged into spans across small gaps, the gaps' bytes
+//! from the CPU copy, and write_face_records for moved blocks, or a full upload when the
+//! layout grew) must leave the GPU's colour atlas and face records such that every lattice point of
 //! every face, addressed as the shaders address it from the read-back records, holds the
 //! store's colour (quantised to the format). The comparison is shown to fail on one
 //! corrupted sample. wgpu errors outside the renderer's error scopes panic in these tests
@@ -16,7 +17,7 @@ use meshpaint::colors::layout::Resolution;
 use meshpaint::colors::store::{ColorStore, SampleRef};
 use meshpaint::mesh::topology::Topology;
 use meshpaint::packing::linear::PackedMesh;
-use meshpaint::packing::paint_layout::PaintLayout;
+use meshpaint::packing::paint_layout::{EncodedBuffer, PaintLayout};
 use meshpaint::packing::sampler::packed_sample_index;
 use meshpaint::render::{GpuMesh, MeshUploadOptions};
 
@@ -49,11 +50,13 @@ fn mismatches(gpu: &Gpu, mesh: &GpuMesh, store: &ColorStore, format: ColorFormat
     out
 }
 
-/// The editor's upload of the store's dirty elements (src/app/paint.rs `sync_gpu`). Returns
-/// whether it was partial and how many face records it rewrote.
+/// The editor's upload of the store's dirty elements (src/app/paint.rs `sync_gpu`): the
+/// plan's ranges encoded into the CPU copy of the buffer and sent as merged spans, or a
+/// full upload when the layout grew. Returns whether it was partial and how many face
+/// records it rewrote.
 fn upload_dirty(
     gpu: &Gpu,
-    mesh: &mut GpuMesh,
+    (mesh, encoded): (&mut GpuMesh, &mut EncodedBuffer),
     layout: &mut PaintLayout,
     store: &mut ColorStore,
     positions: &[[f32; 3]],
@@ -65,15 +68,12 @@ fn upload_dirty(
         let packed = layout.packed(store, positions, format);
         *mesh =
             GpuMesh::upload(&gpu.ctx, &gpu.renderer, &packed, &MeshUploadOptions { atlas_width: Some(61) }).unwrap();
+        *encoded = EncodedBuffer::from_packed(&packed);
         return (false, 0);
     }
-    for &(first, count) in &plan.sample_ranges {
-        let encoded = layout.encode_range(store, &dirty, first, count, format);
-        mesh.write_samples(&gpu.ctx, u64::from(first), &encoded).unwrap();
-    }
-    for &face in &plan.faces {
-        mesh.write_face_records(&gpu.ctx, face, std::slice::from_ref(&layout.records()[face as usize])).unwrap();
-    }
+    let spans = encoded.apply(layout, store, &dirty, &plan);
+    assert!(spans.len() <= plan.sample_ranges.len());
+    mesh.write_paint_upload(&gpu.ctx, &spans, encoded.bytes(), (&plan.faces, layout.records())).unwrap();
     (true, plan.faces.len())
 }
 
@@ -96,6 +96,7 @@ fn partial_uploads_after_random_edits_and_resolution_changes_match_the_store() {
         let packed = layout.packed(&store, &positions, format);
         let mut mesh =
             GpuMesh::upload(&gpu.ctx, &gpu.renderer, &packed, &MeshUploadOptions { atlas_width: Some(61) }).unwrap();
+        let mut encoded = EncodedBuffer::from_packed(&packed);
         let (mut partial, mut grown, mut records) = (0, 0, 0);
         for round in 0..16 {
             // A few resolution changes (some grow blocks beyond their slack), then edits.
@@ -110,7 +111,7 @@ fn partial_uploads_after_random_edits_and_resolution_changes_match_the_store() {
                 let sample = sites[rng.below(sites.len() as u64) as usize];
                 store.set(sample, rng.color());
             }
-            match upload_dirty(&gpu, &mut mesh, &mut layout, &mut store, &positions, format) {
+            match upload_dirty(&gpu, (&mut mesh, &mut encoded), &mut layout, &mut store, &positions, format) {
                 (true, faces) => {
                     partial += 1;
                     records += faces;

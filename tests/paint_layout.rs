@@ -9,7 +9,7 @@ use meshpaint::colors::layout::{self, Resolution};
 use meshpaint::colors::store::{ColorStore, SampleRef};
 use meshpaint::mesh::topology::Topology;
 use meshpaint::packing::linear::PackedMesh;
-use meshpaint::packing::paint_layout::PaintLayout;
+use meshpaint::packing::paint_layout::{EncodedBuffer, MAX_UPLOAD_GAP, PaintLayout};
 use meshpaint::packing::sampler::MeshColorSource;
 
 /// Every lattice point of every face reads the store's colour from the mirror buffer.
@@ -60,11 +60,15 @@ fn partial_uploads_keep_the_gpu_buffer_equal_to_the_store() {
             mirror = layout.packed(&store, &positions, format);
         } else {
             moved += plan.faces.len();
+            let encoded = layout.encode_plan(&store, &dirty, &plan, format);
+            let mut offset = 0;
             for &(first, count) in &plan.sample_ranges {
-                let bytes = layout.encode_range(&store, &dirty, first, count, format);
-                let start = first as usize * format.bytes_per_sample();
-                mirror.colors[start..start + bytes.len()].copy_from_slice(&bytes);
+                let (start, len) =
+                    (first as usize * format.bytes_per_sample(), count as usize * format.bytes_per_sample());
+                mirror.colors[start..start + len].copy_from_slice(&encoded[offset..offset + len]);
+                offset += len;
             }
+            assert_eq!(offset, encoded.len());
             for &face in &plan.faces {
                 mirror.face_records[face as usize] = layout.records()[face as usize];
             }
@@ -90,4 +94,47 @@ fn one_dab_uploads_only_the_painted_elements() {
     let plan = layout.sync(&store, &dirty);
     assert_eq!(plan.sample_count(), u64::from(layout::interior_sample_count(Resolution::new(64).unwrap())));
     assert!(plan.faces.is_empty() && !plan.grown);
+}
+
+/// The CPU copy the editor uploads spans from: after random edits on a mesh large enough for
+/// gaps wider than `MAX_UPLOAD_GAP`, it equals a full encode of the store (the packed paint
+/// buffer, made from scratch), and the spans are sorted, disjoint, cover every planned range,
+/// and are never closer than the gap they could have bridged.
+#[test]
+fn the_encoded_copy_equals_a_full_encode_and_its_spans_cover_the_plan() {
+    let (positions, triangles) = common::icosphere(3);
+    let topology = Topology::build(positions.len() as u32, &triangles).unwrap();
+    let mut store = ColorStore::uniform(topology, Resolution::new(8).unwrap(), [0.5; 4]);
+    let format = ColorFormat::Rgba8Srgb;
+    let mut layout = PaintLayout::new(&store);
+    let mut encoded = EncodedBuffer::from_packed(&layout.packed(&store, &positions, format));
+    store.take_dirty();
+    let mut rng = Rng(17);
+    let mut sites = Vec::new();
+    store.for_each_site(|site| sites.push(site.sample));
+    let (mut bridged, mut separate) = (0, 0);
+    for _ in 0..40 {
+        for _ in 0..1 + rng.next() % 300 {
+            let sample = sites[(rng.next() % sites.len() as u64) as usize];
+            store.set(sample, [rng.unit(), rng.unit(), rng.unit(), 1.0]);
+        }
+        let dirty = store.take_dirty();
+        let plan = layout.sync(&store, &dirty);
+        assert!(!plan.grown);
+        let spans = encoded.apply(&layout, &store, &dirty, &plan);
+        let full = layout.packed(&store, &positions, format);
+        assert!(encoded.bytes() == full.colors.as_slice(), "the copy differs from a full encode");
+        for pair in spans.windows(2) {
+            let gap = pair[1].0 - (pair[0].0 + pair[0].1);
+            assert!(gap > MAX_UPLOAD_GAP, "spans {pair:?} should have been merged");
+            separate += 1;
+        }
+        for &(first, count) in &plan.sample_ranges {
+            let k = spans.partition_point(|&(start, _)| start <= first) - 1;
+            let (start, len) = spans[k];
+            assert!(first + count <= start + len, "range ({first}, {count}) outside span ({start}, {len})");
+        }
+        bridged += plan.sample_ranges.len() - spans.len();
+    }
+    assert!(bridged > 100 && separate > 10, "bridged {bridged} ranges, {separate} separate spans");
 }

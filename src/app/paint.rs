@@ -13,7 +13,7 @@ use std::time::Instant;
 use crate::colors::layout::Resolution;
 use crate::colors::store::{ColorStore, DirtyAccumulator};
 use crate::packing::packer::PackCache;
-use crate::packing::paint_layout::PaintLayout;
+use crate::packing::paint_layout::{EncodedBuffer, PaintLayout};
 use crate::paint::brush::{
     self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, ResolutionOp, StrokeUpdate,
     Tool,
@@ -57,13 +57,14 @@ impl Editor {
         // packing is reused on leaving only if it is still the store's.
         let unpacked_changes = !document.store.take_dirty().is_empty();
         let layout = PaintLayout::new(&document.store);
-        let mut compact_gpu_mesh = None;
+        let (mut compact_gpu_mesh, mut encoded) = (None, None);
         if let Some(gpu) = &self.gpu {
             let packed = layout.packed(&document.store, &document.positions, open.format);
             match gpu.upload(&packed) {
                 Ok(mesh) => {
                     self.upload_bytes_this_frame += packed.color_bytes() + packed.face_record_bytes();
                     compact_gpu_mesh = open.gpu_mesh.replace(mesh);
+                    encoded = Some(EncodedBuffer::from_packed(&packed));
                 }
                 Err(error) => {
                     let text = format!("Cannot enter paint mode: uploading the paint layout failed: {error}");
@@ -80,6 +81,7 @@ impl Editor {
         };
         self.paint = Some(PaintSession {
             layout,
+            encoded,
             base: document.store.clone(),
             painter,
             gesture: None,
@@ -278,30 +280,24 @@ impl Editor {
         let mut bytes = 0u64;
         let mut error = None;
         if let (Some(gpu), Some(mesh)) = (gpu.as_ref(), open.gpu_mesh.as_mut()) {
-            if plan.grown {
-                let packed = session.layout.packed(&doc.store, &doc.positions, open.format);
-                match gpu.upload(&packed) {
-                    Ok(new_mesh) => {
-                        *mesh = new_mesh;
-                        bytes += packed.color_bytes() + packed.face_record_bytes();
-                    }
-                    Err(e) => error = Some(e.to_string()),
-                }
-            } else {
-                for &(first, count) in &plan.sample_ranges {
-                    let encoded = session.layout.encode_range(&doc.store, &dirty, first, count, open.format);
-                    bytes += encoded.len() as u64;
-                    if let Err(e) = mesh.write_samples(&gpu.ctx, u64::from(first), &encoded) {
-                        error = Some(e.to_string());
+            match session.encoded.as_mut() {
+                Some(encoded) if !plan.grown && encoded.format() == open.format => {
+                    let spans = encoded.apply(&session.layout, &doc.store, &dirty, &plan);
+                    let records = (plan.faces.as_slice(), session.layout.records());
+                    match mesh.write_paint_upload(&gpu.ctx, &spans, encoded.bytes(), records) {
+                        Ok(written) => bytes += written,
+                        Err(e) => error = Some(e.to_string()),
                     }
                 }
-                let records = session.layout.records();
-                for &face in &plan.faces {
-                    if let Some(record) = records.get(face as usize) {
-                        bytes += std::mem::size_of_val(record) as u64;
-                        if let Err(e) = mesh.write_face_records(&gpu.ctx, face, std::slice::from_ref(record)) {
-                            error = Some(e.to_string());
+                _ => {
+                    let packed = session.layout.packed(&doc.store, &doc.positions, open.format);
+                    match gpu.upload(&packed) {
+                        Ok(new_mesh) => {
+                            *mesh = new_mesh;
+                            bytes += packed.color_bytes() + packed.face_record_bytes();
+                            session.encoded = Some(EncodedBuffer::from_packed(&packed));
                         }
+                        Err(e) => error = Some(e.to_string()),
                     }
                 }
             }

@@ -8,7 +8,7 @@ use std::time::Duration;
 use crate::colors::store::{ColorStore, DirtyAccumulator};
 use crate::io::document::Document;
 use crate::packing::packer::PackCache;
-use crate::packing::paint_layout::PaintLayout;
+use crate::packing::paint_layout::{EncodedBuffer, PaintLayout};
 use crate::paint::brush::{self, Painter};
 use crate::render::GpuMesh;
 
@@ -41,6 +41,9 @@ pub struct Gesture {
 pub struct PaintSession {
     /// Where every element's samples live in the GPU colour buffer.
     pub layout: PaintLayout,
+    /// The encoded paint buffer as the GPU holds it (uploads send merged spans from it);
+    /// `None` without a GPU.
+    pub encoded: Option<EncodedBuffer>,
     /// The colours when paint mode was entered (Erase to base).
     pub base: ColorStore,
     /// The brush engine.

@@ -2,7 +2,7 @@
 //! tool, the bytes each dab uploads and the repack time, on the editor's own code paths; `headline` is the editor's defaults
 //! (occlusion and backface culling on) on the largest brush.
 //!
-//! Upload bytes come from [`PaintLayout::sync`] and [`PaintLayout::encode_range`], exactly
+//! Upload bytes come from [`PaintLayout::sync`] and [`PaintLayout::encode_plan`], exactly
 //! what the editor's paint mode sends to the GPU after a dab (samples and patched face
 //! records), not from a formula of our own.
 
@@ -16,10 +16,11 @@ use crate::colors::format::ColorFormat;
 use crate::colors::store::ColorStore;
 use crate::io::document::Document;
 use crate::packing::linear::FaceRecord;
-use crate::packing::paint_layout::PaintLayout;
+use crate::packing::paint_layout::{EncodedBuffer, PaintLayout};
 use crate::paint::brush::{BlendMode, BrushError, BrushSettings, Falloff, PaintView, Painter, Tool, samples_within};
 use crate::paint::picking::{BvhPreset, MeshBvh};
 use crate::paint::undo::UndoHistory;
+use crate::render::Gpu;
 
 /// Options of [`bench_paint`].
 #[derive(Debug, Clone, PartialEq)]
@@ -124,6 +125,16 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
             "samples_per_second_median": dab["samples_per_second_median"],
         })
     });
+    // The editor's whole dab on the largest brush: the dab, then the upload it triggers.
+    let gpu_upload = match (Gpu::new_headless(), options.target_samples.last()) {
+        (Ok(gpu), Some(&target)) => {
+            let radius = radius_covering(&view, &store, center, scene_radius, target);
+            let settings = BrushSettings { tool: Tool::Paint, blend: BlendMode::Mix, ..BrushSettings::default() };
+            measure_gpu_upload(&view, &mut store, &mut painter, settings, (center, radius), options.dabs, &gpu)?
+        }
+        (Err(error), _) => serde_json::json!({ "skipped": error.to_string() }),
+        (Ok(_), None) => serde_json::Value::Null,
+    };
     let (pack_timing, packed) = Timing::measure(options.pack_runs, || document.pack(ColorFormat::Rgba8Srgb));
     let packed_bytes = packed.map(|p| p.face_record_bytes() + p.color_bytes()).unwrap_or(0);
     Ok(serde_json::json!({
@@ -142,6 +153,7 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
         "bvh_presets": presets,
         "pick_latency": pick_timing.to_json(),
         "brushes": brushes,
+        "gpu_upload": gpu_upload,
         "repack_rgba8": {
             "timing": pack_timing.to_json(),
             "bytes": packed_bytes,
@@ -271,8 +283,8 @@ fn measure_dabs(
 ) -> Result<serde_json::Value, BrushError> {
     let mut history = UndoHistory::new(crate::paint::undo::DEFAULT_CAP_BYTES);
     store.take_dirty();
-    let mut times = Vec::new();
-    let (mut covered, mut upload_bytes) = (0, 0);
+    let (mut times, mut sync_times) = (Vec::new(), Vec::new());
+    let (mut covered, mut upload_bytes, mut upload_ranges) = (0, 0, 0);
     let mut layout = PaintLayout::new(store);
     if !step_per_dab {
         history.begin_step(store, "bench")?;
@@ -290,10 +302,13 @@ fn measure_dabs(
             history.end_step();
         }
         covered = stats.samples_covered;
-        upload_bytes = upload_like_the_editor(&mut layout, store);
+        let started = Instant::now();
+        (upload_bytes, upload_ranges) = upload_like_the_editor(&mut layout, store);
+        sync_times.push(started.elapsed().as_secs_f64());
     }
     history.end_step();
     times.sort_by(f64::total_cmp);
+    sync_times.sort_by(f64::total_cmp);
     let (best, median) = (times[0], times[times.len() / 2]);
     Ok(serde_json::json!({
         "samples_covered": covered,
@@ -302,20 +317,100 @@ fn measure_dabs(
         "samples_per_second_best": covered as f64 / best,
         "samples_per_second_median": covered as f64 / median,
         "upload_bytes_rgba8": upload_bytes,
+        "upload_ranges": upload_ranges,
+        "sync_encode_seconds_best": sync_times[0],
+        "sync_encode_seconds_median": sync_times[sync_times.len() / 2],
         "dabs": times.len(),
         "undo_bytes": history.bytes_used(),
     }))
 }
 
-/// Bytes the editor's paint mode uploads for the store's dirty elements (RGBA8): the
-/// encoded sample ranges of the plan and the patched face records.
-fn upload_like_the_editor(layout: &mut PaintLayout, store: &mut ColorStore) -> u64 {
+/// Bytes the editor's paint mode uploads for the store's dirty elements (RGBA8: the
+/// encoded sample ranges of the plan and the patched face records), and the sample ranges
+/// (one GPU write each).
+fn upload_like_the_editor(layout: &mut PaintLayout, store: &mut ColorStore) -> (u64, usize) {
     let dirty = store.take_dirty();
     let plan = layout.sync(store, &dirty);
-    let samples: u64 = plan
-        .sample_ranges
-        .iter()
-        .map(|&(first, count)| layout.encode_range(store, &dirty, first, count, ColorFormat::Rgba8Srgb).len() as u64)
-        .sum();
-    samples + plan.faces.len() as u64 * std::mem::size_of::<FaceRecord>() as u64
+    let samples = layout.encode_plan(store, &dirty, &plan, ColorFormat::Rgba8Srgb).len() as u64;
+    (samples + plan.faces.len() as u64 * std::mem::size_of::<FaceRecord>() as u64, plan.sample_ranges.len())
+}
+
+/// Times `dabs` dabs of `settings` (the editor's defaults) at `sphere` as the editor runs
+/// them, each followed by the paint-mode upload it triggers ([`PaintLayout::sync`],
+/// [`EncodedBuffer::apply`], [`crate::render::GpuMesh::write_paint_upload`] and the
+/// queue submitted and waited for): the dab, the encode and the GPU write apart, and the
+/// samples per second of the whole.
+fn measure_gpu_upload(
+    view: &PaintView,
+    store: &mut ColorStore,
+    painter: &mut Painter,
+    settings: BrushSettings,
+    (center, radius): (DVec3, f64),
+    dabs: usize,
+    gpu: &Gpu,
+) -> Result<serde_json::Value, BrushError> {
+    let format = ColorFormat::Rgba8Srgb;
+    let mut layout = PaintLayout::new(store);
+    let packed = layout.packed(store, view.positions, format);
+    let mesh = match gpu.upload(&packed) {
+        Ok(mesh) => mesh,
+        Err(error) => return Ok(serde_json::json!({ "skipped": error.to_string() })),
+    };
+    let mut encoded = EncodedBuffer::from_packed(&packed);
+    drop(packed);
+    let mut history = UndoHistory::new(crate::paint::undo::DEFAULT_CAP_BYTES);
+    store.take_dirty();
+    history.begin_step(store, "bench")?;
+    let mut rows = Vec::new();
+    let mut covered = 0;
+    for k in 0..dabs.max(1) {
+        let color = if k % 2 == 0 { [0.9, 0.2, 0.1, 1.0] } else { [0.1, 0.3, 0.9, 1.0] };
+        painter.set_settings(BrushSettings { color, ..settings });
+        let started = Instant::now();
+        covered = painter.dab_at(view, store, &mut history, center, radius)?.samples_covered;
+        let dabbed = Instant::now();
+        let dirty = store.take_dirty();
+        let plan = layout.sync(store, &dirty);
+        let spans = encoded.apply(&layout, store, &dirty, &plan);
+        let encoded_at = Instant::now();
+        let records = (plan.faces.as_slice(), layout.records());
+        let written = if plan.grown { Err("the layout grew".to_owned()) } else { Ok(()) }.and_then(|()| {
+            mesh.write_paint_upload(&gpu.ctx, &spans, encoded.bytes(), records).map_err(|e| e.to_string())
+        });
+        gpu.ctx.queue.submit([]);
+        let _ = gpu.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+        if let Err(error) = written {
+            return Ok(serde_json::json!({ "skipped": error }));
+        }
+        let done = Instant::now();
+        rows.push([
+            (dabbed - started).as_secs_f64(),
+            (encoded_at - dabbed).as_secs_f64(),
+            (done - encoded_at).as_secs_f64(),
+            (done - started).as_secs_f64(),
+            plan.sample_ranges.len() as f64,
+            spans.len() as f64,
+            spans.iter().map(|&(_, n)| f64::from(n)).sum::<f64>(),
+        ]);
+    }
+    history.end_step();
+    // The dab with the fastest whole (dab + upload).
+    rows.sort_by(|a, b| a[3].total_cmp(&b[3]));
+    let best = rows[0];
+    let median = rows[rows.len() / 2];
+    Ok(serde_json::json!({
+        "what": "the editor's defaults on the largest brush, each dab followed by its GPU upload (RGBA8)",
+        "samples_covered": covered,
+        "dab_seconds": best[0],
+        "sync_encode_seconds": best[1],
+        "gpu_write_seconds": best[2],
+        "total_seconds_best": best[3],
+        "total_seconds_median": median[3],
+        "upload_ranges": best[4] as u64,
+        "upload_spans": best[5] as u64,
+        "upload_span_samples": best[6] as u64,
+        "max_upload_gap": crate::packing::paint_layout::MAX_UPLOAD_GAP,
+        "samples_per_second_best": covered as f64 / best[3],
+        "samples_per_second_median": covered as f64 / median[3],
+    }))
 }

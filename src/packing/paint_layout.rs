@@ -243,23 +243,41 @@ impl PaintLayout {
         out
     }
 
-    /// Encodes the samples of one upload range (fast path: walks the dirty elements only).
-    pub fn encode_range(
+    /// Encodes every sample range of `plan` (as [`PaintLayout::sync`] returned it for
+    /// `dirty`) in `format`, concatenated in the plan's order: range `k` starts at byte
+    /// `(count₀ + … + count_{k−1}) × bytes_per_sample`. One pass over the dirty elements, each
+    /// placed in its range by binary search (O(dirty · log ranges + samples)); slots of a
+    /// range that no dirty element covers are zero.
+    pub fn encode_plan(
         &self,
         store: &ColorStore,
         dirty: &DirtyElements,
-        first: u32,
-        count: u32,
+        plan: &UploadPlan,
         format: ColorFormat,
     ) -> Vec<u8> {
-        let mut colors = vec![[0.0f32; 4]; count as usize];
-        let end = first + count;
+        let ranges = &plan.sample_ranges;
+        // Sample offset of each range in the output.
+        let mut starts = Vec::with_capacity(ranges.len());
+        let mut total = 0usize;
+        for &(_, count) in ranges {
+            starts.push(total);
+            total += count as usize;
+        }
+        let mut colors = vec![[0.0f32; 4]; total];
         let mut put = |base: u32, samples: &[Rgba]| {
-            if base >= first && base < end {
-                let start = (base - first) as usize;
-                for (slot, &c) in colors[start..].iter_mut().zip(samples) {
-                    *slot = c;
-                }
+            // The range holding `base`: the last one starting at or before it.
+            let k = ranges.partition_point(|&(first, _)| first <= base);
+            let Some(&(first, count)) = k.checked_sub(1).and_then(|k| ranges.get(k)) else {
+                return;
+            };
+            let within = (base - first) as usize;
+            if within >= count as usize {
+                return;
+            }
+            let start = starts[k - 1] + within;
+            let room = count as usize - within;
+            for (slot, &c) in colors[start..start + room].iter_mut().zip(samples) {
+                *slot = c;
             }
         };
         for &v in &dirty.vertices {
@@ -292,5 +310,75 @@ impl PaintLayout {
             format,
             colors: bytes,
         }
+    }
+}
+
+/// Samples of unchanged colour an upload span may bridge between two dirty ranges: one
+/// GPU write for both costs less than two (each write has a fixed cost; on lavapipe about
+/// 7 µs, `bench paint`'s `gpu_upload` row) while the bridged bytes are cheap to copy.
+pub const MAX_UPLOAD_GAP: u32 = 1024;
+
+/// The paint-mode colour buffer as the GPU holds it, encoded, kept on the CPU beside it: an
+/// upload then sends a few long spans, the dirty ranges of a plan merged across gaps of at
+/// most [`MAX_UPLOAD_GAP`] samples (the gaps' bytes are this copy's, which the GPU already
+/// holds), instead of one write per dirty element. Costs one more copy of the buffer
+/// (`capacity × bytes per sample`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EncodedBuffer {
+    format: ColorFormat,
+    bytes: Vec<u8>,
+}
+
+impl EncodedBuffer {
+    /// The buffer `packed` holds (as [`PaintLayout::packed`] made it, the GPU's copy).
+    pub fn from_packed(packed: &PackedMesh) -> Self {
+        EncodedBuffer { format: packed.format, bytes: packed.colors.clone() }
+    }
+
+    /// The encoded samples, `bytes_per_sample` each.
+    pub fn bytes(&self) -> &[u8] {
+        &self.bytes
+    }
+
+    /// The format the samples are encoded in.
+    pub fn format(&self) -> ColorFormat {
+        self.format
+    }
+
+    /// Encodes the ranges of `plan` (from [`PaintLayout::sync`] for `dirty`) into the buffer
+    /// and returns the spans `(first, count)` to upload from [`EncodedBuffer::bytes`]: every
+    /// range covered, sorted, disjoint, neighbours merged when at most [`MAX_UPLOAD_GAP`]
+    /// samples apart. Ranges past the buffer (a plan that `grown`) are not encoded: rebuild
+    /// the buffer from [`PaintLayout::packed`] then.
+    pub fn apply(
+        &mut self,
+        layout: &PaintLayout,
+        store: &ColorStore,
+        dirty: &DirtyElements,
+        plan: &UploadPlan,
+    ) -> Vec<(u32, u32)> {
+        let size = self.format.bytes_per_sample();
+        let encoded = layout.encode_plan(store, dirty, plan, self.format);
+        let mut offset = 0usize;
+        let mut spans: Vec<(u32, u32)> = Vec::new();
+        for &(first, count) in &plan.sample_ranges {
+            let len = count as usize * size;
+            let start = first as usize * size;
+            if let (Some(target), Some(source)) =
+                (self.bytes.get_mut(start..start + len), encoded.get(offset..offset + len))
+            {
+                target.copy_from_slice(source);
+                match spans.last_mut() {
+                    Some((last_first, last_count))
+                        if first.saturating_sub(*last_first + *last_count) <= MAX_UPLOAD_GAP =>
+                    {
+                        *last_count = first + count - *last_first;
+                    }
+                    _ => spans.push((first, count)),
+                }
+            }
+            offset += len;
+        }
+        spans
     }
 }

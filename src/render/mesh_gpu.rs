@@ -332,6 +332,39 @@ impl GpuMesh {
         Ok(())
     }
 
+    /// Writes one paint-mode upload (the editor's path after a dab): the sample spans
+    /// `(first, count)` from `buffer` (the whole encoded paint buffer,
+    /// [`crate::packing::paint_layout::EncodedBuffer::bytes`]) and the records of `faces`
+    /// from `records` (all faces). Returns the bytes written; stops at the first write refused.
+    pub fn write_paint_upload(
+        &self,
+        ctx: &GpuContext,
+        spans: &[(u32, u32)],
+        buffer: &[u8],
+        (faces, records): (&[u32], &[FaceRecord]),
+    ) -> Result<u64, RenderError> {
+        let size = self.format.bytes_per_sample();
+        let mut bytes = 0u64;
+        for &(first, count) in spans {
+            let (start, end) = (first as usize * size, (first as usize + count as usize) * size);
+            let Some(data) = buffer.get(start..end) else {
+                return Err(RenderError::InvalidMesh(format!(
+                    "the upload span of {count} samples at {first} is past the {} samples encoded",
+                    buffer.len() / size.max(1)
+                )));
+            };
+            self.write_samples(ctx, u64::from(first), data)?;
+            bytes += data.len() as u64;
+        }
+        for &face in faces {
+            if let Some(record) = records.get(face as usize) {
+                self.write_face_records(ctx, face, std::slice::from_ref(record))?;
+                bytes += std::mem::size_of_val(record) as u64;
+            }
+        }
+        Ok(bytes)
+    }
+
     /// Overwrites face records `first_face..first_face + records.len()` (e.g. faces whose
     /// paint-layout blocks moved). Refuses writes past the face count.
     pub fn write_face_records(
