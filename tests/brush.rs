@@ -1054,6 +1054,14 @@ fn bench_paint_reports_every_measurement() {
     assert!(report["occlusion_depth_map"]["build_seconds"].as_f64().unwrap() > 0.0);
     assert_eq!(report["occlusion_depth_map"]["maps_built"], 1);
     assert!(report["threads"].as_u64().unwrap() >= 1);
+    // The editor's whole dab with its GPU upload: spans merged from the ranges, every
+    // planned sample inside them.
+    let upload = &report["gpu_upload"];
+    assert!(upload["samples_per_second_best"].as_f64().unwrap() > 0.0, "{upload}");
+    assert!(upload["gpu_write_seconds"].as_f64().unwrap() > 0.0);
+    let (ranges, spans) = (upload["upload_ranges"].as_u64().unwrap(), upload["upload_spans"].as_u64().unwrap());
+    assert!(spans >= 1 && spans <= ranges, "{spans} spans for {ranges} ranges");
+    assert!(upload["upload_span_samples"].as_u64().unwrap() >= upload["samples_covered"].as_u64().unwrap());
     // `--subdivide 1`: four times the triangles, the same rows.
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_meshpaint"))
         .args(["bench", "paint", input.to_str().unwrap(), "-r", "2", "--subdivide", "1", "--dabs", "1"])
