@@ -299,9 +299,30 @@ impl PaintLayout {
     /// The whole paint-layout buffer as a [`PackedMesh`] (level 0, `vertex_levels = 1`,
     /// `capacity` samples) for a full upload, in `format`.
     pub fn packed(&self, store: &ColorStore, positions: &[[f32; 3]], format: ColorFormat) -> PackedMesh {
-        let colors = self.colors(store, 0, self.capacity.min(u64::from(u32::MAX)) as u32);
-        let mut bytes = vec![0u8; colors.len() * format.bytes_per_sample()];
-        format.encode_slice(&colors, &mut bytes);
+        // Each element encoded straight into its block (no linear copy of the whole buffer);
+        // slack stays zero bytes, which is the encoding of a zero colour in every format.
+        let size = format.bytes_per_sample();
+        let capacity = self.capacity.min(u64::from(u32::MAX)) as usize;
+        let mut bytes = vec![0u8; capacity * size];
+        let mut put = |base: u32, samples: &[Rgba]| {
+            let start = base as usize * size;
+            if let Some(out) = bytes.get_mut(start..start + samples.len() * size) {
+                format.encode_slice(samples, out);
+            }
+        };
+        let topology = store.topology();
+        let vertices: Vec<Rgba> = (0..topology.vertex_count).map(|v| store.vertex_color(v).unwrap_or([0.0; 4])).collect();
+        put(0, &vertices);
+        for (edge, block) in self.edge_blocks.iter().enumerate() {
+            if block.capacity > 0 {
+                put(block.base, store.edge_samples(edge as u32));
+            }
+        }
+        for (face, block) in self.interior_blocks.iter().enumerate() {
+            if block.capacity > 0 {
+                put(block.base, store.interior_samples(face as u32));
+            }
+        }
         PackedMesh {
             positions: positions.to_vec(),
             indices: store.topology().face_vertices.clone(),
