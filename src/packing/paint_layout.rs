@@ -311,7 +311,8 @@ impl PaintLayout {
             }
         };
         let topology = store.topology();
-        let vertices: Vec<Rgba> = (0..topology.vertex_count).map(|v| store.vertex_color(v).unwrap_or([0.0; 4])).collect();
+        let vertices: Vec<Rgba> =
+            (0..topology.vertex_count).map(|v| store.vertex_color(v).unwrap_or([0.0; 4])).collect();
         put(0, &vertices);
         for (edge, block) in self.edge_blocks.iter().enumerate() {
             if block.capacity > 0 {

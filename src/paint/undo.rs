@@ -706,6 +706,14 @@ impl<'a> StoreWriter<'a> {
         self.element(element).write(index, old, color)
     }
 
+    /// Makes room in the open step for `samples` more first writes (a dab that knows how
+    /// many samples it writes grows the log once instead of doubling it repeatedly).
+    pub fn reserve(&mut self, samples: usize) {
+        if let Some(list) = current_samples(&mut self.history.open) {
+            list.reserve(samples);
+        }
+    }
+
     /// The writer of one element's samples: the fast path for many writes to one element
     /// (one slot look-up, then a bit test per write).
     #[inline]

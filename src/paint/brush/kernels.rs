@@ -355,6 +355,7 @@ pub(super) fn paint_faces<C: Coverage + Sync>(
         work.par_chunks(CHUNK).map(compute).collect()
     };
     let mut stats = DabStats { faces: scratch.faces.len() as u32, ..DabStats::default() };
+    writer.reserve(parts.iter().map(|part| part.len() as usize).sum());
     for part in &parts {
         stats.samples_covered += part.len();
         stats.samples_changed += part.write(writer);
