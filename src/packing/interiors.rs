@@ -74,6 +74,53 @@ impl InteriorReader<'_> {
     }
 }
 
+/// One face's interior chain at one level, as [`InteriorReader::level`] finds it.
+#[derive(Clone, Copy)]
+pub(crate) enum FaceLevel<'a> {
+    /// Level 0: the encoded samples.
+    Bytes(&'a [u8], ColorFormat),
+    /// A level ≥ 1: the `f32` samples from that level's start on.
+    Upper(&'a [Rgba]),
+}
+
+impl FaceLevel<'_> {
+    /// Sample `offset` of the level.
+    #[inline(always)]
+    pub(crate) fn get(&self, offset: usize) -> Option<Rgba> {
+        match *self {
+            FaceLevel::Bytes(bytes, format) => {
+                let size = format.bytes_per_sample();
+                Some(format.decode(bytes.get(offset * size..offset * size + size)?))
+            }
+            FaceLevel::Upper(upper) => upper.get(offset).copied(),
+        }
+    }
+}
+
+impl<'a> InteriorReader<'a> {
+    /// `face`'s interior chain from offset `level_offset` on (the start of one level).
+    #[inline]
+    pub(crate) fn level(&self, face: u32, level_offset: usize) -> FaceLevel<'a> {
+        let r = self.store.face_resolution(face).unwrap_or(Resolution::ONE);
+        let n0 = layout::interior_sample_count(r) as usize;
+        let f = face as usize;
+        let empty = FaceLevel::Upper(&[]);
+        if level_offset < n0 {
+            let size = self.format.bytes_per_sample();
+            let Some(&start) = self.prefix.chain.get(f) else {
+                return empty;
+            };
+            let at = (start as usize + level_offset) * size;
+            self.bytes.get(at..).map_or(empty, |bytes| FaceLevel::Bytes(bytes, self.format))
+        } else {
+            let Some(&start) = self.prefix.upper.get(f) else {
+                return empty;
+            };
+            self.upper.get(start as usize + level_offset - n0..).map_or(empty, FaceLevel::Upper)
+        }
+    }
+}
+
 /// Splits `slice` into the pieces between consecutive `bounds` (increasing, relative to the
 /// slice; bounds past the end are cut to it).
 pub(crate) fn split_at_bounds<'a, T>(slice: &'a mut [T], bounds: &[usize]) -> Vec<&'a mut [T]> {
@@ -89,4 +136,32 @@ pub(crate) fn split_at_bounds<'a, T>(slice: &'a mut [T], bounds: &[usize]) -> Ve
         cursor += len;
     }
     pieces
+}
+
+/// The interior bytes and upper levels of each face of `faces` (sorted, unique) that has an
+/// interior chain, cut out of the interior section (`bytes`, `size` bytes a sample) and the
+/// upper buffer.
+pub(crate) fn dirty_pieces<'a>(
+    prefix: &InteriorPrefix,
+    faces: &[u32],
+    size: usize,
+    bytes: &'a mut [u8],
+    upper: &'a mut [Rgba],
+) -> Vec<(u32, &'a mut [u8], &'a mut [Rgba])> {
+    let chain = |f: u32| prefix.chain.get(f as usize..f as usize + 2).map_or((0, 0), |c| (c[0], c[1]));
+    let faces: Vec<u32> = faces.iter().copied().filter(|&f| chain(f).1 > chain(f).0).collect();
+    // Bounds as [start, end] pairs: pieces alternate between a face's chain and the gap after it.
+    let byte_bounds: Vec<usize> =
+        faces.iter().flat_map(|&f| [chain(f).0 as usize * size, chain(f).1 as usize * size]).collect();
+    let upper_of = |f: u32| prefix.upper.get(f as usize..f as usize + 2).map_or((0, 0), |u| (u[0], u[1]));
+    let upper_bounds: Vec<usize> =
+        faces.iter().flat_map(|&f| [upper_of(f).0 as usize, upper_of(f).1 as usize]).collect();
+    let byte_pieces = split_at_bounds(bytes, &byte_bounds);
+    let upper_pieces = split_at_bounds(upper, &upper_bounds);
+    faces
+        .into_iter()
+        .zip(byte_pieces.into_iter().step_by(2))
+        .zip(upper_pieces.into_iter().step_by(2))
+        .map(|((f, out), up)| (f, out, up))
+        .collect()
 }

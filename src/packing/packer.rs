@@ -37,9 +37,9 @@ use crate::colors::store::{ColorStore, DirtyElements};
 use crate::mesh::topology::TopologyError;
 use crate::packing::blocks::{BLOCK, split_blocks};
 use crate::packing::chains_view::ChainsView;
-use crate::packing::interiors::{InteriorPrefix, InteriorReader, split_at_bounds};
+use crate::packing::interiors::{FaceLevel, InteriorPrefix, InteriorReader, dirty_pieces, split_at_bounds};
 use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
-use crate::packing::mip::{interior_row_start, mip_filter, reduce_interior_chain, vertex_edges};
+use crate::packing::mip::{inside_neighbours, interior_row_start, mip_filter, reduce_interior_chain, vertex_edges};
 use crate::packing::sampler::{self, Filter};
 
 /// Errors of packing and unpacking.
@@ -187,12 +187,7 @@ impl Context<'_> {
 
     /// Writes level 0 of `edge` from the store and its encoding.
     fn edge_level0(&self, edge: u32, chain: &mut [Rgba], bytes: &mut [u8]) {
-        let size = self.format.bytes_per_sample();
-        for ((slot, out), &color) in
-            chain.iter_mut().zip(bytes.chunks_exact_mut(size)).zip(self.store.edge_samples(edge))
-        {
-            *slot = self.format.encode_quantized(color, out);
-        }
+        self.format.encode_quantized_slice(self.store.edge_samples(edge), bytes, chain);
     }
 
     /// Builds `face`'s whole interior chain in `scratch` and writes its encoding to `bytes`
@@ -203,9 +198,7 @@ impl Context<'_> {
         let r = self.store.face_resolution(face).unwrap_or(Resolution::ONE);
         scratch.clear();
         scratch.resize(layout::interior_chain_len(r) as usize, [0.0; 4]);
-        for ((slot, out), &color) in scratch.iter_mut().zip(bytes.chunks_exact_mut(size)).zip(level0) {
-            *slot = self.format.encode_quantized(color, out);
-        }
+        self.format.encode_quantized_slice(level0, bytes, scratch);
         reduce_interior_chain(scratch, r);
         let n0 = level0.len().min(scratch.len());
         self.format.encode_slice(&scratch[n0..], &mut bytes[n0 * size..]);
@@ -247,16 +240,6 @@ impl Context<'_> {
         let size = self.format.bytes_per_sample();
         let n0 = self.store.edge_samples(edge).len().min(chain.len());
         self.format.encode_slice(&chain[n0..], &mut bytes[n0 * size..]);
-    }
-}
-
-/// The two lattice neighbours strictly inside the face of the point at position `p`
-/// along face edge `face_edge`, on a lattice of resolution `rp` (LATTICE_DIRECTIONS order).
-fn inside_neighbours(face_edge: u8, p: usize, rp: usize) -> [(usize, usize); 2] {
-    match face_edge {
-        0 => [(p, 1), (p - 1, 1)],
-        1 => [(rp - p - 1, p), (rp - p, p - 1)],
-        _ => [(1, rp - p), (1, rp - p - 1)],
     }
 }
 
@@ -320,6 +303,19 @@ fn reduce_edge_level(
     let rp = r_previous as usize;
     let faces = topology.faces_of_edge(edge);
     let coarse_count = faces.iter().filter(|&&(face, _)| store.face_resolution(face) != Some(r_edge)).count();
+    // The equal-resolution faces' level − 1, looked up once (a manifold edge has ≤ 2).
+    let mut equal: [Option<(FaceLevel, u8, bool)>; 2] = [None; 2];
+    if faces.len() - coarse_count <= 2 {
+        let mut n = 0;
+        for &(face, face_edge) in faces {
+            if store.face_resolution(face) == Some(r_edge) {
+                let reversed = topology.is_reversed(face, usize::from(face_edge));
+                equal[n] = Some((interiors.level(face, face_level_offset), face_edge, reversed));
+                n += 1;
+            }
+        }
+    }
+    let few_faces = faces.len() - coarse_count <= 2;
     for k in 1..r_level {
         let position = 2 * k;
         let at = |p: u32| -> Rgba {
@@ -335,15 +331,24 @@ fn reduce_edge_level(
         neighbours.clear();
         neighbours.push(at(position - 1));
         neighbours.push(at(position + 1));
-        for &(face, face_edge) in faces {
-            if store.face_resolution(face) != Some(r_edge) {
-                continue;
+        if few_faces {
+            for &(face_level, face_edge, reversed) in equal.iter().flatten() {
+                let p = if reversed { r_previous - position } else { position } as usize;
+                for (i, j) in inside_neighbours(face_edge, p, rp) {
+                    neighbours.push(face_level.get(interior_row_start(rp, i) + j - 1).unwrap_or([0.0; 4]));
+                }
             }
-            let reversed = topology.is_reversed(face, usize::from(face_edge));
-            let p = if reversed { r_previous - position } else { position } as usize;
-            for (i, j) in inside_neighbours(face_edge, p, rp) {
-                let at = face_level_offset + interior_row_start(rp, i) + j - 1;
-                neighbours.push(interiors.get(face, at).unwrap_or([0.0; 4]));
+        } else {
+            for &(face, face_edge) in faces {
+                if store.face_resolution(face) != Some(r_edge) {
+                    continue;
+                }
+                let reversed = topology.is_reversed(face, usize::from(face_edge));
+                let p = if reversed { r_previous - position } else { position } as usize;
+                for (i, j) in inside_neighbours(face_edge, p, rp) {
+                    let at = face_level_offset + interior_row_start(rp, i) + j - 1;
+                    neighbours.push(interiors.get(face, at).unwrap_or([0.0; 4]));
+                }
             }
         }
         // Coarser faces: what they show at those two points (computed beforehand).
@@ -439,7 +444,9 @@ fn build_all(
         });
     ctx.all_interior_chains(interior_bytes, upper);
     let interiors = ctx.interiors(interior_bytes, upper);
-    let all_edges: Vec<u32> = (0..topology.edge_count()).collect();
+    // Whether an edge has coarser faces does not change from level to level.
+    let coarse_edges: Vec<u32> =
+        (0..topology.edge_count()).into_par_iter().filter(|&e| ctx.has_coarse_faces(e)).collect();
     for level in 1..levels {
         let coarse = {
             let view = ChainsView {
@@ -452,7 +459,7 @@ fn build_all(
                 vertex_section: s.vertex_end,
                 interior_start: s.edge_end,
             };
-            coarse_table(ctx, &view, &all_edges, level as u32)
+            coarse_table(ctx, &view, &coarse_edges, level as u32)
         };
         {
             let vertex_colors: &[Rgba] = vertex_colors;
@@ -619,25 +626,7 @@ impl PackCache {
         }
         {
             let (_, interior_bytes) = bytes.split_at_mut(s.edge_end * size);
-            // Bounds of the dirty faces' chains (sorted, disjoint): [start, end] pairs.
-            let faces: Vec<u32> = dirty.faces.iter().copied().filter(|&f| interior_len(f) > 0).collect();
-            let chain_bounds: Vec<usize> = faces
-                .iter()
-                .flat_map(|&f| [prefix.chain[f as usize] as usize * size, prefix.chain[f as usize + 1] as usize * size])
-                .collect();
-            let upper_bounds: Vec<usize> = faces
-                .iter()
-                .flat_map(|&f| [prefix.upper[f as usize] as usize, prefix.upper[f as usize + 1] as usize])
-                .collect();
-            let byte_pieces = split_at_bounds(interior_bytes, &chain_bounds);
-            let upper_pieces = split_at_bounds(upper, &upper_bounds);
-            // Pieces alternate: a dirty face's chain, then the gap to the next one.
-            let mut work: Vec<(u32, &mut [u8], &mut [Rgba])> = Vec::with_capacity(faces.len());
-            for ((f, out), up) in
-                faces.iter().zip(byte_pieces.into_iter().step_by(2)).zip(upper_pieces.into_iter().step_by(2))
-            {
-                work.push((*f, out, up));
-            }
+            let mut work = dirty_pieces(prefix, &dirty.faces, size, interior_bytes, upper);
             work.par_iter_mut()
                 .for_each_init(Vec::new, |scratch, (f, out, up)| ctx.interior_chain(*f, scratch, up, out));
         }
