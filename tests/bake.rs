@@ -423,6 +423,7 @@ fn document_open_bakes_textured_models() {
     let document = Document::open(&path, r(2)).unwrap();
     document.store.for_each_site(|site| {
         let got = document.store.get(site.sample).unwrap();
+        assert_eq!(got, meshpaint::io::document::NEUTRAL_BASE_COLOR, "{site:?}");
         assert_eq!(meshpaint::colors::format::encode_rgba8_srgb(got), [203, 203, 203, 255], "{site:?}");
     });
     // The position colour field is a view of it, computed from the positions alone.

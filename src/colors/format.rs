@@ -114,7 +114,30 @@ impl ColorFormat {
 
     /// Decodes one sample from `bytes` (exactly `bytes_per_sample` long; shorter input
     /// decodes missing bytes as zero).
+    #[inline]
     pub fn decode(self, bytes: &[u8]) -> Rgba {
+        // Whole samples (the usual case) without per-byte checks.
+        match self {
+            ColorFormat::Rgba8Srgb => {
+                if let Some(b) = bytes.first_chunk::<4>() {
+                    return decode_rgba8_srgb(*b);
+                }
+            }
+            ColorFormat::Rgba16F => {
+                if let Some(b) = bytes.first_chunk::<8>() {
+                    return std::array::from_fn(|c| {
+                        f16::from_bits(u16::from_le_bytes([b[2 * c], b[2 * c + 1]])).to_f32()
+                    });
+                }
+            }
+            ColorFormat::Rgba32F => {
+                if let Some(b) = bytes.first_chunk::<16>() {
+                    return std::array::from_fn(|c| {
+                        f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])
+                    });
+                }
+            }
+        }
         let byte = |k: usize| bytes.get(k).copied().unwrap_or(0);
         match self {
             ColorFormat::Rgba8Srgb => decode_rgba8_srgb([byte(0), byte(1), byte(2), byte(3)]),
@@ -161,6 +184,29 @@ impl ColorFormat {
                     quad.copy_from_slice(&channel.to_le_bytes());
                 }
                 color
+            }
+        }
+    }
+
+    /// [`ColorFormat::encode_quantized`] over a slice: encodes `colors` into `out` and
+    /// writes what decoding gives to `quantized` (as far as all three reach), the format
+    /// chosen once for the run.
+    pub fn encode_quantized_slice(self, colors: &[Rgba], out: &mut [u8], quantized: &mut [Rgba]) {
+        let size = self.bytes_per_sample();
+        let items = colors.iter().zip(out.chunks_exact_mut(size)).zip(quantized.iter_mut());
+        match self {
+            ColorFormat::Rgba8Srgb => {
+                let tables = srgb_tables();
+                for ((&color, out), slot) in items {
+                    let bytes = tables.encode_rgba8(clamp_color(color));
+                    out.copy_from_slice(&bytes);
+                    *slot = tables.decode_rgba8(bytes);
+                }
+            }
+            ColorFormat::Rgba16F | ColorFormat::Rgba32F => {
+                for ((&color, out), slot) in items {
+                    *slot = self.encode_quantized(color, out);
+                }
             }
         }
     }

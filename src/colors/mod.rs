@@ -6,6 +6,7 @@ pub mod budget;
 pub mod format;
 pub mod layout;
 pub mod resample;
+mod slab;
 pub mod stats;
 pub mod store;
 

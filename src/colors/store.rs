@@ -1,10 +1,11 @@
 //! The editable store: what paint mode edits.
 //!
 //! Colours are held per element, keyed by element id: one colour per vertex, one sample
-//! vector per edge (its `R_e − 1` samples in canonical direction) and one per face (its
-//! interior samples). Each element owns its own allocation (`Vec<Vec<_>>` is a dense map
-//! from id to samples), so changing one face's resolution reallocates only that face and
-//! its edges and never shifts any global array. The linear GPU layout is produced from
+//! run per edge (its `R_e − 1` samples in canonical direction) and one per face (its
+//! interior samples). Each element owns its own slot in a slab of large chunks
+//! ([`crate::colors::slab`]: a dense map from id to samples, allocated in a few pieces), so
+//! changing one face's resolution moves only that face and its edges and never shifts any
+//! global array. The linear GPU layout is produced from
 //! this by the packer when paint mode ends.
 //!
 //! Rules:
@@ -21,6 +22,7 @@ use thiserror::Error;
 use crate::colors::format::Rgba;
 use crate::colors::layout::{self, Resolution, SampleLocation};
 use crate::colors::resample::{Lattice, reduce_polyline, refine_polyline};
+use crate::colors::slab::Slab;
 use crate::mesh::topology::Topology;
 
 /// Errors of store operations.
@@ -214,8 +216,8 @@ pub struct ColorStore {
     face_resolution: Vec<Resolution>,
     edge_resolution: Vec<Resolution>,
     vertex_colors: Vec<Rgba>,
-    edge_samples: Vec<Vec<Rgba>>,
-    interior_samples: Vec<Vec<Rgba>>,
+    edge_samples: Slab,
+    interior_samples: Slab,
     /// For each vertex, the lowest face id that uses it (`INVALID` if none).
     vertex_owner_face: Vec<u32>,
     dirty_vertices: DirtySet,
@@ -267,11 +269,8 @@ impl ColorStore {
         }
         ColorStore {
             vertex_colors: vec![color; topology.vertex_count as usize],
-            edge_samples: edge_resolution.iter().map(|&r| vec![color; layout::edge_sample_count(r) as usize]).collect(),
-            interior_samples: face_resolution
-                .iter()
-                .map(|&r| vec![color; layout::interior_sample_count(r) as usize])
-                .collect(),
+            edge_samples: Slab::filled(edge_resolution.iter().map(|&r| layout::edge_sample_count(r)), color),
+            interior_samples: Slab::filled(face_resolution.iter().map(|&r| layout::interior_sample_count(r)), color),
             dirty_vertices: DirtySet::new(topology.vertex_count as usize),
             dirty_edges: DirtySet::new(edge_resolution.len()),
             dirty_faces: DirtySet::new(faces),
@@ -311,19 +310,17 @@ impl ColorStore {
 
     /// The samples of `edge`, canonical direction.
     pub fn edge_samples(&self, edge: u32) -> &[Rgba] {
-        self.edge_samples.get(edge as usize).map_or(&[], Vec::as_slice)
+        self.edge_samples.get(edge as usize).unwrap_or(&[])
     }
 
     /// The interior samples of `face`, thesis eq. 3.2 order.
     pub fn interior_samples(&self, face: u32) -> &[Rgba] {
-        self.interior_samples.get(face as usize).map_or(&[], Vec::as_slice)
+        self.interior_samples.get(face as usize).unwrap_or(&[])
     }
 
     /// Number of level-0 samples stored.
     pub fn sample_count(&self) -> u64 {
-        self.vertex_colors.len() as u64
-            + self.edge_samples.iter().map(|s| s.len() as u64).sum::<u64>()
-            + self.interior_samples.iter().map(|s| s.len() as u64).sum::<u64>()
+        self.vertex_colors.len() as u64 + self.edge_samples.live_samples() + self.interior_samples.live_samples()
     }
 
     /// Reads one sample.
@@ -378,10 +375,8 @@ impl ColorStore {
     ) -> u64 {
         let slice = match element {
             StoreElement::Vertices => self.vertex_colors.as_mut_slice(),
-            StoreElement::Edge(edge) => self.edge_samples.get_mut(edge as usize).map_or(&mut [][..], Vec::as_mut_slice),
-            StoreElement::Interior(face) => {
-                self.interior_samples.get_mut(face as usize).map_or(&mut [][..], Vec::as_mut_slice)
-            }
+            StoreElement::Edge(edge) => self.edge_samples.get_mut(edge as usize).unwrap_or(&mut []),
+            StoreElement::Interior(face) => self.interior_samples.get_mut(face as usize).unwrap_or(&mut []),
         };
         let start = (first as usize).min(slice.len());
         let end = (first as usize).saturating_add(len as usize).min(slice.len());
@@ -506,7 +501,7 @@ impl ColorStore {
             };
             let r_edge = self.edge_resolution[edge as usize];
             let reversed = self.topology.is_reversed(face, usize::from(k));
-            let samples = &mut self.edge_samples[edge as usize];
+            let samples = self.edge_samples.get_mut(edge as usize).unwrap_or(&mut []);
             for (offset, slot) in (0..layout::edge_sample_count(r_edge)).zip(samples.iter_mut()) {
                 let position = if reversed { r_edge.get() - 1 - offset } else { offset + 1 };
                 let site = SampleSite {
@@ -522,7 +517,7 @@ impl ColorStore {
         }
         for face in 0..self.topology.face_count() {
             let r = self.face_resolution[face as usize];
-            let samples = &mut self.interior_samples[face as usize];
+            let samples = self.interior_samples.get_mut(face as usize).unwrap_or(&mut []);
             // Rows i ascending, then j ascending: the storage order (eq. 3.2).
             let res = r.get();
             let mut slots = samples.iter_mut();
@@ -589,7 +584,7 @@ impl ColorStore {
                 lattice.get(i, j).map(crate::colors::format::clamp_color)
             })
             .collect();
-        self.interior_samples[face as usize] = interior;
+        self.interior_samples.set(face as usize, &interior);
         self.dirty_faces.mark(face);
         Ok(())
     }
@@ -611,7 +606,7 @@ impl ColorStore {
             let reversed = self.topology.is_reversed(face, usize::from(k));
             for position in 1..r {
                 let offset = layout::edge_storage_offset(r_edge, position * stride, reversed);
-                if let Some(&color) = self.edge_samples[edge as usize].get(offset as usize) {
+                if let Some(&color) = self.edge_samples(edge).get(offset as usize) {
                     let (i, j) = layout::edge_sample_coords(r_lattice, k, position);
                     lattice.set(i, j, color);
                 }
@@ -626,9 +621,9 @@ impl ColorStore {
             return;
         }
         let [lower, higher] = self.topology.edge_vertices[edge as usize];
-        let mut polyline = Vec::with_capacity(self.edge_samples[edge as usize].len() + 2);
+        let mut polyline = Vec::with_capacity(self.edge_samples(edge).len() + 2);
         polyline.push(self.vertex_colors[lower as usize]);
-        polyline.extend_from_slice(&self.edge_samples[edge as usize]);
+        polyline.extend_from_slice(self.edge_samples(edge));
         polyline.push(self.vertex_colors[higher as usize]);
         let mut r = current.get();
         while r < target.get() {
@@ -640,7 +635,8 @@ impl ColorStore {
             r /= 2;
         }
         let inner = polyline.get(1..polyline.len().saturating_sub(1)).unwrap_or(&[]);
-        self.edge_samples[edge as usize] = inner.iter().map(|&c| crate::colors::format::clamp_color(c)).collect();
+        let inner: Vec<Rgba> = inner.iter().map(|&c| crate::colors::format::clamp_color(c)).collect();
+        self.edge_samples.set(edge as usize, &inner);
         self.edge_resolution[edge as usize] = target;
         self.resized_edges.mark(edge);
         self.dirty_edges.mark(edge);

@@ -263,6 +263,32 @@ fn fill_neutral(store: &mut ColorStore, triangle_materials: &[Option<u32>], scen
     });
 }
 
+/// The colour [`fill_neutral`] gives every sample when it gives all the same one: every face
+/// has the same colour (bit for bit) and every vertex belongs to a face (a vertex without
+/// faces keeps the store's initial colour there). `None` otherwise.
+fn uniform_neutral_color(topology: &Topology, triangle_materials: &[Option<u32>], scene: &Scene) -> Option<Rgba> {
+    let color_of = |face: usize| {
+        triangle_materials
+            .get(face)
+            .copied()
+            .flatten()
+            .and_then(|m| scene.materials.get(m as usize))
+            .map_or(NEUTRAL_BASE_COLOR, |material| material.base_color_factor)
+    };
+    let first = color_of(0);
+    let bits = |c: Rgba| c.map(f32::to_bits);
+    if (1..topology.face_count() as usize).any(|f| bits(color_of(f)) != bits(first)) {
+        return None;
+    }
+    let mut used = vec![false; topology.vertex_count as usize];
+    for corners in &topology.face_vertices {
+        for &v in corners {
+            used[v as usize] = true;
+        }
+    }
+    used.iter().all(|&u| u).then_some(first)
+}
+
 /// `store` with every sample coloured by [`position_color`] at its position on `positions`:
 /// a view of the geometry (`render --position-colors`), not a document's content.
 pub fn position_colored(store: &ColorStore, positions: &[[f32; 3]]) -> ColorStore {
@@ -497,12 +523,16 @@ impl Document {
                 resolutions
             }
         };
-        let mut store = ColorStore::with_resolutions(topology, resolutions, [1.0; 4])
-            .map_err(|source| DocumentError::Store { path: name.to_owned(), source })?;
         let has_base_color = crate::io::bake::has_base_color(&welded, &scene);
+        let neutral = !has_base_color && welded.vertex_colors.is_empty();
+        // One colour on every face and no unused vertex: the neutral fill is that colour
+        // everywhere, so the store is built with it and not filled a second time.
+        let uniform = if neutral { uniform_neutral_color(&topology, &welded.triangle_materials, &scene) } else { None };
+        let mut store = ColorStore::with_resolutions(topology, resolutions, uniform.unwrap_or([1.0; 4]))
+            .map_err(|source| DocumentError::Store { path: name.to_owned(), source })?;
         if has_base_color {
             crate::io::adaptive::bake_and_verify(&mut store, &welded, &scene, rule);
-        } else if welded.vertex_colors.is_empty() {
+        } else if neutral && uniform.is_none() {
             fill_neutral(&mut store, &welded.triangle_materials, &scene);
         }
         if !welded.vertex_colors.is_empty() {

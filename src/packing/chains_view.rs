@@ -4,6 +4,7 @@
 use crate::colors::format::Rgba;
 use crate::colors::layout::Resolution;
 use crate::colors::store::ColorStore;
+use crate::packing::interiors::InteriorReader;
 use crate::packing::linear::FaceRecord;
 use crate::packing::sampler::{self, MeshColorSource};
 
@@ -15,20 +16,23 @@ pub(crate) struct ChainsView<'a> {
     pub(crate) vertex_levels: u32,
     pub(crate) vertex_colors: &'a [Rgba],
     pub(crate) edge_colors: &'a [Rgba],
-    pub(crate) interior_colors: &'a [Rgba],
+    pub(crate) interiors: InteriorReader<'a>,
     pub(crate) vertex_section: usize,
     pub(crate) interior_start: usize,
 }
 
 impl ChainsView<'_> {
-    fn at(&self, index: u64) -> Option<Rgba> {
+    /// Sample `index` of the colour buffer, read for `face` (an interior index is always one
+    /// of `face`'s own interior samples).
+    fn at(&self, face: u32, index: u64) -> Option<Rgba> {
         let index = usize::try_from(index).ok()?;
         if index < self.vertex_section {
             self.vertex_colors.get(index).copied()
         } else if index < self.interior_start {
             self.edge_colors.get(index - self.vertex_section).copied()
         } else {
-            self.interior_colors.get(index - self.interior_start).copied()
+            let base = self.records.get(face as usize)?.interior_base() as usize;
+            self.interiors.get(face, index.checked_sub(base)?)
         }
     }
 }
@@ -41,7 +45,7 @@ impl MeshColorSource for ChainsView<'_> {
     fn lattice_color(&self, face: u32, level: u32, i: u32, j: u32) -> Option<Rgba> {
         let record = self.records.get(face as usize)?;
         let corners = self.store.topology().face_vertices.get(face as usize)?;
-        self.at(sampler::record_sample_index(record, corners, self.vertex_levels, level, i, j)?)
+        self.at(face, sampler::record_sample_index(record, corners, self.vertex_levels, level, i, j)?)
     }
 
     fn edge_resolution(&self, face: u32, k: u8) -> Option<Resolution> {
@@ -51,6 +55,6 @@ impl MeshColorSource for ChainsView<'_> {
     fn edge_color(&self, face: u32, k: u8, level: u32, p: u32) -> Option<Rgba> {
         let record = self.records.get(face as usize)?;
         let corners = self.store.topology().face_vertices.get(face as usize)?;
-        self.at(sampler::record_edge_index(record, corners, k, level, p)?)
+        self.at(face, sampler::record_edge_index(record, corners, k, level, p)?)
     }
 }

@@ -78,3 +78,13 @@ pub(crate) fn reduce_interior_chain(chain: &mut [Rgba], r: Resolution) {
         }
     }
 }
+
+/// The two lattice neighbours strictly inside the face of the point at position `p`
+/// along face edge `face_edge`, on a lattice of resolution `rp` (LATTICE_DIRECTIONS order).
+pub(crate) fn inside_neighbours(face_edge: u8, p: usize, rp: usize) -> [(usize, usize); 2] {
+    match face_edge {
+        0 => [(p, 1), (p - 1, 1)],
+        1 => [(rp - p - 1, p), (rp - p, p - 1)],
+        _ => [(1, rp - p), (1, rp - p - 1)],
+    }
+}

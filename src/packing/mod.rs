@@ -16,6 +16,7 @@
 pub(crate) mod blocks;
 pub(crate) mod chains_view;
 pub mod file;
+pub(crate) mod interiors;
 pub mod linear;
 pub mod lod;
 pub(crate) mod mip;

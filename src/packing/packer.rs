@@ -37,8 +37,9 @@ use crate::colors::store::{ColorStore, DirtyElements};
 use crate::mesh::topology::TopologyError;
 use crate::packing::blocks::{BLOCK, split_blocks};
 use crate::packing::chains_view::ChainsView;
+use crate::packing::interiors::{FaceLevel, InteriorPrefix, InteriorReader, dirty_pieces, split_at_bounds};
 use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
-use crate::packing::mip::{interior_row_start, mip_filter, reduce_interior_chain, vertex_edges};
+use crate::packing::mip::{inside_neighbours, interior_row_start, mip_filter, reduce_interior_chain, vertex_edges};
 use crate::packing::sampler::{self, Filter};
 
 /// Errors of packing and unpacking.
@@ -158,9 +159,15 @@ struct Context<'a> {
     records: &'a [FaceRecord],
     sections: Sections,
     format: ColorFormat,
+    prefix: &'a InteriorPrefix,
 }
 
 impl Context<'_> {
+    /// The interior section as written so far (`bytes`: its colour bytes).
+    fn interiors<'b>(&'b self, bytes: &'b [u8], upper: &'b [Rgba]) -> InteriorReader<'b> {
+        InteriorReader { store: self.store, prefix: self.prefix, bytes, upper, format: self.format }
+    }
+
     fn edge_log2(&self, edge: u32) -> u32 {
         self.store.edge_resolution(edge).map_or(0, Resolution::log2)
     }
@@ -180,25 +187,52 @@ impl Context<'_> {
 
     /// Writes level 0 of `edge` from the store and its encoding.
     fn edge_level0(&self, edge: u32, chain: &mut [Rgba], bytes: &mut [u8]) {
+        self.format.encode_quantized_slice(self.store.edge_samples(edge), bytes, chain);
+    }
+
+    /// Builds `face`'s whole interior chain in `scratch` and writes its encoding to `bytes`
+    /// (level 0 encoded once) and its levels ≥ 1 to `upper`.
+    fn interior_chain(&self, face: u32, scratch: &mut Vec<Rgba>, upper: &mut [Rgba], bytes: &mut [u8]) {
         let size = self.format.bytes_per_sample();
-        for ((slot, out), &color) in
-            chain.iter_mut().zip(bytes.chunks_exact_mut(size)).zip(self.store.edge_samples(edge))
-        {
-            *slot = self.format.encode_quantized(color, out);
+        let level0 = self.store.interior_samples(face);
+        let r = self.store.face_resolution(face).unwrap_or(Resolution::ONE);
+        scratch.clear();
+        scratch.resize(layout::interior_chain_len(r) as usize, [0.0; 4]);
+        self.format.encode_quantized_slice(level0, bytes, scratch);
+        reduce_interior_chain(scratch, r);
+        let n0 = level0.len().min(scratch.len());
+        self.format.encode_slice(&scratch[n0..], &mut bytes[n0 * size..]);
+        for (slot, &color) in upper.iter_mut().zip(&scratch[n0..]) {
+            *slot = color;
         }
     }
 
-    /// Builds and encodes `face`'s whole interior chain (level 0 encoded once).
-    fn interior_chain(&self, face: u32, chain: &mut [Rgba], bytes: &mut [u8]) {
+    /// Builds every face's interior chain: `bytes` is the interior section, `upper` every
+    /// face's levels ≥ 1 (blocks of faces in parallel, one scratch chain per block).
+    fn all_interior_chains(&self, bytes: &mut [u8], upper: &mut [Rgba]) {
         let size = self.format.bytes_per_sample();
-        let level0 = self.store.interior_samples(face);
-        for ((slot, out), &color) in chain.iter_mut().zip(bytes.chunks_exact_mut(size)).zip(level0) {
-            *slot = self.format.encode_quantized(color, out);
-        }
-        let r = self.store.face_resolution(face).unwrap_or(Resolution::ONE);
-        reduce_interior_chain(chain, r);
-        let n0 = level0.len().min(chain.len());
-        self.format.encode_slice(&chain[n0..], &mut bytes[n0 * size..]);
+        let faces = self.store.topology().face_count() as usize;
+        let chain = &self.prefix.chain;
+        let up = &self.prefix.upper;
+        let block_first: Vec<usize> = (0..=faces.div_ceil(BLOCK)).map(|b| (b * BLOCK).min(faces)).collect();
+        let byte_bounds: Vec<usize> = block_first.iter().map(|&f| chain[f] as usize * size).collect();
+        let upper_bounds: Vec<usize> = block_first.iter().map(|&f| up[f] as usize).collect();
+        split_at_bounds(bytes, &byte_bounds)
+            .into_par_iter()
+            .zip(split_at_bounds(upper, &upper_bounds))
+            .enumerate()
+            .for_each(|(b, (bytes, upper))| {
+                let mut scratch = Vec::new();
+                let (first, end) = (block_first[b], block_first[b + 1]);
+                for f in first..end {
+                    let (c, c_end) = ((chain[f] - chain[first]) as usize, (chain[f + 1] - chain[first]) as usize);
+                    let (u, u_end) = ((up[f] - up[first]) as usize, (up[f + 1] - up[first]) as usize);
+                    if c_end > c {
+                        let out = &mut bytes[c * size..c_end * size];
+                        self.interior_chain(f as u32, &mut scratch, &mut upper[u..u_end], out);
+                    }
+                }
+            });
     }
 
     /// Encodes levels 1.. of an edge chain (level 0 was encoded with the store read).
@@ -206,16 +240,6 @@ impl Context<'_> {
         let size = self.format.bytes_per_sample();
         let n0 = self.store.edge_samples(edge).len().min(chain.len());
         self.format.encode_slice(&chain[n0..], &mut bytes[n0 * size..]);
-    }
-}
-
-/// The two lattice neighbours strictly inside the face of the point at position `p`
-/// along face edge `face_edge`, on a lattice of resolution `rp` (LATTICE_DIRECTIONS order).
-fn inside_neighbours(face_edge: u8, p: usize, rp: usize) -> [(usize, usize); 2] {
-    match face_edge {
-        0 => [(p, 1), (p - 1, 1)],
-        1 => [(rp - p - 1, p), (rp - p, p - 1)],
-        _ => [(1, rp - p), (1, rp - p - 1)],
     }
 }
 
@@ -257,7 +281,7 @@ fn reduce_edge_level(
     chain: &mut [Rgba],
     level: u32,
     vertex_colors: &[Rgba],
-    interior_colors: &[Rgba],
+    interiors: &InteriorReader,
     neighbours: &mut Vec<Rgba>,
 ) {
     let log2 = ctx.edge_log2(edge);
@@ -267,7 +291,6 @@ fn reduce_edge_level(
     let store = ctx.store;
     let topology = store.topology();
     let levels = ctx.sections.levels;
-    let interior_start = ctx.sections.edge_end;
     let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
     let r_level = 1u32 << (log2 - level);
     let r_previous = 2 * r_level;
@@ -280,6 +303,19 @@ fn reduce_edge_level(
     let rp = r_previous as usize;
     let faces = topology.faces_of_edge(edge);
     let coarse_count = faces.iter().filter(|&&(face, _)| store.face_resolution(face) != Some(r_edge)).count();
+    // The equal-resolution faces' level − 1, looked up once (a manifold edge has ≤ 2).
+    let mut equal: [Option<(FaceLevel, u8, bool)>; 2] = [None; 2];
+    if faces.len() - coarse_count <= 2 {
+        let mut n = 0;
+        for &(face, face_edge) in faces {
+            if store.face_resolution(face) == Some(r_edge) {
+                let reversed = topology.is_reversed(face, usize::from(face_edge));
+                equal[n] = Some((interiors.level(face, face_level_offset), face_edge, reversed));
+                n += 1;
+            }
+        }
+    }
+    let few_faces = faces.len() - coarse_count <= 2;
     for k in 1..r_level {
         let position = 2 * k;
         let at = |p: u32| -> Rgba {
@@ -295,16 +331,24 @@ fn reduce_edge_level(
         neighbours.clear();
         neighbours.push(at(position - 1));
         neighbours.push(at(position + 1));
-        for &(face, face_edge) in faces {
-            if store.face_resolution(face) != Some(r_edge) {
-                continue;
+        if few_faces {
+            for &(face_level, face_edge, reversed) in equal.iter().flatten() {
+                let p = if reversed { r_previous - position } else { position } as usize;
+                for (i, j) in inside_neighbours(face_edge, p, rp) {
+                    neighbours.push(face_level.get(interior_row_start(rp, i) + j - 1).unwrap_or([0.0; 4]));
+                }
             }
-            let reversed = topology.is_reversed(face, usize::from(face_edge));
-            let p = if reversed { r_previous - position } else { position } as usize;
-            let face_base = ctx.layout.interior_base[face as usize] as usize;
-            let start = face_base - interior_start + face_level_offset;
-            for (i, j) in inside_neighbours(face_edge, p, rp) {
-                neighbours.push(interior_colors[start + interior_row_start(rp, i) + j - 1]);
+        } else {
+            for &(face, face_edge) in faces {
+                if store.face_resolution(face) != Some(r_edge) {
+                    continue;
+                }
+                let reversed = topology.is_reversed(face, usize::from(face_edge));
+                let p = if reversed { r_previous - position } else { position } as usize;
+                for (i, j) in inside_neighbours(face_edge, p, rp) {
+                    let at = face_level_offset + interior_row_start(rp, i) + j - 1;
+                    neighbours.push(interiors.get(face, at).unwrap_or([0.0; 4]));
+                }
             }
         }
         // Coarser faces: what they show at those two points (computed beforehand).
@@ -356,17 +400,23 @@ fn coarse_of(table: &(Vec<u32>, Vec<Vec<Rgba>>), edge: u32) -> &[Rgba] {
     }
 }
 
-/// The full pack into `chains` / `bytes` (both zeroed, `layout.sample_count` samples).
+/// The full pack into `chains` (the vertex and edge sections), `upper` (the interiors'
+/// levels ≥ 1) and `bytes` (`layout.sample_count` samples).
 /// Long: three sections split and re-split per pass (level 0, interiors, each level of
 /// edges and vertices, encoding), each pass a few lines of rayon.
-fn build_all(ctx: &Context, chains: &mut [Rgba], bytes: &mut [u8], vertex_edge: &(Vec<u32>, Vec<u32>)) {
+fn build_all(
+    ctx: &Context,
+    chains: &mut [Rgba],
+    upper: &mut [Rgba],
+    bytes: &mut [u8],
+    vertex_edge: &(Vec<u32>, Vec<u32>),
+) {
     let store = ctx.store;
     let topology = store.topology();
     let layout = ctx.layout;
     let s = ctx.sections;
     let size = ctx.format.bytes_per_sample();
-    let (vertex_colors, rest) = chains.split_at_mut(s.vertex_end);
-    let (edge_colors, interior_colors) = rest.split_at_mut(s.edge_end - s.vertex_end);
+    let (vertex_colors, edge_colors) = chains.split_at_mut(s.vertex_end);
     let (vertex_bytes, rest_bytes) = bytes.split_at_mut(s.vertex_end * size);
     let (edge_bytes, interior_bytes) = rest_bytes.split_at_mut((s.edge_end - s.vertex_end) * size);
     // Level 0 of vertices and edges (encoded once, here), every interior chain.
@@ -392,29 +442,11 @@ fn build_all(ctx: &Context, chains: &mut [Rgba], bytes: &mut [u8], vertex_edge: 
                 }
             }
         });
-    let interior_base = |f: u32| {
-        let r = store.face_resolution(f).unwrap_or(Resolution::ONE);
-        (layout::interior_chain_len(r) > 0).then(|| layout.interior_base[f as usize] as usize)
-    };
-    let interior_len =
-        |f: u32| layout::interior_chain_len(store.face_resolution(f).unwrap_or(Resolution::ONE)) as usize;
-    split_blocks(interior_colors, interior_bytes, size, s.edge_end, topology.face_count(), interior_base)
-        .into_par_iter()
-        .for_each(|block| {
-            for f in block.ids.clone() {
-                if let Some(b) = interior_base(f) {
-                    let at = b - block.offset;
-                    let len = interior_len(f);
-                    ctx.interior_chain(
-                        f,
-                        &mut block.chains[at..at + len],
-                        &mut block.bytes[at * size..(at + len) * size],
-                    );
-                }
-            }
-        });
-    let interior_colors: &[Rgba] = interior_colors;
-    let all_edges: Vec<u32> = (0..topology.edge_count()).collect();
+    ctx.all_interior_chains(interior_bytes, upper);
+    let interiors = ctx.interiors(interior_bytes, upper);
+    // Whether an edge has coarser faces does not change from level to level.
+    let coarse_edges: Vec<u32> =
+        (0..topology.edge_count()).into_par_iter().filter(|&e| ctx.has_coarse_faces(e)).collect();
     for level in 1..levels {
         let coarse = {
             let view = ChainsView {
@@ -423,11 +455,11 @@ fn build_all(ctx: &Context, chains: &mut [Rgba], bytes: &mut [u8], vertex_edge: 
                 vertex_levels: layout.vertex_levels,
                 vertex_colors: &*vertex_colors,
                 edge_colors: &*edge_colors,
-                interior_colors,
+                interiors,
                 vertex_section: s.vertex_end,
                 interior_start: s.edge_end,
             };
-            coarse_table(ctx, &view, &all_edges, level as u32)
+            coarse_table(ctx, &view, &coarse_edges, level as u32)
         };
         {
             let vertex_colors: &[Rgba] = vertex_colors;
@@ -447,7 +479,7 @@ fn build_all(ctx: &Context, chains: &mut [Rgba], bytes: &mut [u8], vertex_edge: 
                                 &mut block.chains[at..at + edge_len(e)],
                                 level as u32,
                                 vertex_colors,
-                                interior_colors,
+                                &interiors,
                                 &mut neighbours,
                             );
                         }
@@ -487,14 +519,17 @@ fn build_all(ctx: &Context, chains: &mut [Rgba], bytes: &mut [u8], vertex_edge: 
     }
 }
 
-/// A packed mesh with what an incremental repack needs: its layout, every chain in `f32`
-/// and the vertex → edge incidence. Built by a full pack; [`PackCache::update`] then
+/// A packed mesh with what an incremental repack needs: its layout, the vertex and edge
+/// chains and the interiors' levels ≥ 1 in `f32` (interior level 0 is read back from the
+/// bytes, [`crate::packing::interiors`]) and the vertex → edge incidence. Built by a full pack; [`PackCache::update`] then
 /// recomputes only the chains an edit reaches.
 #[derive(Debug, Clone)]
 pub struct PackCache {
     layout: PackLayout,
     sections: Sections,
     chains: Vec<Rgba>,
+    prefix: InteriorPrefix,
+    upper: Vec<Rgba>,
     vertex_edge: (Vec<u32>, Vec<u32>),
     packed: PackedMesh,
 }
@@ -517,12 +552,14 @@ impl PackCache {
             .map(|f| layout.face_record(store, f))
             .collect();
         let size = format.bytes_per_sample();
-        let mut chains = vec![[0.0f32; 4]; sections.total];
+        let prefix = InteriorPrefix::of(store);
+        let mut chains = vec![[0.0f32; 4]; sections.edge_end];
+        let mut upper = vec![[0.0f32; 4]; prefix.upper_len()];
         let mut colors = vec![0u8; sections.total * size];
         let vertex_edge = vertex_edges(topology);
         {
-            let ctx = Context { store, layout: &layout, records: &records, sections, format };
-            build_all(&ctx, &mut chains, &mut colors, &vertex_edge);
+            let ctx = Context { store, layout: &layout, records: &records, sections, format, prefix: &prefix };
+            build_all(&ctx, &mut chains, &mut upper, &mut colors, &vertex_edge);
         }
         let packed = PackedMesh {
             positions: positions.to_vec(),
@@ -532,7 +569,7 @@ impl PackCache {
             format,
             colors,
         };
-        Ok(PackCache { layout, sections, chains, vertex_edge, packed })
+        Ok(PackCache { layout, sections, chains, prefix, upper, vertex_edge, packed })
     }
 
     /// The packed mesh.
@@ -568,8 +605,10 @@ impl PackCache {
         let s = self.sections;
         let levels = s.levels;
         let layout = &self.layout;
-        let ctx = Context { store, layout, records: &self.packed.face_records, sections: s, format };
+        let prefix = &self.prefix;
+        let ctx = Context { store, layout, records: &self.packed.face_records, sections: s, format, prefix };
         let chains = &mut self.chains;
+        let upper = &mut self.upper;
         let bytes = &mut self.packed.colors;
         let edge_len = |e: u32| store.edge_resolution(e).map_or(0, layout::edge_chain_len) as usize;
         let interior_len =
@@ -586,26 +625,10 @@ impl PackCache {
             }
         }
         {
-            let (_, interior_chains) = chains.split_at_mut(s.edge_end);
             let (_, interior_bytes) = bytes.split_at_mut(s.edge_end * size);
-            let mut faces: Vec<(u32, &mut [Rgba], &mut [u8])> = Vec::with_capacity(dirty.faces.len());
-            let (mut rest_c, mut rest_b, mut cursor) = (interior_chains, interior_bytes, s.edge_end);
-            for &f in &dirty.faces {
-                let len = interior_len(f);
-                if len == 0 {
-                    continue;
-                }
-                let at = layout.interior_base[f as usize] as usize;
-                let (_, c) = std::mem::take(&mut rest_c).split_at_mut(at - cursor);
-                let (_, b) = std::mem::take(&mut rest_b).split_at_mut((at - cursor) * size);
-                let (chain, c_tail) = c.split_at_mut(len);
-                let (out, b_tail) = b.split_at_mut(len * size);
-                rest_c = c_tail;
-                rest_b = b_tail;
-                cursor = at + len;
-                faces.push((f, chain, out));
-            }
-            faces.par_iter_mut().for_each(|(f, chain, out)| ctx.interior_chain(*f, chain, out));
+            let mut work = dirty_pieces(prefix, &dirty.faces, size, interior_bytes, upper);
+            work.par_iter_mut()
+                .for_each_init(Vec::new, |scratch, (f, out, up)| ctx.interior_chain(*f, scratch, up, out));
         }
         // Which edges and vertices each level recomputes: an edge at level l reads its own
         // level l − 1, its endpoints', its faces' (interiors, and what coarse faces show,
@@ -673,9 +696,8 @@ impl PackCache {
             }
             edges.sort_unstable();
             vertices.sort_unstable();
-            let (vertex_colors, rest) = chains.split_at_mut(s.vertex_end);
-            let (edge_colors, interior_colors) = rest.split_at_mut(s.edge_end - s.vertex_end);
-            let interior_colors: &[Rgba] = interior_colors;
+            let (vertex_colors, edge_colors) = chains.split_at_mut(s.vertex_end);
+            let interiors = ctx.interiors(&bytes[s.edge_end * size..], upper);
             let coarse = {
                 let view = ChainsView {
                     store,
@@ -683,7 +705,7 @@ impl PackCache {
                     vertex_levels: layout.vertex_levels,
                     vertex_colors: &*vertex_colors,
                     edge_colors: &*edge_colors,
-                    interior_colors,
+                    interiors,
                     vertex_section: s.vertex_end,
                     interior_start: s.edge_end,
                 };
@@ -703,7 +725,7 @@ impl PackCache {
                     &mut edge_colors[at..at + len],
                     level as u32,
                     vertex_colors,
-                    interior_colors,
+                    &interiors,
                     &mut neighbours,
                 );
             }

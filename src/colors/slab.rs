@@ -1,0 +1,188 @@
+//! Per-element sample slots in a few large chunks: the store's edge and interior samples.
+//!
+//! Each element (an edge, a face's interior) owns one slot: a run of samples inside one
+//! chunk. Opening a mesh allocates a handful of chunks (filled in parallel) instead of one
+//! allocation per element. Changing one element's sample count moves only that element: the
+//! new run goes to the end of the last chunk (or a new one), the old one becomes dead space,
+//! and a chunk more than half dead is compacted (its live runs move down, nothing else), so
+//! no global array shifts and dead space stays under half of each chunk.
+
+use rayon::prelude::*;
+
+use crate::colors::format::Rgba;
+
+/// Samples per chunk (16 MiB of `f32` RGBA); a longer element gets a chunk of its own.
+const CHUNK: usize = 1 << 20;
+
+/// Where one element's samples are.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct Slot {
+    chunk: u32,
+    start: u32,
+    len: u32,
+}
+
+/// The samples of `slots.len()` elements, each a contiguous run.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Slab {
+    chunks: Vec<Vec<Rgba>>,
+    /// Dead samples per chunk.
+    dead: Vec<usize>,
+    slots: Vec<Slot>,
+    live: u64,
+}
+
+impl Slab {
+    /// Elements of `lens` samples each, every sample `color`.
+    pub(crate) fn filled(lens: impl Iterator<Item = u32>, color: Rgba) -> Self {
+        let mut slots = Vec::with_capacity(lens.size_hint().0);
+        let mut chunk_lens: Vec<usize> = Vec::new();
+        let mut live = 0u64;
+        for len in lens {
+            let n = len as usize;
+            let fits = chunk_lens.last().is_some_and(|&used| used + n <= CHUNK);
+            if !fits && n > 0 {
+                chunk_lens.push(0);
+            }
+            let chunk = chunk_lens.len().saturating_sub(1);
+            let start = chunk_lens.get(chunk).copied().unwrap_or(0);
+            if let Some(used) = chunk_lens.get_mut(chunk) {
+                *used += n;
+            }
+            slots.push(Slot { chunk: chunk as u32, start: start as u32, len });
+            live += u64::from(len);
+        }
+        let chunks: Vec<Vec<Rgba>> = chunk_lens.par_iter().map(|&n| vec![color; n]).collect();
+        Slab { dead: vec![0; chunks.len()], chunks, slots, live }
+    }
+
+    /// Samples held by all elements.
+    pub(crate) fn live_samples(&self) -> u64 {
+        self.live
+    }
+
+    /// The samples of element `id` (`None` past the end).
+    #[inline]
+    pub(crate) fn get(&self, id: usize) -> Option<&[Rgba]> {
+        let slot = *self.slots.get(id)?;
+        let start = slot.start as usize;
+        self.chunks.get(slot.chunk as usize)?.get(start..start + slot.len as usize)
+    }
+
+    /// The samples of element `id`, writable (`None` past the end).
+    #[inline]
+    pub(crate) fn get_mut(&mut self, id: usize) -> Option<&mut [Rgba]> {
+        let slot = *self.slots.get(id)?;
+        let start = slot.start as usize;
+        self.chunks.get_mut(slot.chunk as usize)?.get_mut(start..start + slot.len as usize)
+    }
+
+    /// Replaces element `id`'s samples by `samples` (a different count moves the element).
+    pub(crate) fn set(&mut self, id: usize, samples: &[Rgba]) {
+        let Some(&slot) = self.slots.get(id) else {
+            return;
+        };
+        if slot.len as usize == samples.len() {
+            if let Some(run) = self.get_mut(id) {
+                run.copy_from_slice(samples);
+            }
+            return;
+        }
+        let old_chunk = slot.chunk as usize;
+        if slot.len > 0
+            && let Some(dead) = self.dead.get_mut(old_chunk)
+        {
+            *dead += slot.len as usize;
+        }
+        self.live = self.live - u64::from(slot.len) + samples.len() as u64;
+        let n = samples.len();
+        let new_slot = if n == 0 {
+            Slot::default()
+        } else {
+            let fits = self.chunks.last().is_some_and(|last| last.len() + n <= CHUNK.max(last.capacity()));
+            if !fits {
+                self.chunks.push(Vec::with_capacity(CHUNK.max(n)));
+                self.dead.push(0);
+            }
+            let chunk = self.chunks.len() - 1;
+            let last = &mut self.chunks[chunk];
+            if last.capacity() < CHUNK {
+                last.reserve_exact(CHUNK - last.len());
+            }
+            let start = last.len();
+            last.extend_from_slice(samples);
+            Slot { chunk: chunk as u32, start: start as u32, len: n as u32 }
+        };
+        self.slots[id] = new_slot;
+        if slot.len > 0 {
+            self.compact_if_mostly_dead(old_chunk);
+        }
+    }
+
+    /// Moves the live runs of `chunk` down over its dead space when more than half of it
+    /// is dead (each element keeps its chunk; only slots of this chunk change).
+    fn compact_if_mostly_dead(&mut self, chunk: usize) {
+        let (Some(&dead), Some(data)) = (self.dead.get(chunk), self.chunks.get(chunk)) else {
+            return;
+        };
+        if dead == 0 || 2 * dead <= data.len() {
+            return;
+        }
+        let mut members: Vec<(u32, usize)> = (0..self.slots.len())
+            .filter(|&id| self.slots[id].chunk as usize == chunk && self.slots[id].len > 0)
+            .map(|id| (self.slots[id].start, id))
+            .collect();
+        members.sort_unstable();
+        let data = &mut self.chunks[chunk];
+        let mut next = 0usize;
+        for (start, id) in members {
+            let len = self.slots[id].len as usize;
+            data.copy_within(start as usize..start as usize + len, next);
+            self.slots[id].start = next as u32;
+            next += len;
+        }
+        data.truncate(next);
+        self.dead[chunk] = 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The slab against a `Vec<Vec<_>>` (the obvious map), through many resizes that move,
+    /// kill and compact runs.
+    #[test]
+    fn slab_holds_what_a_vec_of_vecs_holds() {
+        let lens: Vec<u32> = (0..3000u32).map(|i| (i * 7919) % 700).collect();
+        let mut truth: Vec<Vec<Rgba>> = lens.iter().map(|&n| vec![[0.5; 4]; n as usize]).collect();
+        let mut slab = Slab::filled(lens.iter().copied(), [0.5; 4]);
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 33) as usize
+        };
+        for step in 0..20_000 {
+            let id = next() % truth.len();
+            let n = if step % 3 == 0 { truth[id].len() } else { next() % 2000 };
+            let samples: Vec<Rgba> = (0..n).map(|k| [step as f32, k as f32, id as f32, 1.0]).collect();
+            slab.set(id, &samples);
+            truth[id] = samples;
+            if step % 97 == 0
+                && let Some(run) = slab.get_mut(id)
+                && let Some(first) = run.first_mut()
+            {
+                *first = [9.0; 4];
+                truth[id][0] = [9.0; 4];
+            }
+        }
+        assert_eq!(slab.slots.len(), truth.len());
+        for (id, want) in truth.iter().enumerate() {
+            assert_eq!(slab.get(id).unwrap(), want.as_slice(), "element {id}");
+        }
+        assert_eq!(slab.live_samples(), truth.iter().map(|t| t.len() as u64).sum::<u64>());
+        let held: usize = slab.chunks.iter().map(Vec::len).sum();
+        assert!(held as u64 <= 2 * slab.live_samples() + 2 * CHUNK as u64, "dead space bounded");
+        assert!(slab.get(truth.len()).is_none());
+    }
+}
