@@ -435,3 +435,74 @@ fn document_open_bakes_textured_models() {
         assert!((0..4).all(|c| (got[c] - expected[c]).abs() < 1e-6), "vertex {v}: {got:?} vs {expected:?}");
     }
 }
+
+/// (d) The level a sample is read at follows the lattice's spacing, not the longest edge:
+/// the quad's faces are right triangles whose legs span 64 texels, so at R = 64 the lattice
+/// is a square grid of one texel (its diagonal neighbours 1.41 texels away) and must read
+/// level 0 unblurred, at R = 32 exactly level 1 (2 texels). The truth is this test's own
+/// bilinear lookup on levels it box-filters itself from a random texture.
+#[test]
+fn the_mip_level_follows_the_lattice_spacing_of_a_right_triangle() {
+    let state = std::cell::Cell::new(0x9e37_79b9_u32);
+    let next = || {
+        let mut s = state.get();
+        s ^= s << 13;
+        s ^= s >> 17;
+        s ^= s << 5;
+        state.set(s);
+        (s >> 24) as u8
+    };
+    let tex = texture(64, 64, |_, _| [next(), next(), next(), 255]);
+    let level0: Vec<[f64; 3]> = tex
+        .rgba8_srgb
+        .chunks_exact(4)
+        .map(|p| {
+            let l = decode_rgba8_srgb([p[0], p[1], p[2], p[3]]);
+            [f64::from(l[0]), f64::from(l[1]), f64::from(l[2])]
+        })
+        .collect();
+    // Level 1: 2 × 2 box averages.
+    let level1: Vec<[f64; 3]> = (0..32 * 32)
+        .map(|k| {
+            let (x, y) = (k % 32, k / 32);
+            let mut sum = [0.0; 3];
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let t = level0[(2 * y + dy) * 64 + 2 * x + dx];
+                for c in 0..3 {
+                    sum[c] += t[c] / 4.0;
+                }
+            }
+            sum
+        })
+        .collect();
+    let bilinear = |texels: &[[f64; 3]], size: usize, uv: [f64; 2]| -> [f64; 3] {
+        let (x, y) = (uv[0] * size as f64 - 0.5, uv[1] * size as f64 - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let at =
+            |xi: i64, yi: i64| texels[yi.rem_euclid(size as i64) as usize * size + xi.rem_euclid(size as i64) as usize];
+        let mut out = [0.0; 3];
+        for (dx, dy, w) in
+            [(0, 0, (1.0 - fx) * (1.0 - fy)), (1, 0, fx * (1.0 - fy)), (0, 1, (1.0 - fx) * fy), (1, 1, fx * fy)]
+        {
+            let t = at(x0 as i64 + dx, y0 as i64 + dy);
+            for c in 0..3 {
+                out[c] += w * t[c];
+            }
+        }
+        out
+    };
+    let mesh = mapped_quad(0.0, 1.0);
+    let scene = scene_with(tex, [1.0; 4]);
+    for (resolution, texels, size) in [(64u64, &level0, 64usize), (32, &level1, 32)] {
+        let store = baked(&mesh, &scene, resolution);
+        let mut worst = 0.0f64;
+        for (_, _, uv, color) in samples_with_uv(&store, &mesh) {
+            let expected = bilinear(texels, size, uv);
+            for c in 0..3 {
+                worst = worst.max((f64::from(color[c]) - expected[c]).abs());
+            }
+        }
+        assert!(worst < 1e-5, "R = {resolution}: largest difference {worst} from level {}", 64 / size - 1);
+    }
+}

@@ -3,13 +3,20 @@
 //!
 //! Error is measured against the UV-textured render of the same file (the baseline
 //! pipeline: the glTF UVs and base-colour texture with hardware trilinear filtering):
-//! both are rendered unlit at 4× the image size in each direction and box-filtered 4×4
+//! both are rendered unlit at `s`× the image size in each direction and box-filtered `s`×`s`
 //! to the image size (so the figure measures the colour signal, not edge aliasing), from
 //! `views` cameras around the model (yaw 30° + k·360°/views, pitch 20°, framing
 //! distance). PSNR is over the RGB channels of the 8-bit sRGB images, on the pixels that
 //! either render covers; the row reports the mean over the views and the worst view.
 //! Mesh colors are packed in RGBA8 (the display and save format) and drawn with the
 //! linear filter at level 0, the reconstruction the conversion fits.
+//!
+//! The supersampling `s` is [`ADAPTIVE_SUPERSAMPLE`] = 16 by default, not the trade study's
+//! [`SUPERSAMPLE`] = 4: at 4 the reference itself is only 55.9 dB (Duck, interior pixels,
+//! mean of the three views) from the same render at 16 — hardware trilinear picks its level
+//! from the supersample's footprint, so the box-filtered pixel is blurred once more — and the
+//! rows above ~55 dB measured that blur, not the conversion (docs/ADAPTIVE.md, "Why the
+//! figures saturated"). At 8 the reference is 65.2 dB from 16.
 
 use std::path::Path;
 use std::time::Instant;
@@ -26,8 +33,11 @@ use crate::render::{DrawItem, FilterMode, Gpu, RenderSettings, Shading};
 
 use super::BenchRenderError;
 
-/// Supersampling factor per axis of both renders.
+/// Supersampling factor per axis of both renders in `bench trade`.
 pub const SUPERSAMPLE: u32 = 4;
+
+/// Supersampling factor per axis of both renders in `bench adaptive` (module docs).
+pub const ADAPTIVE_SUPERSAMPLE: u32 = 16;
 
 /// One measured conversion.
 #[derive(Debug, Clone, PartialEq)]
@@ -46,6 +56,8 @@ pub struct AdaptiveRow {
     pub psnr_db: Vec<f64>,
     /// Face resolutions: smallest and largest.
     pub resolution_range: (u32, u32),
+    /// Supersampling per axis of both renders.
+    pub supersample: u32,
 }
 
 impl AdaptiveRow {
@@ -79,12 +91,13 @@ impl AdaptiveRow {
             "psnr_db_per_view": self.psnr_db,
             "resolution_min": self.resolution_range.0,
             "resolution_max": self.resolution_range.1,
+            "supersample": self.supersample,
         })
     }
 }
 
-/// Measures every rule in `rules` on `scene` (read from `path`), `size`² images, `views`
-/// cameras; with `budget_max`, each uniform `R ≥ 4` is followed by the budget allocation
+/// Measures every rule in `rules` on `scene` (read from `path`), `size`² images supersampled
+/// `supersample`² (module docs), `views` cameras; with `budget_max`, each uniform `R ≥ 4` is followed by the budget allocation
 /// (capped at `budget_max`) given a third of its samples. Fails when the scene has no
 /// base-colour texture (no reference).
 pub fn bench_adaptive(
@@ -94,6 +107,7 @@ pub fn bench_adaptive(
     budget_max: Option<Resolution>,
     size: u32,
     views: u32,
+    supersample: u32,
 ) -> Result<Vec<AdaptiveRow>, BenchRenderError> {
     let gpu = Gpu::new_headless()?;
     let baseline = gpu
@@ -112,7 +126,8 @@ pub fn bench_adaptive(
     let references: Vec<RgbaImage> = cameras
         .iter()
         .map(|&camera| {
-            render_supersampled(&gpu, DrawItem::Baseline(&baseline), &settings(camera), size).map(|s| s.image)
+            render_supersampled_by(&gpu, DrawItem::Baseline(&baseline), &settings(camera), size, supersample)
+                .map(|s| s.image)
         })
         .collect::<Result<_, _>>()?;
     let mut rows: Vec<AdaptiveRow> = Vec::new();
@@ -126,7 +141,8 @@ pub fn bench_adaptive(
         let mesh = gpu.upload(&packed)?;
         let mut psnr_db = Vec::new();
         for (camera, reference) in cameras.iter().zip(&references) {
-            let image = render_supersampled(&gpu, DrawItem::MeshColors(&mesh), &settings(*camera), size)?.image;
+            let image =
+                render_supersampled_by(&gpu, DrawItem::MeshColors(&mesh), &settings(*camera), size, supersample)?.image;
             psnr_db.push(psnr(reference, &image));
         }
         let resolutions = document.store.face_resolutions();
@@ -148,6 +164,7 @@ pub fn bench_adaptive(
             convert_seconds,
             psnr_db,
             resolution_range: range,
+            supersample: supersample.max(1),
         });
     }
     Ok(rows)
@@ -181,27 +198,40 @@ pub fn render_supersampled(
     settings: &RenderSettings,
     size: u32,
 ) -> Result<Supersampled, crate::render::RenderError> {
-    let big = size * SUPERSAMPLE;
-    Ok(box_down(&gpu.render_image(item, settings, big, big)?))
+    render_supersampled_by(gpu, item, settings, size, SUPERSAMPLE)
 }
 
-/// Box filter `SUPERSAMPLE × SUPERSAMPLE` (in 8-bit sRGB values, alpha averaged too).
-fn box_down(image: &RgbaImage) -> Supersampled {
-    let (w, h) = (image.width() / SUPERSAMPLE, image.height() / SUPERSAMPLE);
+/// Renders `item` at `size · supersample` per side (`supersample` at least 1) and
+/// box-filters it to `size × size`.
+pub fn render_supersampled_by(
+    gpu: &Gpu,
+    item: DrawItem<'_>,
+    settings: &RenderSettings,
+    size: u32,
+    supersample: u32,
+) -> Result<Supersampled, crate::render::RenderError> {
+    let supersample = supersample.max(1);
+    let big = size * supersample;
+    Ok(box_down(&gpu.render_image(item, settings, big, big)?, supersample))
+}
+
+/// Box filter `factor × factor` (in 8-bit sRGB values, alpha averaged too).
+fn box_down(image: &RgbaImage, factor: u32) -> Supersampled {
+    let (w, h) = (image.width() / factor, image.height() / factor);
     let mut interior = vec![false; w as usize * h as usize];
     let image = RgbaImage::from_fn(w, h, |x, y| {
         let mut sum = [0u32; 4];
         let mut covered = 0;
-        for dy in 0..SUPERSAMPLE {
-            for dx in 0..SUPERSAMPLE {
-                let p = image.get_pixel(x * SUPERSAMPLE + dx, y * SUPERSAMPLE + dy).0;
+        for dy in 0..factor {
+            for dx in 0..factor {
+                let p = image.get_pixel(x * factor + dx, y * factor + dy).0;
                 for c in 0..4 {
                     sum[c] += u32::from(p[c]);
                 }
                 covered += u32::from(p[3] > 0);
             }
         }
-        let n = SUPERSAMPLE * SUPERSAMPLE;
+        let n = factor * factor;
         interior[y as usize * w as usize + x as usize] = covered == n;
         image::Rgba(sum.map(|s| ((s + n / 2) / n) as u8))
     });
@@ -236,6 +266,18 @@ pub fn psnr_over(a: &RgbaImage, b: &RgbaImage, mask: &[bool]) -> f64 {
 /// Texels the UV islands of `scene` cover in their base-colour textures (per texture, UVs
 /// wrapped; texels several faces cover count once), summed over the textures.
 pub fn uv_island_texels(scene: &Scene) -> u64 {
+    uv_texels(scene, |faces, size| crate::io::bake_uv::uv_island_texels(faces, size))
+}
+
+/// Texels the faces of `scene` show: as [`uv_island_texels`], but a texel counts once per
+/// face that maps it ([`crate::io::bake_uv::uv_face_texels`]); larger where UV islands
+/// overlap (BoxTextured: each of the 6 sides maps the whole texture).
+pub fn uv_face_texels(scene: &Scene) -> u64 {
+    uv_texels(scene, |faces, size| crate::io::bake_uv::uv_face_texels(faces, size))
+}
+
+/// `count(faces of each base-colour texture, its size)` summed over the textures.
+fn uv_texels(scene: &Scene, count: impl Fn(Vec<&[[f32; 2]; 3]>, [u32; 2]) -> u64) -> u64 {
     let welded = crate::mesh::weld::weld_scene(scene);
     let texture_of = |material: &Option<u32>| {
         material.and_then(|m| scene.materials.get(m as usize)).and_then(|m| m.base_color_texture)
@@ -250,8 +292,9 @@ pub fn uv_island_texels(scene: &Scene) -> u64 {
                 .iter()
                 .zip(&welded.triangle_materials)
                 .filter(|(_, material)| texture_of(material) == Some(index as u32))
-                .map(|(uvs, _)| uvs);
-            crate::io::bake_uv::uv_island_texels(faces, [texture.width, texture.height])
+                .map(|(uvs, _)| uvs)
+                .collect::<Vec<_>>();
+            count(faces, [texture.width, texture.height])
         })
         .sum()
 }

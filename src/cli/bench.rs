@@ -74,12 +74,16 @@ pub(super) enum BenchCommand {
         /// The largest R the adaptive rules give.
         #[arg(long, default_value_t = 64)]
         max_resolution: u64,
-        /// Image size (each view is rendered at 4× and box-filtered).
+        /// Image size (each view is rendered at --supersample × and box-filtered).
         #[arg(long, default_value_t = 256)]
         size: u32,
         /// Camera views around the model.
         #[arg(long, default_value_t = 3)]
         views: u32,
+        /// Supersampling per axis of both renders (the reference converges with it; see
+        /// docs/ADAPTIVE.md).
+        #[arg(long, default_value_t = meshpaint::bench::adaptive::ADAPTIVE_SUPERSAMPLE)]
+        supersample: u32,
     },
     /// What every choice costs and buys: filter × resolution (uniform R 1…32 and --error
     /// bounds) × colour format, per view at several distances — PSNR, max error, FLIP against a
@@ -185,11 +189,12 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             }
             Ok(())
         }
-        BenchCommand::Adaptive { file, max_resolution, size, views } => {
+        BenchCommand::Adaptive { file, max_resolution, size, views, supersample } => {
             let max = meshpaint::colors::layout::Resolution::new(max_resolution).context("--max-resolution")?;
             let scene = meshpaint::mesh::import::import_gltf(&file)?;
             let rules = meshpaint::bench::adaptive::default_rules(max);
-            let rows = meshpaint::bench::adaptive::bench_adaptive(&file, &scene, &rules, Some(max), size, views)?;
+            let rows =
+                meshpaint::bench::adaptive::bench_adaptive(&file, &scene, &rules, Some(max), size, views, supersample)?;
             for row in &rows {
                 let mut value = row.to_json();
                 value["bench"] = "adaptive".into();
@@ -198,6 +203,7 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             }
             let texels = meshpaint::bench::adaptive::uv_island_texels(&scene);
             let mut summary = meshpaint::bench::adaptive::summary(&rows, texels);
+            summary["uv_face_texels"] = meshpaint::bench::adaptive::uv_face_texels(&scene).into();
             summary["bench"] = "adaptive-summary".into();
             summary["file"] = file.display().to_string().into();
             println!("{summary}");

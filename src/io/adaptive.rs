@@ -16,7 +16,10 @@
 //! times the base-colour factor), and reconstructed with the linear filter (eq. 2.4) at
 //! the centroids of the `D²` sub-triangles of a denser lattice `D` — the *test points*,
 //! `D` = twice the smallest power of two ≥ the face's longest UV edge in texels, at least
-//! 8 and at most `2·max`, so every texel the face covers holds several points. The truth
+//! 8, at least `2R` and at most `2·max`, so every texel the face covers holds several
+//! points and so does every strip one sample spacing wide along an edge (where a UV seam's
+//! foreign colours fade out: with `D` from the texture alone, faces under a texel were
+//! tested on a lattice of 8 at every `R`, and at `R ≥ 32` the strip held no point). The truth
 //! at a test point is the texture's level 0 read bilinearly there (what a magnified UV
 //! render shows) times the factor. The error is the **root mean square** of the
 //! differences over the test points and the four channels, the colour channels compared
@@ -332,7 +335,7 @@ pub fn bake_and_verify(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene,
                 }
                 let uvs = mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
                 let fit = FaceFit::new(&materials, face, shared[face], &pyramids, uvs, max);
-                fit.error_of(|bary| sample(shown, face as u32, bary, Filter::Linear, 0).unwrap_or([0.0; 4]))
+                fit.error_of(r, |bary| sample(shown, face as u32, bary, Filter::Linear, 0).unwrap_or([0.0; 4]))
                     > bound.max(ROUNDING)
             })
             .map(|face| face as u32)
@@ -411,7 +414,10 @@ struct FaceFit<'a> {
     material: &'a FaceMaterial,
     pyramids: &'a [Option<crate::io::bake::TexturePyramid>],
     uvs: [[f32; 2]; 3],
-    /// Barycentrics of the test points and the truth there.
+    /// The test lattice from the texture alone: twice the face's longest UV edge in
+    /// texels (a power of two), at least 8, at most `2·max`.
+    dense: u32,
+    /// Barycentrics of the test points of `dense` and the truth there.
     points: Vec<([f32; 3], Rgba)>,
 }
 
@@ -427,9 +433,36 @@ impl<'a> FaceFit<'a> {
         let material = &materials[face];
         let texels = power_of_two_at_least(material.longest_uv_edge_texels, Resolution::MAX).get();
         let dense = (2 * texels).clamp(8, 2 * max.get());
+        let mut fit = FaceFit { materials, shared, material, pyramids, uvs, dense, points: Vec::new() };
+        fit.points = fit.test_points(dense);
+        fit
+    }
+
+    /// The test points for a face shown at `r`: those of `dense`, or of `2·r` when that is
+    /// finer, so that every strip of one sample spacing along an edge holds test points.
+    /// (With the texture's lattice alone, a face under one texel gets `D = 8`, whose
+    /// centroids lie at least 1/24 of the face from each edge, and at `R ≥ 32` the strip
+    /// where a UV seam's foreign edge colours fade out — 1/R wide — held none: the fit
+    /// saw no error there, random points did, docs/ADAPTIVE.md.)
+    fn points_for(&self, r: Resolution) -> std::borrow::Cow<'_, [([f32; 3], Rgba)]> {
+        let wanted = 2 * r.get();
+        if wanted <= self.dense {
+            std::borrow::Cow::Borrowed(&self.points)
+        } else {
+            std::borrow::Cow::Owned(self.test_points(wanted))
+        }
+    }
+
+    /// The centroids of the `dense²` sub-triangles of a lattice `dense` and the truth there
+    /// (the texture's level 0 read bilinearly, times the factor).
+    fn test_points(&self, dense: u32) -> Vec<([f32; 3], Rgba)> {
         let n = dense as f32;
-        let level0 =
-            material.texture.and_then(|t| pyramids.get(t)).and_then(Option::as_ref).and_then(|p| p.levels().first());
+        let material = self.material;
+        let level0 = material
+            .texture
+            .and_then(|t| self.pyramids.get(t))
+            .and_then(Option::as_ref)
+            .and_then(|p| p.levels().first());
         let mut points = Vec::with_capacity((dense * dense) as usize);
         for j in 0..dense {
             for i in 0..dense - j {
@@ -440,22 +473,24 @@ impl<'a> FaceFit<'a> {
                 }
                 for (cu, cv) in centroids {
                     let bary = [(n - cu - cv) / n, cu / n, cv / n];
-                    let uv = interpolate_uv(uvs, bary);
+                    let uv = interpolate_uv(self.uvs, bary);
                     let texel = level0.map_or([1.0; 4], |level| level.sample_bilinear(uv));
                     points.push((bary, std::array::from_fn(|c| material.factor[c] * texel[c])));
                 }
             }
         }
-        FaceFit { materials, shared, material, pyramids, uvs, points }
+        points
     }
 
-    /// The error (module docs) of the colours `shown` returns at the test points.
-    fn error_of(&self, shown: impl Fn([f32; 3]) -> Rgba) -> f32 {
+    /// The error (module docs) of the colours `shown` returns at the test points of a face
+    /// shown at `r`.
+    fn error_of(&self, r: Resolution, shown: impl Fn([f32; 3]) -> Rgba) -> f32 {
+        let points = self.points_for(r);
         let mut sum = 0.0f64;
-        for (bary, truth) in &self.points {
+        for (bary, truth) in points.iter() {
             sum += difference(shown(*bary), *truth);
         }
-        (sum / (4 * self.points.len().max(1)) as f64).sqrt() as f32
+        (sum / (4 * points.len().max(1)) as f64).sqrt() as f32
     }
 
     /// The colour baked at lattice point `(i, j)` of resolution `res`: corners and edge
@@ -501,8 +536,9 @@ impl<'a> FaceFit<'a> {
                 lattice.push(self.lattice_color(i, j, res));
             }
         }
+        let points = self.points_for(r);
         let mut sum = 0.0f64;
-        for (bary, truth) in &self.points {
+        for (bary, truth) in points.iter() {
             let mut shown = [0.0f32; 4];
             for s in layout::linear_samples(r, *bary) {
                 let color = lattice[row(s.j) + s.i as usize];
@@ -512,7 +548,7 @@ impl<'a> FaceFit<'a> {
             }
             sum += difference(shown, *truth);
         }
-        (sum / (4 * self.points.len().max(1)) as f64).sqrt() as f32
+        (sum / (4 * points.len().max(1)) as f64).sqrt() as f32
     }
 }
 

@@ -24,11 +24,19 @@
 //! sample is read trilinearly at
 //!
 //! ```text
-//! lod = log2( max(1, longest UV edge of the owner face in texels / R) )
+//! lod = log2( max(1, second-longest UV edge of the owner face in texels / R) )
 //! ```
 //!
 //! where `R` is the resolution the sample lives at (the face's, or the edge's for edge
-//! samples). Pyramids are built once per texture and only for textures in use.
+//! samples). `edge / R` is the lattice's spacing along that edge; the second-longest edge
+//! is the longer vector of the lattice's reduced basis (a right triangle's lattice is a
+//! square grid of its legs' spacing; a sliver's lattice is fine across and coarse along
+//! it, and its second-longest edge is one of the two long ones), which is what a GPU's
+//! isotropic level takes: the larger of the two axes' footprints. The longest edge (the
+//! rule before) is √2 too coarse on right triangles — a 0.5-level blur that cost
+//! BoxTextured's faces (every one a right triangle carrying the whole texture) about 1 dB
+//! at R = 256 (docs/ADAPTIVE.md). Pyramids are built once per texture and only for
+//! textures in use.
 
 use crate::colors::format::{Rgba, srgb_to_linear};
 use crate::colors::store::{ColorStore, SampleRef, SampleSite};
@@ -207,6 +215,9 @@ pub(crate) struct FaceMaterial {
     pub(crate) texture: Option<usize>,
     /// Longest UV edge of the face in texels of level 0 (0 without a texture).
     pub(crate) longest_uv_edge_texels: f32,
+    /// Second-longest UV edge of the face in texels of level 0 (0 without a texture): the
+    /// lattice spacing at `R` is this over `R` (module docs, Filtering).
+    pub(crate) spacing_uv_edge_texels: f32,
 }
 
 /// Each face's material (by face id, `face_count` of them) and the pyramids of the
@@ -223,7 +234,12 @@ pub(crate) fn face_materials(
             let material =
                 mesh.triangle_materials.get(face).copied().flatten().and_then(|m| scene.materials.get(m as usize));
             let Some(material) = material else {
-                return FaceMaterial { factor: [1.0; 4], texture: None, longest_uv_edge_texels: 0.0 };
+                return FaceMaterial {
+                    factor: [1.0; 4],
+                    texture: None,
+                    longest_uv_edge_texels: 0.0,
+                    spacing_uv_edge_texels: 0.0,
+                };
             };
             let texture = material.base_color_texture.map(|t| t as usize).filter(|&t| {
                 let Some(slot) = pyramids.get_mut(t) else {
@@ -231,14 +247,19 @@ pub(crate) fn face_materials(
                 };
                 slot.get_or_insert_with(|| scene.textures.get(t).and_then(TexturePyramid::new)).is_some()
             });
-            let longest = match (texture, mesh.corner_uvs.get(face)) {
+            let [_, second, longest] = match (texture, mesh.corner_uvs.get(face)) {
                 (Some(t), Some(uvs)) => {
                     let (w, h) = scene.textures.get(t).map_or((0, 0), |tex| (tex.width, tex.height));
-                    longest_uv_edge_texels(*uvs, w, h)
+                    uv_edges_texels(*uvs, w, h)
                 }
-                _ => 0.0,
+                _ => [0.0; 3],
             };
-            FaceMaterial { factor: material.base_color_factor, texture, longest_uv_edge_texels: longest }
+            FaceMaterial {
+                factor: material.base_color_factor,
+                texture,
+                longest_uv_edge_texels: longest,
+                spacing_uv_edge_texels: second,
+            }
         })
         .collect();
     (faces, pyramids.into_iter().map(Option::flatten).collect())
@@ -256,7 +277,7 @@ pub(crate) fn material_color(
     let Some(pyramid) = material.texture.and_then(|t| pyramids.get(t)).and_then(Option::as_ref) else {
         return material.factor;
     };
-    let spacing = material.longest_uv_edge_texels / resolution.max(1) as f32;
+    let spacing = material.spacing_uv_edge_texels / resolution.max(1) as f32;
     let lod = if spacing > 1.0 { spacing.log2() } else { 0.0 };
     let texel = pyramid.sample_trilinear(uv, lod);
     std::array::from_fn(|c| material.factor[c] * texel[c])
@@ -316,15 +337,16 @@ pub(crate) fn interpolate_uv(uvs: [[f32; 2]; 3], w: [f32; 3]) -> [f32; 2] {
     })
 }
 
-/// Longest edge of a UV triangle measured in texels of a `width × height` image.
-fn longest_uv_edge_texels(uvs: [[f32; 2]; 3], width: u32, height: u32) -> f32 {
+/// The edges of a UV triangle measured in texels of a `width × height` image, shortest
+/// first (non-finite lengths read as 0).
+fn uv_edges_texels(uvs: [[f32; 2]; 3], width: u32, height: u32) -> [f32; 3] {
     let (w, h) = (width as f32, height as f32);
-    (0..3)
-        .map(|k| {
-            let (a, b) = (uvs[k], uvs[(k + 1) % 3]);
-            let (du, dv) = ((b[0] - a[0]) * w, (b[1] - a[1]) * h);
-            let length = (du * du + dv * dv).sqrt();
-            if length.is_finite() { length } else { 0.0 }
-        })
-        .fold(0.0, f32::max)
+    let mut edges = [0, 1, 2].map(|k| {
+        let (a, b) = (uvs[k], uvs[(k + 1) % 3]);
+        let (du, dv) = ((b[0] - a[0]) * w, (b[1] - a[1]) * h);
+        let length = (du * du + dv * dv).sqrt();
+        if length.is_finite() { length } else { 0.0 }
+    });
+    edges.sort_by(f32::total_cmp);
+    edges
 }

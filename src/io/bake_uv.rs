@@ -136,6 +136,17 @@ pub fn uv_island_texels<'a>(corner_uvs: impl IntoIterator<Item = &'a [[f32; 2]; 
     covered.iter().filter(|&&c| c).count() as u64
 }
 
+/// Like [`uv_island_texels`], but a texel counts once per face whose UV triangle holds its
+/// centre: the texels the surface shows, where faces that reuse the same texels (a box
+/// whose six sides each map the whole image) count each use.
+pub fn uv_face_texels<'a>(corner_uvs: impl IntoIterator<Item = &'a [[f32; 2]; 3]>, [width, height]: [u32; 2]) -> u64 {
+    let mut count = 0u64;
+    for uvs in corner_uvs {
+        for_each_texel(uvs, [width, height], |_, _| count += 1);
+    }
+    count
+}
+
 /// Calls `visit(texel, barycentric)` for each texel of a `width × height` texture whose
 /// centre lies in the UV triangle `uvs` (texel index wrapped into the texture); false when
 /// it has no area.
