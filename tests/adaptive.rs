@@ -109,7 +109,8 @@ fn error_bound_holds_on_every_face_below_the_cap_and_tighter_bounds_cost_more() 
         // same face. When the test points ignored R (a lattice of 8 on faces under a texel),
         // 0.5–1.1 % of the Duck's faces read over 1.5 E here (the strip of foreign colours
         // along a UV seam, 1/R wide, held no test point; docs/ADAPTIVE.md); with test points
-        // at least 2R per side, 0–7 faces (≤ 0.17 %) do, seen over several runs (the points are random). This fails at the old share.
+        // at least 2R per side, 0–7 faces (≤ 0.17 %) do, seen over several runs (the points
+        // are random). This fails at the old share.
         assert!(over * 400 <= below_cap.len(), "E = {bound}: {over} faces over 1.5 E");
         assert!(document.store.sample_count() > previous_samples, "a tighter bound must not cost less");
         previous_samples = document.store.sample_count();
