@@ -196,6 +196,53 @@ fn each_shared_sample_is_updated_once_in_a_large_dab() {
     each_shared_sample_is_updated_once(16, 1.5, 20_000);
 }
 
+/// A stroke of large dabs (parallel chunks whose undo records become blocks of their own)
+/// at R = 32: every changed sample's element is reported dirty, undo restores the store
+/// before the stroke bit for bit, and redo the store after it.
+#[test]
+fn large_dabs_undo_redo_and_dirty_sets_are_exact() {
+    let scene = Scene::new(icosphere(2), 32, [0.2, 0.3, 0.4, 1.0], 0.0, 0.0);
+    let mut store = scene.store.clone();
+    let before = store.clone();
+    store.take_dirty();
+    let mut painter = Painter::new(&scene.positions);
+    let settings =
+        BrushSettings { strength: 0.7, falloff: Falloff::Smooth, ..plain(Tool::Paint, GREEN, BrushRadius::default()) };
+    painter.set_settings(settings);
+    let mut history = UndoHistory::default();
+    history.begin_step(&store, "stroke").unwrap();
+    let mut covered = 0;
+    for (k, &v) in [0usize, 3, 7].iter().enumerate() {
+        let center = DVec3::from_array(scene.positions[v].map(f64::from));
+        let radius = 0.6 + 0.1 * k as f64;
+        covered += painter.dab_at(&scene.view(None), &mut store, &mut history, center, radius).unwrap().samples_covered;
+    }
+    let summary = history.end_step().unwrap();
+    assert!(covered > 30_000, "{covered} samples covered");
+    let after = store.clone();
+    let dirty = store.take_dirty();
+    let mut all = Vec::new();
+    before.for_each_site(|site| all.push(site.sample));
+    let mut changed = 0u64;
+    for &sample in &all {
+        if bits(before.get(sample).unwrap()) == bits(after.get(sample).unwrap()) {
+            continue;
+        }
+        changed += 1;
+        let reported = match sample {
+            SampleRef::Vertex(v) => dirty.vertices.contains(&v),
+            SampleRef::Edge { edge, .. } => dirty.edges.contains(&edge),
+            SampleRef::Interior { face, .. } => dirty.faces.contains(&face),
+        };
+        assert!(reported, "{sample:?} changed but its element is not dirty");
+    }
+    assert_eq!(summary.samples, changed, "one record per changed sample");
+    assert!(history.undo(&mut store).unwrap());
+    assert!(all.iter().all(|&s| bits(store.get(s).unwrap()) == bits(before.get(s).unwrap())), "undo");
+    assert!(history.redo(&mut store).unwrap());
+    assert!(all.iter().all(|&s| bits(store.get(s).unwrap()) == bits(after.get(s).unwrap())), "redo");
+}
+
 fn each_shared_sample_is_updated_once(resolution: u64, radius: f64, min_covered: u64) {
     // Add with constant weight 1: a sample updated twice would get the colour twice.
     let scene = Scene::new(icosphere(2), resolution, [0.0, 0.0, 0.0, 1.0], 0.0, 0.0);

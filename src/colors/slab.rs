@@ -77,6 +77,44 @@ impl Slab {
         self.chunks.get_mut(slot.chunk as usize)?.get_mut(start..start + slot.len as usize)
     }
 
+    /// The samples of each element of `ids`, all writable at once (for writers that work on
+    /// many elements in parallel). `None` when an id is past the end or listed twice.
+    pub(crate) fn many_mut(&mut self, ids: &[u32]) -> Option<Vec<&mut [Rgba]>> {
+        let mut order = Vec::with_capacity(ids.len());
+        for (position, &id) in ids.iter().enumerate() {
+            let slot = *self.slots.get(id as usize)?;
+            order.push((slot.chunk, slot.start, slot.len, position));
+        }
+        // Empty runs share `Slot::default()`; they need no storage.
+        order.retain(|&(_, _, len, _)| len > 0);
+        order.sort_unstable();
+        let mut out: Vec<&mut [Rgba]> = Vec::with_capacity(ids.len());
+        out.resize_with(ids.len(), || &mut []);
+        let mut chunks = self.chunks.iter_mut().enumerate();
+        // The chunk being split: its index, the part after the last run taken, and where that
+        // part starts.
+        let mut current: Option<(usize, &mut [Rgba], usize)> = None;
+        for (chunk, start, len, position) in order {
+            let (chunk, start, len) = (chunk as usize, start as usize, len as usize);
+            while current.as_ref().is_none_or(|(index, _, _)| *index != chunk) {
+                let (index, data) = chunks.next()?;
+                current = Some((index, data.as_mut_slice(), 0));
+            }
+            let (_, rest, offset) = current.as_mut()?;
+            // A run starting before the end of the previous one: an id listed twice.
+            let skip = start.checked_sub(*offset)?;
+            let tail = std::mem::take(rest);
+            if skip + len > tail.len() {
+                return None;
+            }
+            let (piece, tail) = tail[skip..].split_at_mut(len);
+            *rest = tail;
+            *offset = start + len;
+            *out.get_mut(position)? = piece;
+        }
+        Some(out)
+    }
+
     /// Replaces element `id`'s samples by `samples` (a different count moves the element).
     pub(crate) fn set(&mut self, id: usize, samples: &[Rgba]) {
         let Some(&slot) = self.slots.get(id) else {
@@ -184,5 +222,26 @@ mod tests {
         let held: usize = slab.chunks.iter().map(Vec::len).sum();
         assert!(held as u64 <= 2 * slab.live_samples() + 2 * CHUNK as u64, "dead space bounded");
         assert!(slab.get(truth.len()).is_none());
+        // Many runs at once, in any order, are the runs `get` returns; a repeat is refused.
+        let mut ids: Vec<u32> = (0..truth.len() as u32).filter(|id| id % 3 != 1).collect();
+        ids.reverse();
+        let runs = slab.many_mut(&ids).unwrap();
+        for (run, &id) in runs.into_iter().zip(&ids) {
+            assert_eq!(&*run, truth[id as usize].as_slice(), "element {id}");
+            if let Some(first) = run.first_mut() {
+                *first = [id as f32; 4];
+            }
+        }
+        for &id in &ids {
+            if let Some(first) = truth[id as usize].first_mut() {
+                *first = [id as f32; 4];
+            }
+        }
+        for (id, want) in truth.iter().enumerate() {
+            assert_eq!(slab.get(id).unwrap(), want.as_slice(), "element {id} after many_mut");
+        }
+        let repeated = truth.iter().position(|t| !t.is_empty()).unwrap() as u32;
+        assert!(slab.many_mut(&[repeated, 0, repeated]).is_none());
+        assert!(slab.many_mut(&[truth.len() as u32]).is_none());
     }
 }

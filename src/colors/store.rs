@@ -400,6 +400,41 @@ impl ColorStore {
         written
     }
 
+    /// The samples of each of `elements` (edges and face interiors, each listed once), all
+    /// writable at once, with the topology to read: how a writer changes many elements in
+    /// parallel. `None` when one is listed twice, does not exist, or is `Vertices`. Whoever
+    /// writes through them reports each changed element with [`ColorStore::mark_written`].
+    pub(crate) fn elements_mut(&mut self, elements: &[StoreElement]) -> Option<(&Topology, Vec<&mut [Rgba]>)> {
+        let (mut edges, mut faces) = (Vec::new(), Vec::new());
+        for element in elements {
+            match *element {
+                StoreElement::Vertices => return None,
+                StoreElement::Edge(edge) => edges.push(edge),
+                StoreElement::Interior(face) => faces.push(face),
+            }
+        }
+        let mut edge_runs = self.edge_samples.many_mut(&edges)?.into_iter();
+        let mut face_runs = self.interior_samples.many_mut(&faces)?.into_iter();
+        let runs = elements
+            .iter()
+            .map(|element| match element {
+                StoreElement::Edge(_) => edge_runs.next(),
+                _ => face_runs.next(),
+            })
+            .collect::<Option<Vec<_>>>()?;
+        Some((&self.topology, runs))
+    }
+
+    /// Marks `element` changed (for the GPU upload) after writes through
+    /// [`ColorStore::elements_mut`]; `Vertices` marks nothing (vertices are written one by one).
+    pub(crate) fn mark_written(&mut self, element: StoreElement) {
+        match element {
+            StoreElement::Vertices => {}
+            StoreElement::Edge(edge) => self.dirty_edges.mark(edge),
+            StoreElement::Interior(face) => self.dirty_faces.mark(face),
+        }
+    }
+
     /// The stored sample at face-local lattice point `(i, j)` of `face` at the face's
     /// resolution (edges read with stride when the edge is finer than the face).
     pub fn face_sample_ref(&self, face: u32, i: u32, j: u32) -> Option<SampleRef> {

@@ -24,6 +24,10 @@
 //! one bitset over all vertices, and one per touched edge or face interior, found through a
 //! dense element → slot table. A tool asks the [`StoreWriter`] for an element's
 //! [`ElementWriter`] once per element, which records each write with a bit test and a push.
+//! Tools that write many elements in parallel [`StoreWriter::split`] the writer into one
+//! [`ElementSlice`] per element (its samples and its bitset, disjoint borrows); each parallel
+//! task records into its own [`UndoLog`], and [`StoreWriter::commit`] appends the logs to
+//! the open step and marks the changed elements dirty.
 //!
 //! # One write path
 //!
@@ -52,6 +56,7 @@ use crate::colors::budget::{Budget, BudgetError};
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::Resolution;
 use crate::colors::store::{ColorStore, SampleRef, StoreError};
+use crate::mesh::topology::Topology;
 
 /// The default memory cap of an [`UndoHistory`]: 512 MiB.
 pub const DEFAULT_CAP_BYTES: usize = 512 << 20;
@@ -726,6 +731,71 @@ impl<'a> StoreWriter<'a> {
         ElementWriter { store: self.store, log: self.history.element_log(element, count) }
     }
 
+    /// Splits the writer into one [`ElementSlice`] per element of `elements` (edges and face
+    /// interiors, each listed once), for writes from parallel tasks. `None` when an element is
+    /// listed twice, does not exist or is `Vertices` (write vertices through
+    /// [`StoreWriter::element`]). After the writes, hand the changed elements and the tasks'
+    /// logs to [`StoreWriter::commit`].
+    pub fn split(&mut self, elements: &[Element]) -> Option<Split<'_>> {
+        let recording = self.history.open.is_some();
+        // Every element's bitset slot, made before anything is borrowed.
+        let mut slots = Vec::with_capacity(if recording { elements.len() } else { 0 });
+        if recording {
+            let seen = &mut self.history.seen;
+            for element in elements {
+                let (is_edge, id, count) = match *element {
+                    Element::Vertices => return None,
+                    Element::Edge(edge) => (true, edge, self.store.edge_samples(edge).len()),
+                    Element::Interior(face) => (false, face, self.store.interior_samples(face).len()),
+                };
+                let table_len = if is_edge { seen.edge_slot.len() } else { seen.face_slot.len() };
+                if id as usize >= table_len {
+                    return None;
+                }
+                slots.push(seen.slot(is_edge, id, count));
+            }
+        }
+        let (topology, runs) = self.store.elements_mut(elements)?;
+        let mut bits = if recording {
+            let used = self.history.seen.used.min(self.history.seen.slots.len());
+            pick_mut(&mut self.history.seen.slots[..used], &slots)?
+                .into_iter()
+                .map(|b| Some(b.as_mut_slice()))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        bits.resize_with(elements.len(), || None);
+        let elements = elements
+            .iter()
+            .zip(runs)
+            .zip(bits)
+            .map(|((&element, samples), bits)| ElementSlice { element, samples, bits, changed: 0 })
+            .collect();
+        Some(Split { topology, elements })
+    }
+
+    /// Ends writes through a [`Split`]: marks `changed` elements dirty for the GPU upload and
+    /// appends the tasks' `logs` to the open step.
+    pub fn commit(&mut self, changed: impl IntoIterator<Item = Element>, logs: impl IntoIterator<Item = UndoLog>) {
+        for element in changed {
+            self.store.mark_written(element);
+        }
+        for log in logs.into_iter().filter(|log| !log.is_empty()) {
+            let Some(step) = self.history.open.as_mut() else {
+                return;
+            };
+            // A large log becomes a block of its own (moved, not copied); small ones join
+            // the current block. The order of blocks does not matter: each sample is
+            // recorded once per step.
+            if log.len() >= OWN_BLOCK_RECORDS {
+                step.changes.push(Change::Samples(log.list));
+            } else if let Some(list) = current_samples(&mut self.history.open) {
+                list.extend(log.list);
+            }
+        }
+    }
+
     /// Changes the resolution of `face` (resampling as [`ColorStore::set_face_resolution`]
     /// defines), recording the face's old resolution and the old samples of the face and its
     /// three edges in the open step. Returns whether the resolution changed.
@@ -740,6 +810,129 @@ impl<'a> StoreWriter<'a> {
         self.store.set_face_resolution(face, resolution)?;
         Ok(true)
     }
+}
+
+/// A [`StoreWriter`] split into one writer per element, from [`StoreWriter::split`].
+#[derive(Debug)]
+pub struct Split<'a> {
+    /// The mesh's topology, to read while the elements are borrowed.
+    pub topology: &'a Topology,
+    /// One writer per element, in the order asked for.
+    pub elements: Vec<ElementSlice<'a>>,
+}
+
+/// Old colours recorded by one parallel task of a [`Split`] (handed to [`StoreWriter::commit`]).
+#[derive(Debug, Default)]
+pub struct UndoLog {
+    list: Vec<(SampleRef, Rgba)>,
+    /// Entries reserved at the first record (the samples the task may write).
+    hint: usize,
+}
+
+impl UndoLog {
+    /// A log that reserves room for `samples` records when it records its first.
+    pub fn with_hint(samples: usize) -> Self {
+        UndoLog { list: Vec::new(), hint: samples }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, record: (SampleRef, Rgba)) {
+        if self.list.capacity() == 0 {
+            self.list.reserve(self.hint);
+        }
+        self.list.push(record);
+    }
+
+    /// Samples recorded.
+    pub fn len(&self) -> usize {
+        self.list.len()
+    }
+
+    /// Whether nothing was recorded.
+    pub fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+}
+
+/// The samples of one element and its first-write bitset, writable from a parallel task.
+#[derive(Debug)]
+pub struct ElementSlice<'a> {
+    element: Element,
+    samples: &'a mut [Rgba],
+    /// `None`: no step is open, nothing is recorded.
+    bits: Option<&'a mut [u64]>,
+    changed: u32,
+}
+
+impl ElementSlice<'_> {
+    /// The element.
+    #[inline(always)]
+    pub fn element(&self) -> Element {
+        self.element
+    }
+
+    /// Its samples, to read (storage order).
+    #[inline(always)]
+    pub fn samples(&self) -> &[Rgba] {
+        self.samples
+    }
+
+    /// Writes `new` (clamped as the store holds colours) to sample `index`, recording the old
+    /// colour into `log` on the sample's first write in the step. Returns whether the colour
+    /// changed (`false` when bit-identical or the sample does not exist).
+    #[inline(always)]
+    pub fn write(&mut self, index: u32, new: Rgba, log: &mut UndoLog) -> bool {
+        let Some(slot) = self.samples.get_mut(index as usize) else {
+            return false;
+        };
+        let new = crate::colors::format::clamp_color(new);
+        if !differs(new, *slot) {
+            return false;
+        }
+        if let Some(bits) = self.bits.as_deref_mut() {
+            let (word, bit) = ((index / 64) as usize, 1u64 << (index % 64));
+            if let Some(bits) = bits.get_mut(word)
+                && *bits & bit == 0
+            {
+                *bits |= bit;
+                log.push((self.element.sample(index), *slot));
+            }
+        }
+        *slot = new;
+        self.changed += 1;
+        true
+    }
+
+    /// Samples whose colour [`ElementSlice::write`] changed.
+    pub fn changed(&self) -> u32 {
+        self.changed
+    }
+}
+
+/// Records from which an [`UndoLog`] is kept as its own block of the step.
+const OWN_BLOCK_RECORDS: usize = 1024;
+
+/// Disjoint `&mut` to the items of `items` at `indices` (each listed once; `None` when one is
+/// repeated or past the end), in the order of `indices`.
+fn pick_mut<'a, T>(items: &'a mut [T], indices: &[usize]) -> Option<Vec<&'a mut T>> {
+    let mut order: Vec<(usize, usize)> = indices.iter().copied().zip(0..).collect();
+    order.sort_unstable();
+    let mut out: Vec<Option<&'a mut T>> = Vec::with_capacity(indices.len());
+    out.resize_with(indices.len(), || None);
+    let mut iter = items.iter_mut().enumerate();
+    for (index, position) in order {
+        let item = loop {
+            let (at, item) = iter.next()?;
+            if at == index {
+                break item;
+            }
+            if at > index {
+                return None;
+            }
+        };
+        *out.get_mut(position)? = Some(item);
+    }
+    out.into_iter().collect()
 }
 
 /// Writes the samples of one [`Element`], from [`StoreWriter::element`].

@@ -44,6 +44,69 @@ fn grid_index(res: u32, i: u32, j: u32) -> usize {
     (i * (res + 1) - i * i.saturating_sub(1) / 2 + j) as usize
 }
 
+/// Where the boundary points of one face's lattice are stored: per face edge its edge, the
+/// edge's resolution as a shift over the face's (`r_edge = r << shift`), its samples and
+/// whether the face walks it reversed; per corner its vertex.
+struct Boundary<'a> {
+    corners: [u32; 3],
+    edges: [(u32, u32, &'a [Rgba], bool); 3],
+    res: u32,
+}
+
+impl<'a> Boundary<'a> {
+    /// The boundary of `face` at resolution `res` (`None` when the store disagrees).
+    fn of(store: &'a ColorStore, face: u32, res: u32, corners: [u32; 3], edges: [u32; 3]) -> Option<Self> {
+        let topology = store.topology();
+        let face_log2 = res.trailing_zeros();
+        let mut out = [(0, 0, &[][..], false); 3];
+        for (k, slot) in out.iter_mut().enumerate() {
+            let edge = edges[k];
+            let edge_log2 = store.edge_resolution(edge)?.log2();
+            let shift = edge_log2.checked_sub(face_log2)?;
+            *slot = (edge, shift, store.edge_samples(edge), topology.is_reversed(face, k));
+        }
+        Some(Boundary { corners, edges: out, res })
+    }
+
+    /// The stored sample at boundary point `(i, j)` of the lattice (thesis eq. 2.2 with
+    /// [`crate::colors::layout::classify_sample`]'s conventions: face edge 0 is `j = 0`, 1 is
+    /// `i + j = R`, 2 is `i = 0` walked from corner 2); `None` for interior points.
+    #[inline(always)]
+    fn locate(&self, i: u32, j: u32) -> Option<SampleRef> {
+        let res = self.res;
+        let (k, position) = match (i, j) {
+            (0, 0) => return Some(SampleRef::Vertex(self.corners[0])),
+            (i, 0) if i == res => return Some(SampleRef::Vertex(self.corners[1])),
+            (0, j) if j == res => return Some(SampleRef::Vertex(self.corners[2])),
+            (i, 0) => (0, i),
+            (i, j) if i + j == res => (1, j),
+            (0, j) => (2, res - j),
+            _ => return None,
+        };
+        let (edge, shift, _, reversed) = self.edges[k];
+        let along = position << shift;
+        let offset = if reversed { (res << shift) - along - 1 } else { along - 1 };
+        Some(SampleRef::Edge { edge, offset })
+    }
+
+    /// The colour at boundary point `(i, j)`.
+    #[inline(always)]
+    fn color(&self, store: &ColorStore, i: u32, j: u32) -> Option<Rgba> {
+        match self.locate(i, j)? {
+            SampleRef::Vertex(v) => store.vertex_color(v),
+            SampleRef::Edge { edge: _, offset } => {
+                let k = match (i, j) {
+                    (_, 0) => 0,
+                    (0, _) => 2,
+                    _ => 1,
+                };
+                self.edges[k].2.get(offset as usize).copied()
+            }
+            SampleRef::Interior { .. } => None,
+        }
+    }
+}
+
 /// The blur dab over `scratch.faces` (masks in `scratch.face_masks`).
 pub(super) fn blur_faces<C: Coverage + Sync>(
     coverage: &C,
@@ -144,16 +207,21 @@ fn blur_face<C: Coverage>(
     if all == 0 {
         return;
     }
-    if !gather_lattice(store, face, res, grid) {
+    let Some(boundary) = Boundary::of(store, face, res, corners, edges) else {
+        return;
+    };
+    if !gather_lattice(store, face, &boundary, grid) {
         return;
     }
     let [p0, p1, p2] = corners.map(|v| position(positions, v));
     let inv = 1.0 / f64::from(res);
     let (e1, e2) = ((p1 - p0) * inv, (p2 - p0) * inv);
     let unoccluded = coverage.unoccluded(&[p0, p1, p2], all);
+    let whole = coverage.covers(&[p0, p1, p2], all);
     for i in 0..=res {
         let a = p0 + e1 * f64::from(i);
-        let Some((j0, j1)) = coverage.row_range(a, e2, 0, res - i, all) else {
+        let range = if whole { Some((0, res - i)) } else { coverage.row_range(a, e2, 0, res - i, all) };
+        let Some((j0, j1)) = range else {
             continue;
         };
         for j in j0..=j1 {
@@ -185,7 +253,7 @@ fn blur_face<C: Coverage>(
                 out.interiors.push(Element::Interior(face), index, new);
                 continue;
             }
-            let slot = match store.face_sample_ref(face, i, j) {
+            let slot = match boundary.locate(i, j) {
                 Some(SampleRef::Vertex(v)) => scratch.vertex_slot[v as usize],
                 Some(SampleRef::Edge { edge, offset }) => scratch.edge_slot[edge as usize] + offset,
                 _ => continue,
@@ -232,7 +300,8 @@ fn boundary_sum(grid: &[Rgba], res: u32, i: u32, j: u32) -> (Rgba, u32) {
 /// Gathers the whole lattice of `face` (resolution `res`) into `grid` ([`grid_index`]
 /// order): interior rows copied, boundary points read from the edges and vertices. `false`
 /// when the store does not hold what the face's resolution says.
-fn gather_lattice(store: &ColorStore, face: u32, res: u32, grid: &mut Vec<Rgba>) -> bool {
+fn gather_lattice(store: &ColorStore, face: u32, boundary: &Boundary, grid: &mut Vec<Rgba>) -> bool {
+    let res = boundary.res;
     grid.clear();
     let interior = store.interior_samples(face);
     for i in 0..=res {
@@ -244,7 +313,7 @@ fn gather_lattice(store: &ColorStore, face: u32, res: u32, grid: &mut Vec<Rgba>)
                 grid.extend_from_slice(row);
             }
             if !interior_point {
-                grid.push(store.face_sample(face, i, j).unwrap_or([0.0; 4]));
+                grid.push(boundary.color(store, i, j).unwrap_or([0.0; 4]));
             }
         }
     }

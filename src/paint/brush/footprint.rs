@@ -160,12 +160,18 @@ impl Coverage for Footprint<'_> {
             range = Some(range.map_or((k0, k1), |(r0, r1)| (r0.min(k0), r1.max(k1))));
         }
         let (k0, k1) = range?;
-        let start = k0.floor().max(f64::from(lo));
-        let end = k1.ceil().min(f64::from(hi));
-        if start.is_nan() || end.is_nan() || start > end {
+        // floor(k0) and ceil(k1) clamped to [lo, hi] (NaN clamps to the bound), without a
+        // libm call: above `lo ≥ 0` truncation is the floor.
+        let start = if k0 > f64::from(lo) { k0 as u32 } else { lo };
+        let end = if k1.is_nan() || k1 >= f64::from(hi) {
+            hi
+        } else if k1 < 0.0 {
             return None;
-        }
-        Some((start as u32, end as u32))
+        } else {
+            let t = k1 as u32;
+            if f64::from(t) < k1 { t + 1 } else { t }
+        };
+        (start <= end).then_some((start, end))
     }
 
     #[inline(always)]

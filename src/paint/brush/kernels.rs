@@ -16,7 +16,8 @@ use crate::colors::store::ColorStore;
 use crate::packing::sampler::{self, Filter};
 use rayon::prelude::*;
 
-use crate::paint::undo::{Element, StoreWriter};
+use crate::mesh::topology::Topology;
+use crate::paint::undo::{Element, ElementSlice, Split, StoreWriter, UndoLog};
 
 use super::footprint::Coverage;
 use super::scratch::{Scratch, accumulate_masks, position, visit_mask};
@@ -122,26 +123,30 @@ struct Kernel<'a, C> {
     positions: &'a [[f32; 3]],
 }
 
+/// Where one element's new colours go: its writer, the task's undo log, and the count of
+/// covered samples.
+struct Out<'s, 'a> {
+    slice: &'s mut ElementSlice<'a>,
+    log: &'s mut UndoLog,
+    covered: &'s mut u64,
+}
+
 impl<C: Coverage> Kernel<'_, C> {
-    /// The new colours of the samples of `row` with a positive weight (`current`: the
-    /// element's stored samples; `base_other(k, old)` is the base colour of point `k` when
-    /// the base holds the element at another resolution, for Erase to base).
+    /// Blends the samples of `row` with a positive weight (`base_other(k, old)` is the base
+    /// colour of point `k` when the base holds the element at another resolution, for Erase
+    /// to base).
     #[inline(always)]
     fn row(
         &self,
-        (element, current, out): (Element, &[Rgba], &mut Runs),
+        out: &mut Out,
         (row, mask, unoccluded): (Row, u8, bool),
         base_same: Option<&[Rgba]>,
         base_other: impl Fn(u32, Rgba) -> Rgba,
     ) {
         if unoccluded {
-            self.row_with((element, current, out), (row, mask), base_same, base_other, |p, mask| {
-                self.coverage.weight_unoccluded(p, mask)
-            });
+            self.row_with(out, (row, mask), base_same, base_other, |p, mask| self.coverage.weight_unoccluded(p, mask));
         } else {
-            self.row_with((element, current, out), (row, mask), base_same, base_other, |p, mask| {
-                self.coverage.weight(p, mask)
-            });
+            self.row_with(out, (row, mask), base_same, base_other, |p, mask| self.coverage.weight(p, mask));
         }
     }
 
@@ -149,7 +154,7 @@ impl<C: Coverage> Kernel<'_, C> {
     #[inline(always)]
     fn row_with(
         &self,
-        (element, current, out): (Element, &[Rgba], &mut Runs),
+        out: &mut Out,
         (row, mask): (Row, u8),
         base_same: Option<&[Rgba]>,
         base_other: impl Fn(u32, Rgba) -> Rgba,
@@ -162,7 +167,7 @@ impl<C: Coverage> Kernel<'_, C> {
         let op = self.op;
         for k in k0..=k1 {
             let index = row.first + k - 1;
-            let Some(&old) = current.get(index as usize) else {
+            let Some(&old) = out.slice.samples().get(index as usize) else {
                 break;
             };
             let w = weight(row.a + row.b * f64::from(k), mask);
@@ -174,15 +179,15 @@ impl<C: Coverage> Kernel<'_, C> {
                 (BlendMode::EraseToBase, None) => base_other(k, old),
                 _ => old,
             };
-            out.push(element, index, op.blend.blend(old, op.color, base, w));
+            *out.covered += 1;
+            out.slice.write(index, op.blend.blend(old, op.color, base, w), out.log);
         }
     }
 
-    /// The new interior colours of `face` (mask `mask`).
-    fn interior(&self, store: &ColorStore, face: u32, mask: u8, out: &mut Runs) {
+    /// Blends the interior samples of `face` (resolution `r`, mask `mask`).
+    fn interior(&self, topology: &Topology, (face, r, mask): (u32, Resolution, u8), out: &mut Out) {
         let op = self.op;
-        let (Some(r), Some(corners)) = (store.face_resolution(face), store.topology().face_vertices.get(face as usize))
-        else {
+        let Some(corners) = topology.face_vertices.get(face as usize) else {
             return;
         };
         let res = r.get();
@@ -195,7 +200,6 @@ impl<C: Coverage> Kernel<'_, C> {
         let base_same = op.base.and_then(|b| (b.face_resolution(face) == Some(r)).then(|| b.interior_samples(face)));
         let whole = self.coverage.covers(&[p0, p1, p2], mask);
         let unoccluded = self.coverage.unoccluded(&[p0, p1, p2], mask);
-        let current = store.interior_samples(face);
         for i in 1..res - 1 {
             let a = p0 + e1 * f64::from(i);
             let range =
@@ -205,15 +209,13 @@ impl<C: Coverage> Kernel<'_, C> {
             };
             let row = Row { a, b: e2, ks, first: (i - 1) * (2 * res - 2 - i) / 2 };
             let base_other = |j: u32, old: Rgba| op.base_on_face(face, r, i, j, old);
-            self.row((Element::Interior(face), current, out), (row, mask, unoccluded), base_same, base_other);
+            self.row(out, (row, mask, unoccluded), base_same, base_other);
         }
     }
 
-    /// The new colours of the samples of `edge` (at the edge's resolution).
-    fn edge(&self, store: &ColorStore, edge: u32, mask: u8, out: &mut Runs) {
-        let (Some(r), Some(&[lo, hi])) =
-            (store.edge_resolution(edge), store.topology().edge_vertices.get(edge as usize))
-        else {
+    /// Blends the samples of `edge` (at the edge's resolution `r`).
+    fn edge(&self, topology: &Topology, (edge, r, mask): (u32, Resolution, u8), out: &mut Out) {
+        let Some(&[lo, hi]) = topology.edge_vertices.get(edge as usize) else {
             return;
         };
         let res = r.get();
@@ -233,41 +235,38 @@ impl<C: Coverage> Kernel<'_, C> {
         let op = self.op;
         let base_same =
             op.base.and_then(|base| (base.edge_resolution(edge) == Some(r)).then(|| base.edge_samples(edge)));
-        let base_other = |k: u32, old: Rgba| base_on_edge(op, store, edge, r, k, old);
+        let base_other = |k: u32, old: Rgba| base_on_edge(op, topology, edge, r, k, old);
         let row = Row { a, b, ks, first: 0 };
         let unoccluded = self.coverage.unoccluded(&[a, end], mask);
-        let current = store.edge_samples(edge);
-        self.row((Element::Edge(edge), current, out), (row, mask, unoccluded), base_same, base_other);
+        self.row(out, (row, mask, unoccluded), base_same, base_other);
     }
 
-    /// The new colour of vertex `v` (mask `mask`).
-    fn vertex(&self, store: &ColorStore, v: u32, mask: u8, out: &mut Runs) {
+    /// The new colour of vertex `v` (mask `mask`) from its colour `old`, `None` outside.
+    fn vertex(&self, v: u32, mask: u8, old: Rgba) -> Option<Rgba> {
         let w = self.coverage.weight(position(self.positions, v), mask);
-        let Some(old) = store.vertex_color(v) else {
-            return;
-        };
-        if w > 0.0 {
-            let op = self.op;
-            let base = match op.blend {
-                BlendMode::EraseToBase => op.base.and_then(|base| base.vertex_color(v)).unwrap_or(old),
-                _ => old,
-            };
-            out.push(Element::Vertices, v, op.blend.blend(old, op.color, base, w));
+        if w <= 0.0 {
+            return None;
         }
+        let op = self.op;
+        let base = match op.blend {
+            BlendMode::EraseToBase => op.base.and_then(|base| base.vertex_color(v)).unwrap_or(old),
+            _ => old,
+        };
+        Some(op.blend.blend(old, op.color, base, w))
     }
 }
 
 /// The base colour at position `k` (from the lower vertex) of `edge` at resolution `r`, sampled
 /// on the edge's first face when the base holds the edge at another resolution.
-fn base_on_edge(op: &PaintOp, store: &ColorStore, edge: u32, r: Resolution, k: u32, fallback: Rgba) -> Rgba {
+fn base_on_edge(op: &PaintOp, topology: &Topology, edge: u32, r: Resolution, k: u32, fallback: Rgba) -> Rgba {
     let Some(base) = op.base else {
         return fallback;
     };
-    let Some(&(face, face_edge)) = store.topology().faces_of_edge(edge).first() else {
+    let Some(&(face, face_edge)) = topology.faces_of_edge(edge).first() else {
         return fallback;
     };
     let t = k as f32 / r.get() as f32;
-    let reversed = store.topology().is_reversed(face, usize::from(face_edge));
+    let reversed = topology.is_reversed(face, usize::from(face_edge));
     let mut bary = [0.0f32; 3];
     let (start, end) = (usize::from(face_edge), (usize::from(face_edge) + 1) % 3);
     // Not reversed: the face edge starts at the lower vertex.
@@ -327,7 +326,9 @@ fn work_list(store: &ColorStore, scratch: &mut Scratch) -> (Vec<(Item, u8)>, u64
 }
 
 /// Paints every sample of the faces in `scratch.faces` (masks in `scratch.face_masks`), each
-/// shared vertex and edge once.
+/// shared vertex and edge once: the edges and face interiors in parallel, each written in
+/// place through its [`ElementSlice`] (no element's new colour depends on another's), then
+/// the vertices.
 pub(super) fn paint_faces<C: Coverage + Sync>(
     coverage: &C,
     op: &PaintOp,
@@ -337,28 +338,57 @@ pub(super) fn paint_faces<C: Coverage + Sync>(
 ) -> DabStats {
     let kernel = Kernel { coverage, op, positions };
     let (work, samples) = work_list(writer.store(), scratch);
-    let store = writer.store();
-    let compute = |chunk: &[(Item, u8)]| {
-        let mut out = Runs::default();
-        for &(item, mask) in chunk {
-            match item {
-                Item::Interior(face) => kernel.interior(store, face, mask, &mut out),
-                Item::Edge(edge) => kernel.edge(store, edge, mask, &mut out),
-                Item::Vertex(v) => kernel.vertex(store, v, mask, &mut out),
-            }
-        }
-        out
-    };
-    let parts: Vec<Runs> = if samples < PARALLEL_MIN_SAMPLES {
-        vec![compute(&work)]
-    } else {
-        work.par_chunks(CHUNK).map(compute).collect()
-    };
     let mut stats = DabStats { faces: scratch.faces.len() as u32, ..DabStats::default() };
-    writer.reserve(parts.iter().map(|part| part.len() as usize).sum());
-    for part in &parts {
-        stats.samples_covered += part.len();
-        stats.samples_changed += part.write(writer);
+    // Edges and interiors with their resolution and mask; vertices apart.
+    let store = writer.store();
+    let (mut elements, mut jobs, mut vertices) = (Vec::with_capacity(work.len()), Vec::new(), Vec::new());
+    for &(item, mask) in &work {
+        let (element, r) = match item {
+            Item::Interior(face) => (Element::Interior(face), store.face_resolution(face)),
+            Item::Edge(edge) => (Element::Edge(edge), store.edge_resolution(edge)),
+            Item::Vertex(v) => {
+                vertices.push((v, mask));
+                continue;
+            }
+        };
+        if let Some(r) = r {
+            elements.push(element);
+            jobs.push((element, r, mask));
+        }
+    }
+    if let Some(split) = writer.split(&elements) {
+        let Split { topology, elements: mut slices } = split;
+        let compute = |(slices, jobs): (&mut [ElementSlice], &[(Element, Resolution, u8)])| {
+            let samples = slices.iter().map(|slice| slice.samples().len()).sum();
+            let (mut log, mut covered) = (UndoLog::with_hint(samples), 0u64);
+            for (slice, &(element, r, mask)) in slices.iter_mut().zip(jobs) {
+                let mut out = Out { slice, log: &mut log, covered: &mut covered };
+                match element {
+                    Element::Interior(face) => kernel.interior(topology, (face, r, mask), &mut out),
+                    Element::Edge(edge) => kernel.edge(topology, (edge, r, mask), &mut out),
+                    Element::Vertices => {}
+                }
+            }
+            (log, covered)
+        };
+        let parts: Vec<(UndoLog, u64)> = if samples < PARALLEL_MIN_SAMPLES {
+            vec![compute((&mut slices, &jobs))]
+        } else {
+            slices.par_chunks_mut(CHUNK).zip(jobs.par_chunks(CHUNK)).map(compute).collect()
+        };
+        let changed: Vec<Element> = slices.iter().filter(|s| s.changed() > 0).map(ElementSlice::element).collect();
+        stats.samples_changed += slices.iter().map(|s| u64::from(s.changed())).sum::<u64>();
+        stats.samples_covered += parts.iter().map(|part| part.1).sum::<u64>();
+        drop(slices);
+        writer.commit(changed, parts.into_iter().map(|part| part.0));
+    }
+    let mut out = writer.element(Element::Vertices);
+    for (v, mask) in vertices {
+        let Some(new) = out.get(v).and_then(|old| kernel.vertex(v, mask, old)) else {
+            continue;
+        };
+        stats.samples_covered += 1;
+        stats.samples_changed += out.update_run(v, 1, |_, _| Some(new));
     }
     stats
 }
