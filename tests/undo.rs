@@ -307,3 +307,94 @@ fn the_generation_counts_changes() {
     assert_eq!(history.generation(), 3);
     assert_eq!(store.vertex_color(3), Some([0.5; 4]));
 }
+
+/// Writes through [`StoreWriter::split`] from parallel tasks: the refused element lists, then
+/// writes to every second sample of many elements (some twice, some bit-identical) against a
+/// map of the expected store; the changed elements are dirty, undo restores the snapshot and
+/// redo the written state, bit for bit.
+#[test]
+fn split_writes_record_once_and_undo_exactly() {
+    use meshpaint::paint::undo::{Element, StoreWriter, UndoLog};
+    use rayon::prelude::*;
+    let (positions, triangles) = uv_sphere(12, 16);
+    let mut store = random_store(&triangles, positions.len() as u32);
+    let before = snapshot(&store);
+    let mut history = UndoHistory::default();
+    history.begin_step(&store, "split").unwrap();
+    let topology = store.topology().clone();
+    let mut elements: Vec<Element> = (0..topology.face_count()).map(Element::Interior).collect();
+    elements.extend((0..topology.edge_count()).map(Element::Edge));
+    elements.reverse();
+    let mut writer = StoreWriter::new(&mut store, &mut history);
+    assert!(writer.split(&[Element::Edge(0), Element::Vertices]).is_none(), "vertices are refused");
+    assert!(writer.split(&[Element::Edge(3), Element::Interior(0), Element::Edge(3)]).is_none(), "a repeat");
+    assert!(writer.split(&[Element::Edge(topology.edge_count())]).is_none(), "past the end");
+    // The expected colours, written by hand from the snapshot.
+    let mut expected: std::collections::HashMap<SampleRef, [u32; 4]> = before.samples.iter().copied().collect();
+    let new_color = |sample: SampleRef| -> Rgba {
+        let id = match sample {
+            SampleRef::Edge { edge, offset } => edge * 7 + offset,
+            SampleRef::Interior { face, offset } => face * 5 + offset,
+            SampleRef::Vertex(v) => v,
+        };
+        [(id % 13) as f32 / 13.0, 0.5, 0.25, 1.0]
+    };
+    let mut changed_elements = std::collections::HashSet::new();
+    for &element in &elements {
+        let count = match element {
+            Element::Edge(edge) => writer.store().edge_samples(edge).len(),
+            Element::Interior(face) => writer.store().interior_samples(face).len(),
+            Element::Vertices => 0,
+        };
+        for index in (0..count as u32).step_by(2) {
+            let sample = element.sample(index);
+            let old = expected[&sample];
+            let new = new_color(sample).map(f32::to_bits);
+            if new != old {
+                changed_elements.insert(element);
+            }
+            expected.insert(sample, new);
+        }
+    }
+    let split = writer.split(&elements).unwrap();
+    let mut slices = split.elements;
+    let logs: Vec<UndoLog> = slices
+        .par_chunks_mut(7)
+        .map(|slices| {
+            let mut log = UndoLog::default();
+            for slice in slices.iter_mut() {
+                let element = slice.element();
+                for index in (0..slice.samples().len() as u32).step_by(2) {
+                    // Twice: the second write changes nothing and records nothing.
+                    let color = new_color(element.sample(index));
+                    slice.write(index, color, &mut log);
+                    assert!(!slice.write(index, color, &mut log));
+                }
+            }
+            log
+        })
+        .collect();
+    let changed: Vec<Element> = slices.iter().filter(|s| s.changed() > 0).map(|s| s.element()).collect();
+    drop(slices);
+    writer.commit(changed, logs);
+    let dirty = store.take_dirty();
+    for element in &changed_elements {
+        let reported = match *element {
+            Element::Edge(edge) => dirty.edges.contains(&edge),
+            Element::Interior(face) => dirty.faces.contains(&face),
+            Element::Vertices => true,
+        };
+        assert!(reported, "{element:?} changed but is not dirty");
+    }
+    let written = snapshot(&store);
+    for (sample, bits) in &written.samples {
+        assert_eq!(*bits, expected[sample], "{sample:?}");
+    }
+    let summary = history.end_step().unwrap();
+    let differing = before.samples.iter().zip(&written.samples).filter(|(a, b)| a.1 != b.1).count() as u64;
+    assert_eq!(summary.samples, differing, "one record per changed sample");
+    assert!(history.undo(&mut store).unwrap());
+    assert!(snapshot(&store) == before, "undo");
+    assert!(history.redo(&mut store).unwrap());
+    assert!(snapshot(&store) == written, "redo");
+}

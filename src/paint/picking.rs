@@ -426,8 +426,11 @@ impl MeshBvh {
             let Some(&face) = self.faces.get(primitive as usize) else {
                 return;
             };
+            // A corner inside decides without the closest point (most faces of a large
+            // brush); otherwise the closest point does.
             if let Some(corners) = self.corner_positions(face)
-                && (closest_point_on_triangle(c_rel, corners) - c_rel).length_squared() <= radius_sq
+                && (corners.iter().any(|&c| (c - c_rel).length_squared() <= radius_sq)
+                    || (closest_point_on_triangle(c_rel, corners) - c_rel).length_squared() <= radius_sq)
             {
                 out.push(face);
             }

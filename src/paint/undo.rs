@@ -781,18 +781,21 @@ impl<'a> StoreWriter<'a> {
         for element in changed {
             self.store.mark_written(element);
         }
-        for log in logs.into_iter().filter(|log| !log.is_empty()) {
-            let Some(step) = self.history.open.as_mut() else {
-                return;
-            };
-            // A large log becomes a block of its own (moved, not copied); small ones join
-            // the current block. The order of blocks does not matter: each sample is
-            // recorded once per step.
-            if log.len() >= OWN_BLOCK_RECORDS {
-                step.changes.push(Change::Samples(log.list));
-            } else if let Some(list) = current_samples(&mut self.history.open) {
+        // Small logs join the current block; a large one becomes a block of its own (moved,
+        // not copied). The order of blocks does not matter: each sample is recorded once per
+        // step.
+        let (small, large): (Vec<UndoLog>, Vec<UndoLog>) =
+            logs.into_iter().filter(|log| !log.is_empty()).partition(|log| log.len() < OWN_BLOCK_RECORDS);
+        if !small.is_empty()
+            && let Some(list) = current_samples(&mut self.history.open)
+        {
+            list.reserve(small.iter().map(UndoLog::len).sum());
+            for log in small {
                 list.extend(log.list);
             }
+        }
+        if let Some(step) = self.history.open.as_mut() {
+            step.changes.extend(large.into_iter().map(|log| Change::Samples(log.list)));
         }
     }
 
@@ -910,7 +913,7 @@ impl ElementSlice<'_> {
 }
 
 /// Records from which an [`UndoLog`] is kept as its own block of the step.
-const OWN_BLOCK_RECORDS: usize = 1024;
+const OWN_BLOCK_RECORDS: usize = 256;
 
 /// Disjoint `&mut` to the items of `items` at `indices` (each listed once; `None` when one is
 /// repeated or past the end), in the order of `indices`.

@@ -9,14 +9,15 @@
 //! the store only). A face's interior is only ever read by the face itself, so its new
 //! colours are final; samples on edges and vertices belong to several faces, so each face
 //! returns its sums for them, which are accumulated per element (one slot per edge sample
-//! and vertex, found through a per-dab element → slot table). Then everything is written,
-//! in the faces' order, through the [`StoreWriter`].
+//! and vertex, found through a per-dab element → slot table). Then the interiors and the
+//! edges are written in parallel, each in place through its [`ElementSlice`] from
+//! [`StoreWriter::split`], and the vertices last.
 
 use rayon::prelude::*;
 
 use crate::colors::format::Rgba;
 use crate::colors::store::{ColorStore, SampleRef};
-use crate::paint::undo::{Element, StoreWriter};
+use crate::paint::undo::{Element, ElementSlice, Split, StoreWriter, UndoLog};
 
 use super::footprint::Coverage;
 use super::kernels::{DabStats, PARALLEL_MIN_SAMPLES, Runs};
@@ -136,7 +137,6 @@ pub(super) fn blur_faces<C: Coverage + Sync>(
     };
     for part in &parts {
         stats.samples_covered += part.interiors.len();
-        stats.samples_changed += part.interiors.write(writer);
         for &(slot, sum, count, weight) in &part.shared {
             if let Some(acc) = scratch.blur_acc.get_mut(slot as usize) {
                 for (total, channel) in acc.sum.iter_mut().zip(sum) {
@@ -147,8 +147,100 @@ pub(super) fn blur_faces<C: Coverage + Sync>(
             }
         }
     }
-    write_shared(writer, scratch, &mut stats);
+    write_blurred(writer, scratch, &faces, &parts, samples >= PARALLEL_MIN_SAMPLES, &mut stats);
     stats
+}
+
+/// Edges per parallel task when writing.
+const EDGE_CHUNK: usize = 128;
+
+/// Writes the dab: the faces' new interiors (`parts`, one per chunk of [`CHUNK`] faces when
+/// `parallel`, else one for all) and the accumulated edge samples in parallel, each element
+/// in place through its [`ElementSlice`], then the vertices (every mean was taken before any
+/// write).
+fn write_blurred(
+    writer: &mut StoreWriter,
+    scratch: &Scratch,
+    faces: &[(u32, u8)],
+    parts: &[FaceSums],
+    parallel: bool,
+    stats: &mut DabStats,
+) {
+    let mut elements: Vec<Element> = faces.iter().map(|&(face, _)| Element::Interior(face)).collect();
+    elements.extend(scratch.blur_edges.iter().map(|&edge| Element::Edge(edge)));
+    if let Some(split) = writer.split(&elements) {
+        let Split { elements: mut slices, .. } = split;
+        let (face_slices, edge_slices) = slices.split_at_mut(faces.len());
+        let interiors = |(slices, part): (&mut [ElementSlice], &FaceSums)| {
+            let mut log = UndoLog::with_hint(part.interiors.len() as usize);
+            part.interiors.apply(slices, &mut log);
+            log
+        };
+        let (acc, edge_slot) = (&scratch.blur_acc, &scratch.edge_slot);
+        let edges = |slices: &mut [ElementSlice]| {
+            let mut log = UndoLog::with_hint(slices.iter().map(|slice| slice.samples().len()).sum());
+            let mut covered = 0u64;
+            for slice in slices.iter_mut() {
+                let Element::Edge(edge) = slice.element() else {
+                    continue;
+                };
+                let first = edge_slot.get(edge as usize).copied().unwrap_or(0) as usize;
+                for k in 0..slice.samples().len() {
+                    let Some(acc) = acc.get(first + k) else {
+                        break;
+                    };
+                    if acc.weight <= 0.0 {
+                        continue;
+                    }
+                    covered += 1;
+                    if acc.count == 0 {
+                        continue;
+                    }
+                    let old = slice.samples()[k];
+                    let mean = acc.sum.map(|s| s / acc.count as f32);
+                    slice.write(k as u32, BlendMode::Mix.blend(old, mean, old, acc.weight), &mut log);
+                }
+            }
+            (log, covered)
+        };
+        let (interior_logs, edge_parts): (Vec<UndoLog>, Vec<(UndoLog, u64)>) = if parallel {
+            rayon::join(
+                || face_slices.par_chunks_mut(CHUNK).zip(parts.par_iter()).map(interiors).collect(),
+                || edge_slices.par_chunks_mut(EDGE_CHUNK).map(edges).collect(),
+            )
+        } else {
+            let chunk = faces.len().max(1);
+            (face_slices.chunks_mut(chunk).zip(parts).map(interiors).collect(), vec![edges(edge_slices)])
+        };
+        stats.samples_covered += edge_parts.iter().map(|part| part.1).sum::<u64>();
+        stats.samples_changed += slices.iter().map(|slice| u64::from(slice.changed())).sum::<u64>();
+        let changed: Vec<Element> =
+            slices.iter().filter(|slice| slice.changed() > 0).map(ElementSlice::element).collect();
+        drop(slices);
+        writer.commit(changed, interior_logs.into_iter().chain(edge_parts.into_iter().map(|part| part.0)));
+    }
+    let mut out = writer.element(Element::Vertices);
+    for &v in &scratch.blur_vertices {
+        let Some(acc) = scratch.vertex_slot.get(v as usize).and_then(|&slot| scratch.blur_acc.get(slot as usize))
+        else {
+            continue;
+        };
+        if acc.weight <= 0.0 {
+            continue;
+        }
+        let Some(old) = out.get(v) else {
+            continue;
+        };
+        stats.samples_covered += 1;
+        if acc.count == 0 {
+            continue;
+        }
+        let mean = acc.sum.map(|s| s / acc.count as f32);
+        let new = BlendMode::Mix.blend(old, mean, old, acc.weight);
+        if out.write(v, old, new) {
+            stats.samples_changed += 1;
+        }
+    }
 }
 
 /// Gives every edge and vertex of the dab's faces its accumulator slots (an edge one per
@@ -224,6 +316,7 @@ fn blur_face<C: Coverage>(
         let Some((j0, j1)) = range else {
             continue;
         };
+        let distance = if unoccluded { coverage.row_distance(a, e2) } else { None };
         for j in j0..=j1 {
             let interior_point = i >= 1 && j >= 1 && i + j < res;
             let mask = match (i, j) {
@@ -238,8 +331,12 @@ fn blur_face<C: Coverage>(
             if mask == 0 {
                 continue;
             }
-            let p = a + e2 * f64::from(j);
-            let weight = if unoccluded { coverage.weight_unoccluded(p, mask) } else { coverage.weight(p, mask) };
+            let k = f64::from(j);
+            let weight = match distance {
+                Some([c0, c1, c2]) => coverage.weight_of_distance_sq(c0 + k * (c1 + k * c2)),
+                None if unoccluded => coverage.weight_unoccluded(a + e2 * k, mask),
+                None => coverage.weight(a + e2 * k, mask),
+            };
             if weight <= 0.0 {
                 continue;
             }
@@ -318,40 +415,4 @@ fn gather_lattice(store: &ColorStore, face: u32, boundary: &Boundary, grid: &mut
         }
     }
     grid.len() == grid_index(res, res, 0) + 1
-}
-
-/// Writes the accumulated edge and vertex samples (every mean was taken before any of them
-/// is written).
-fn write_shared(writer: &mut StoreWriter, scratch: &Scratch, stats: &mut DabStats) {
-    // (element, index of its first sample's slot, samples)
-    let edges = scratch.blur_edges.iter().map(|&edge| (Element::Edge(edge), None, scratch.edge_slot[edge as usize]));
-    let vertices = scratch.blur_vertices.iter().map(|&v| (Element::Vertices, Some(v), scratch.vertex_slot[v as usize]));
-    for (element, vertex, first) in edges.chain(vertices) {
-        let count = match (element, vertex) {
-            (Element::Edge(edge), _) => writer.store().edge_samples(edge).len() as u32,
-            _ => 1,
-        };
-        let mut out = writer.element(element);
-        for k in 0..count {
-            let Some(acc) = scratch.blur_acc.get((first + k) as usize) else {
-                continue;
-            };
-            if acc.weight <= 0.0 {
-                continue;
-            }
-            let index = vertex.unwrap_or(k);
-            let Some(old) = out.get(index) else {
-                continue;
-            };
-            stats.samples_covered += 1;
-            if acc.count == 0 {
-                continue;
-            }
-            let mean = acc.sum.map(|s| s / acc.count as f32);
-            let new = BlendMode::Mix.blend(old, mean, old, acc.weight);
-            if out.write(index, old, new) {
-                stats.samples_changed += 1;
-            }
-        }
-    }
 }

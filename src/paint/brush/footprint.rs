@@ -34,6 +34,18 @@ pub(super) trait Coverage {
     fn weight_unoccluded(&self, p: DVec3, mask: u8) -> f32 {
         self.weight(p, mask)
     }
+    /// The squared distance from the row `a + b·k` to the brush centre as the quadratic
+    /// `c[0] + k·(c[1] + k·c[2])`, when the coverage is one sphere: then the unoccluded weight
+    /// of a row point with a non-zero mask is [`Coverage::weight_of_distance_sq`] of it. `None`
+    /// otherwise (use [`Coverage::weight_unoccluded`]).
+    fn row_distance(&self, _a: DVec3, _b: DVec3) -> Option<[f64; 3]> {
+        None
+    }
+    /// The unoccluded weight at squared distance `d2` from the one sphere's centre (see
+    /// [`Coverage::row_distance`]).
+    fn weight_of_distance_sq(&self, _d2: f64) -> f32 {
+        0.0
+    }
 }
 
 /// How a dab tests occlusion: the depth map of each sphere's eye where one was built
@@ -96,7 +108,12 @@ impl<'a> Footprint<'a> {
     /// The weight for one sphere and no occlusion: the common case, kept small to inline.
     #[inline(always)]
     fn weight_single(&self, p: DVec3) -> f32 {
-        let d2 = (p - self.centers[0]).length_squared();
+        self.weight_single_sq((p - self.centers[0]).length_squared())
+    }
+
+    /// [`Footprint::weight_single`] at squared distance `d2` from the centre.
+    #[inline(always)]
+    fn weight_single_sq(&self, d2: f64) -> f32 {
         if d2.is_nan() || d2 > self.radius_sq {
             return 0.0;
         }
@@ -199,6 +216,19 @@ impl Coverage for Footprint<'_> {
             return if mask & 1 != 0 { self.weight_single(p) } else { 0.0 };
         }
         self.weight_general(p, mask, false)
+    }
+
+    #[inline(always)]
+    fn row_distance(&self, a: DVec3, b: DVec3) -> Option<[f64; 3]> {
+        (self.count == 1).then(|| {
+            let d = a - self.centers[0];
+            [d.length_squared(), 2.0 * d.dot(b), b.length_squared()]
+        })
+    }
+
+    #[inline(always)]
+    fn weight_of_distance_sq(&self, d2: f64) -> f32 {
+        self.weight_single_sq(d2)
     }
 
     #[inline]

@@ -1,12 +1,12 @@
 //! The colour brush's kernels: every stored sample of a dab's faces blended once (interior
-//! rows per face, each shared edge and vertex once), written through the [`StoreWriter`].
+//! rows per face, each shared edge and vertex once).
 //!
-//! A dab runs in two passes. The first lists the dab's elements (each face interior, and
-//! each shared edge and vertex once) and computes their new colours in parallel (rayon over
-//! chunks of the list, reading the store only: no element's new colour depends on another
-//! element's). The second writes them in list order through the [`StoreWriter`], which
-//! records the undo step: one look-up per run of consecutive samples
-//! ([`ElementWriter::update_run`]), an undo bit test per write.
+//! A dab lists its elements (each face interior, and each shared edge and vertex once),
+//! [splits](StoreWriter::split) the writer into one [`ElementSlice`] per edge and interior,
+//! and blends them in parallel (rayon over chunks of the list), each written in place: no
+//! element's new colour depends on another element's. Each task records the undo step's old
+//! colours into its own [`UndoLog`]; the vertices are written last, on the calling thread.
+//! [`Runs`] carry the blur's new interior colours from its compute pass to its write.
 
 use glam::DVec3;
 
@@ -100,19 +100,24 @@ impl Runs {
         self.colors.len() as u64
     }
 
-    /// Writes the new colours through `writer` (in order, recording the undo step). Returns
-    /// the samples that changed.
-    pub(super) fn write(&self, writer: &mut StoreWriter) -> u64 {
-        let mut changed = 0;
+    /// Writes the new colours into `slices` (the elements of the runs, in the runs' order,
+    /// possibly with others between), recording old colours into `log`.
+    pub(super) fn apply(&self, slices: &mut [ElementSlice], log: &mut UndoLog) {
         let mut offset = 0usize;
+        let mut cursor = 0usize;
         for &(element, first, len) in &self.runs {
-            let colors = &self.colors[offset..offset + len as usize];
+            let colors = self.colors.get(offset..offset + len as usize).unwrap_or(&[]);
             offset += len as usize;
-            changed += writer
-                .element(element)
-                .update_run(first, len, |index, _| colors.get((index - first) as usize).copied());
+            while slices.get(cursor).is_some_and(|slice| slice.element() != element) {
+                cursor += 1;
+            }
+            let Some(slice) = slices.get_mut(cursor) else {
+                return;
+            };
+            for (index, &color) in (first..).zip(colors) {
+                slice.write(index, color, log);
+            }
         }
-        changed
     }
 }
 
@@ -143,22 +148,31 @@ impl<C: Coverage> Kernel<'_, C> {
         base_same: Option<&[Rgba]>,
         base_other: impl Fn(u32, Rgba) -> Rgba,
     ) {
-        if unoccluded {
-            self.row_with(out, (row, mask), base_same, base_other, |p, mask| self.coverage.weight_unoccluded(p, mask));
-        } else {
-            self.row_with(out, (row, mask), base_same, base_other, |p, mask| self.coverage.weight(p, mask));
+        let coverage = self.coverage;
+        match (unoccluded, coverage.row_distance(row.a, row.b)) {
+            (true, Some([c0, c1, c2])) if mask != 0 => {
+                let weight = |k: f64| coverage.weight_of_distance_sq(c0 + k * (c1 + k * c2));
+                self.row_with(out, row, base_same, base_other, weight);
+            }
+            (true, _) => {
+                let weight = |k: f64| coverage.weight_unoccluded(row.a + row.b * k, mask);
+                self.row_with(out, row, base_same, base_other, weight);
+            }
+            (false, _) => {
+                self.row_with(out, row, base_same, base_other, |k: f64| coverage.weight(row.a + row.b * k, mask));
+            }
         }
     }
 
-    /// [`Kernel::row`] with the weight function `weight`.
+    /// [`Kernel::row`] with `weight(k)`, the weight of point `k`.
     #[inline(always)]
     fn row_with(
         &self,
         out: &mut Out,
-        (row, mask): (Row, u8),
+        row: Row,
         base_same: Option<&[Rgba]>,
         base_other: impl Fn(u32, Rgba) -> Rgba,
-        weight: impl Fn(DVec3, u8) -> f32,
+        weight: impl Fn(f64) -> f32,
     ) {
         let (k0, k1) = row.ks;
         if k0 > k1 || row.first + k0 == 0 {
@@ -170,7 +184,7 @@ impl<C: Coverage> Kernel<'_, C> {
             let Some(&old) = out.slice.samples().get(index as usize) else {
                 break;
             };
-            let w = weight(row.a + row.b * f64::from(k), mask);
+            let w = weight(f64::from(k));
             if w <= 0.0 {
                 continue;
             }
