@@ -27,7 +27,8 @@ pub const MAX_CHANNEL: f32 = 65504.0;
 /// `[0, 1]`; NaN becomes 0 (so no NaN or infinity is ever stored, encoded or uploaded).
 #[inline(always)]
 pub fn clamp_color(color: Rgba) -> Rgba {
-    let channel = |x: f32, max: f32| if x.is_nan() { 0.0 } else { x.clamp(0.0, max) };
+    // `f32::max` returns the other operand for NaN: NaN becomes 0, with no branch.
+    let channel = |x: f32, max: f32| x.max(0.0).min(max);
     [
         channel(color[0], MAX_CHANNEL),
         channel(color[1], MAX_CHANNEL),

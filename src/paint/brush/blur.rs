@@ -197,7 +197,8 @@ fn write_blurred(
                         continue;
                     }
                     let old = slice.samples()[k];
-                    let mean = acc.sum.map(|s| s / acc.count as f32);
+                    let inv = 1.0 / acc.count as f32;
+                    let mean = acc.sum.map(|s| s * inv);
                     slice.write(k as u32, BlendMode::Mix.blend(old, mean, old, acc.weight), &mut log);
                 }
             }
@@ -235,7 +236,8 @@ fn write_blurred(
         if acc.count == 0 {
             continue;
         }
-        let mean = acc.sum.map(|s| s / acc.count as f32);
+        let inv = 1.0 / acc.count as f32;
+        let mean = acc.sum.map(|s| s * inv);
         let new = BlendMode::Mix.blend(old, mean, old, acc.weight);
         if out.write(v, old, new) {
             stats.samples_changed += 1;
@@ -344,7 +346,8 @@ fn blur_face<C: Coverage>(
                 if interior_point { interior_sum(grid, res, i, j) } else { boundary_sum(grid, res, i, j) };
             if interior_point {
                 let old = grid[grid_index(res, i, j)];
-                let mean = sum.map(|s| s / count as f32);
+                let inv = 1.0 / count as f32;
+                let mean = sum.map(|s| s * inv);
                 let new = BlendMode::Mix.blend(old, mean, old, weight);
                 let index = (i - 1) * (2 * res - 2 - i) / 2 + (j - 1);
                 out.interiors.push(Element::Interior(face), index, new);
