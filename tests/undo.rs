@@ -314,7 +314,8 @@ fn the_generation_counts_changes() {
 /// redo the written state, bit for bit.
 #[test]
 fn split_writes_record_once_and_undo_exactly() {
-    use meshpaint::paint::undo::{Element, StoreWriter, UndoLog};
+    use meshpaint::paint::split::UndoLog;
+    use meshpaint::paint::undo::{Element, StoreWriter};
     use rayon::prelude::*;
     let (positions, triangles) = uv_sphere(12, 16);
     let mut store = random_store(&triangles, positions.len() as u32);

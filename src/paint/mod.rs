@@ -1,10 +1,13 @@
 //! Painting: BVH picking, the brushes and their tools, occlusion by a depth map of the view, optimize (lower R where nothing
-//! visible changes), and undo / redo per stroke.
+//! visible changes), undo / redo per stroke, and parallel writes
+//! through the undo step (`split`).
 
 pub mod brush;
+mod face_state;
 pub mod occlusion;
 pub mod optimize;
 pub mod picking;
+pub mod split;
 pub mod undo;
 
 pub use brush::{BrushSettings, Painter};

@@ -50,98 +50,19 @@
 
 use std::collections::VecDeque;
 
-use thiserror::Error;
-
 use crate::colors::budget::{Budget, BudgetError};
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::Resolution;
 use crate::colors::store::{ColorStore, SampleRef, StoreError};
-use crate::mesh::topology::Topology;
+
+use super::face_state::FaceState;
+pub use super::face_state::UndoError;
 
 /// The default memory cap of an [`UndoHistory`]: 512 MiB.
 pub const DEFAULT_CAP_BYTES: usize = 512 << 20;
 
 /// Bytes of one recorded sample write.
 pub const SAMPLE_RECORD_BYTES: usize = std::mem::size_of::<(SampleRef, Rgba)>();
-
-/// Errors of recording, undoing and redoing.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
-pub enum UndoError {
-    /// [`UndoHistory::begin_step`] while a step is open.
-    #[error("an undo step is already open (end the stroke first)")]
-    StepOpen,
-    /// Undo or redo while a step is open.
-    #[error("cannot undo or redo during a stroke")]
-    Busy,
-    /// The store changed outside the history; the history was cleared.
-    #[error("the colours changed outside the undo history ({0}); the history was cleared")]
-    Mismatch(String),
-    /// The step would take the store past the budget; nothing changed and the step is kept.
-    #[error(transparent)]
-    Budget(#[from] BudgetError),
-    /// The store refused a change.
-    #[error(transparent)]
-    Store(#[from] StoreError),
-}
-
-/// The saved state of one face and its three edges (see the module documentation).
-#[derive(Debug, Clone, PartialEq)]
-struct FaceState {
-    face: u32,
-    resolution: Resolution,
-    interior: Vec<Rgba>,
-    /// `(edge, resolution, samples)` of face edges 0, 1, 2.
-    edges: [(u32, Resolution, Vec<Rgba>); 3],
-}
-
-impl FaceState {
-    fn capture(store: &ColorStore, face: u32) -> Result<Self, UndoError> {
-        let no_face = || StoreError::NoSuchFace { face, face_count: store.topology().face_count() };
-        let resolution = store.face_resolution(face).ok_or_else(no_face)?;
-        let face_edges = *store.topology().face_edges.get(face as usize).ok_or_else(no_face)?;
-        let edge = |edge: u32| -> Result<(u32, Resolution, Vec<Rgba>), UndoError> {
-            let r = store.edge_resolution(edge).ok_or_else(no_face)?;
-            Ok((edge, r, store.edge_samples(edge).to_vec()))
-        };
-        Ok(FaceState {
-            face,
-            resolution,
-            interior: store.interior_samples(face).to_vec(),
-            edges: [edge(face_edges[0])?, edge(face_edges[1])?, edge(face_edges[2])?],
-        })
-    }
-
-    /// Puts the state back: resolution first (which resizes the elements), then samples.
-    fn restore(&self, store: &mut ColorStore) -> Result<(), UndoError> {
-        store.set_face_resolution(self.face, self.resolution)?;
-        for (edge, resolution, _) in &self.edges {
-            if store.edge_resolution(*edge) != Some(*resolution) {
-                return Err(UndoError::Mismatch(format!(
-                    "edge {edge} should be at resolution {resolution} after restoring face {}",
-                    self.face
-                )));
-            }
-        }
-        if store.interior_samples(self.face).len() != self.interior.len() {
-            return Err(UndoError::Mismatch(format!("face {} interior size", self.face)));
-        }
-        for (offset, &color) in (0u32..).zip(&self.interior) {
-            store.set(SampleRef::Interior { face: self.face, offset }, color);
-        }
-        for (edge, _, samples) in &self.edges {
-            for (offset, &color) in (0u32..).zip(samples) {
-                store.set(SampleRef::Edge { edge: *edge, offset }, color);
-            }
-        }
-        Ok(())
-    }
-
-    fn bytes(&self) -> usize {
-        std::mem::size_of::<Self>()
-            + (self.interior.len() + self.edges.iter().map(|(_, _, s)| s.len()).sum::<usize>())
-                * std::mem::size_of::<Rgba>()
-    }
-}
 
 /// One recorded change.
 #[derive(Debug, Clone, PartialEq)]
@@ -328,7 +249,8 @@ impl SeenSamples {
 pub use crate::colors::store::StoreElement as Element;
 
 /// Records first writes to the samples of one element (or to vertices) in the open step;
-/// recording is a bit test and, the first time, a push. Only [`ElementWriter`] records.
+/// recording is a bit test and, the first time, a push. Only [`ElementWriter`] records
+/// through it ([`ElementSlice`] borrows its element's bitset directly).
 #[derive(Debug)]
 struct SampleLog<'a> {
     element: Element,
@@ -574,6 +496,39 @@ impl UndoHistory {
         }
     }
 
+    /// The first-write bitset slot of an edge (`is_edge`) or face interior `id` of `count`
+    /// samples in the open step, made when missing; `None` without an open step or past the
+    /// end of the tables.
+    pub(super) fn bitset_slot(&mut self, is_edge: bool, id: u32, count: usize) -> Option<usize> {
+        let table_len = if is_edge { self.seen.edge_slot.len() } else { self.seen.face_slot.len() };
+        (self.open.is_some() && (id as usize) < table_len).then(|| self.seen.slot(is_edge, id, count))
+    }
+
+    /// The bitsets of `slots` (from [`UndoHistory::bitset_slot`], each listed once), all
+    /// writable at once.
+    pub(super) fn bitsets(&mut self, slots: &[usize]) -> Option<Vec<&mut [u64]>> {
+        let used = self.seen.used.min(self.seen.slots.len());
+        let picked = pick_mut(&mut self.seen.slots[..used], slots)?;
+        Some(picked.into_iter().map(Vec::as_mut_slice).collect())
+    }
+
+    /// Appends recorded sample writes to the open step: `small` lists join its current block,
+    /// each of `large` becomes a block of its own (moved, not copied). Blocks may come in any
+    /// order: each sample is recorded once per step.
+    pub(super) fn append_records(&mut self, small: Vec<Vec<(SampleRef, Rgba)>>, large: Vec<Vec<(SampleRef, Rgba)>>) {
+        if !small.is_empty()
+            && let Some(list) = current_samples(&mut self.open)
+        {
+            list.reserve(small.iter().map(Vec::len).sum());
+            for records in small {
+                list.extend(records);
+            }
+        }
+        if let Some(step) = self.open.as_mut() {
+            step.changes.extend(large.into_iter().map(Change::Samples));
+        }
+    }
+
     /// Records the state of `face` and its edges before a resolution change in the open step
     /// (no-op without one).
     fn record_resolution_change(&mut self, store: &ColorStore, face: u32) -> Result<(), UndoError> {
@@ -671,7 +626,7 @@ impl UndoHistory {
 
 /// Whether two colours differ in any bit (one 128-bit comparison).
 #[inline(always)]
-fn differs(a: Rgba, b: Rgba) -> bool {
+pub(super) fn differs(a: Rgba, b: Rgba) -> bool {
     bytemuck::cast::<Rgba, u128>(a) != bytemuck::cast::<Rgba, u128>(b)
 }
 
@@ -680,8 +635,8 @@ fn differs(a: Rgba, b: Rgba) -> bool {
 /// element dirty for the GPU upload. Borrow one for the duration of a dab, a fill, …
 #[derive(Debug)]
 pub struct StoreWriter<'a> {
-    store: &'a mut ColorStore,
-    history: &'a mut UndoHistory,
+    pub(super) store: &'a mut ColorStore,
+    pub(super) history: &'a mut UndoHistory,
 }
 
 impl<'a> StoreWriter<'a> {
@@ -731,74 +686,6 @@ impl<'a> StoreWriter<'a> {
         ElementWriter { store: self.store, log: self.history.element_log(element, count) }
     }
 
-    /// Splits the writer into one [`ElementSlice`] per element of `elements` (edges and face
-    /// interiors, each listed once), for writes from parallel tasks. `None` when an element is
-    /// listed twice, does not exist or is `Vertices` (write vertices through
-    /// [`StoreWriter::element`]). After the writes, hand the changed elements and the tasks'
-    /// logs to [`StoreWriter::commit`].
-    pub fn split(&mut self, elements: &[Element]) -> Option<Split<'_>> {
-        let recording = self.history.open.is_some();
-        // Every element's bitset slot, made before anything is borrowed.
-        let mut slots = Vec::with_capacity(if recording { elements.len() } else { 0 });
-        if recording {
-            let seen = &mut self.history.seen;
-            for element in elements {
-                let (is_edge, id, count) = match *element {
-                    Element::Vertices => return None,
-                    Element::Edge(edge) => (true, edge, self.store.edge_samples(edge).len()),
-                    Element::Interior(face) => (false, face, self.store.interior_samples(face).len()),
-                };
-                let table_len = if is_edge { seen.edge_slot.len() } else { seen.face_slot.len() };
-                if id as usize >= table_len {
-                    return None;
-                }
-                slots.push(seen.slot(is_edge, id, count));
-            }
-        }
-        let (topology, runs) = self.store.elements_mut(elements)?;
-        let mut bits = if recording {
-            let used = self.history.seen.used.min(self.history.seen.slots.len());
-            pick_mut(&mut self.history.seen.slots[..used], &slots)?
-                .into_iter()
-                .map(|b| Some(b.as_mut_slice()))
-                .collect()
-        } else {
-            Vec::new()
-        };
-        bits.resize_with(elements.len(), || None);
-        let elements = elements
-            .iter()
-            .zip(runs)
-            .zip(bits)
-            .map(|((&element, samples), bits)| ElementSlice { element, samples, bits, changed: 0 })
-            .collect();
-        Some(Split { topology, elements })
-    }
-
-    /// Ends writes through a [`Split`]: marks `changed` elements dirty for the GPU upload and
-    /// appends the tasks' `logs` to the open step.
-    pub fn commit(&mut self, changed: impl IntoIterator<Item = Element>, logs: impl IntoIterator<Item = UndoLog>) {
-        for element in changed {
-            self.store.mark_written(element);
-        }
-        // Small logs join the current block; a large one becomes a block of its own (moved,
-        // not copied). The order of blocks does not matter: each sample is recorded once per
-        // step.
-        let (small, large): (Vec<UndoLog>, Vec<UndoLog>) =
-            logs.into_iter().filter(|log| !log.is_empty()).partition(|log| log.len() < OWN_BLOCK_RECORDS);
-        if !small.is_empty()
-            && let Some(list) = current_samples(&mut self.history.open)
-        {
-            list.reserve(small.iter().map(UndoLog::len).sum());
-            for log in small {
-                list.extend(log.list);
-            }
-        }
-        if let Some(step) = self.history.open.as_mut() {
-            step.changes.extend(large.into_iter().map(|log| Change::Samples(log.list)));
-        }
-    }
-
     /// Changes the resolution of `face` (resampling as [`ColorStore::set_face_resolution`]
     /// defines), recording the face's old resolution and the old samples of the face and its
     /// three edges in the open step. Returns whether the resolution changed.
@@ -813,129 +700,6 @@ impl<'a> StoreWriter<'a> {
         self.store.set_face_resolution(face, resolution)?;
         Ok(true)
     }
-}
-
-/// A [`StoreWriter`] split into one writer per element, from [`StoreWriter::split`].
-#[derive(Debug)]
-pub struct Split<'a> {
-    /// The mesh's topology, to read while the elements are borrowed.
-    pub topology: &'a Topology,
-    /// One writer per element, in the order asked for.
-    pub elements: Vec<ElementSlice<'a>>,
-}
-
-/// Old colours recorded by one parallel task of a [`Split`] (handed to [`StoreWriter::commit`]).
-#[derive(Debug, Default)]
-pub struct UndoLog {
-    list: Vec<(SampleRef, Rgba)>,
-    /// Entries reserved at the first record (the samples the task may write).
-    hint: usize,
-}
-
-impl UndoLog {
-    /// A log that reserves room for `samples` records when it records its first.
-    pub fn with_hint(samples: usize) -> Self {
-        UndoLog { list: Vec::new(), hint: samples }
-    }
-
-    #[inline(always)]
-    fn push(&mut self, record: (SampleRef, Rgba)) {
-        if self.list.capacity() == 0 {
-            self.list.reserve(self.hint);
-        }
-        self.list.push(record);
-    }
-
-    /// Samples recorded.
-    pub fn len(&self) -> usize {
-        self.list.len()
-    }
-
-    /// Whether nothing was recorded.
-    pub fn is_empty(&self) -> bool {
-        self.list.is_empty()
-    }
-}
-
-/// The samples of one element and its first-write bitset, writable from a parallel task.
-#[derive(Debug)]
-pub struct ElementSlice<'a> {
-    element: Element,
-    samples: &'a mut [Rgba],
-    /// `None`: no step is open, nothing is recorded.
-    bits: Option<&'a mut [u64]>,
-    changed: u32,
-}
-
-impl ElementSlice<'_> {
-    /// The element.
-    #[inline(always)]
-    pub fn element(&self) -> Element {
-        self.element
-    }
-
-    /// Its samples, to read (storage order).
-    #[inline(always)]
-    pub fn samples(&self) -> &[Rgba] {
-        self.samples
-    }
-
-    /// Writes `new` (clamped as the store holds colours) to sample `index`, recording the old
-    /// colour into `log` on the sample's first write in the step. Returns whether the colour
-    /// changed (`false` when bit-identical or the sample does not exist).
-    #[inline(always)]
-    pub fn write(&mut self, index: u32, new: Rgba, log: &mut UndoLog) -> bool {
-        let Some(slot) = self.samples.get_mut(index as usize) else {
-            return false;
-        };
-        let new = crate::colors::format::clamp_color(new);
-        if !differs(new, *slot) {
-            return false;
-        }
-        if let Some(bits) = self.bits.as_deref_mut() {
-            let (word, bit) = ((index / 64) as usize, 1u64 << (index % 64));
-            if let Some(bits) = bits.get_mut(word)
-                && *bits & bit == 0
-            {
-                *bits |= bit;
-                log.push((self.element.sample(index), *slot));
-            }
-        }
-        *slot = new;
-        self.changed += 1;
-        true
-    }
-
-    /// Samples whose colour [`ElementSlice::write`] changed.
-    pub fn changed(&self) -> u32 {
-        self.changed
-    }
-}
-
-/// Records from which an [`UndoLog`] is kept as its own block of the step.
-const OWN_BLOCK_RECORDS: usize = 256;
-
-/// Disjoint `&mut` to the items of `items` at `indices` (each listed once; `None` when one is
-/// repeated or past the end), in the order of `indices`.
-fn pick_mut<'a, T>(items: &'a mut [T], indices: &[usize]) -> Option<Vec<&'a mut T>> {
-    let mut order: Vec<(usize, usize)> = indices.iter().copied().zip(0..).collect();
-    order.sort_unstable();
-    let mut out: Vec<Option<&'a mut T>> = Vec::with_capacity(indices.len());
-    out.resize_with(indices.len(), || None);
-    let mut iter = items.iter_mut().enumerate();
-    for (index, position) in order {
-        let item = loop {
-            let (at, item) = iter.next()?;
-            if at == index {
-                break item;
-            }
-            if at > index {
-                return None;
-            }
-        };
-        *out.get_mut(position)? = Some(item);
-    }
-    out.into_iter().collect()
 }
 
 /// Writes the samples of one [`Element`], from [`StoreWriter::element`].
@@ -985,4 +749,27 @@ impl ElementWriter<'_> {
             Some(new)
         })
     }
+}
+
+/// Disjoint `&mut` to the items of `items` at `indices` (each listed once; `None` when one is
+/// repeated or past the end), in the order of `indices`.
+fn pick_mut<'a, T>(items: &'a mut [T], indices: &[usize]) -> Option<Vec<&'a mut T>> {
+    let mut order: Vec<(usize, usize)> = indices.iter().copied().zip(0..).collect();
+    order.sort_unstable();
+    let mut out: Vec<Option<&'a mut T>> = Vec::with_capacity(indices.len());
+    out.resize_with(indices.len(), || None);
+    let mut iter = items.iter_mut().enumerate();
+    for (index, position) in order {
+        let item = loop {
+            let (at, item) = iter.next()?;
+            if at == index {
+                break item;
+            }
+            if at > index {
+                return None;
+            }
+        };
+        *out.get_mut(position)? = Some(item);
+    }
+    out.into_iter().collect()
 }

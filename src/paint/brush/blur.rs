@@ -17,7 +17,8 @@ use rayon::prelude::*;
 
 use crate::colors::format::Rgba;
 use crate::colors::store::{ColorStore, SampleRef};
-use crate::paint::undo::{Element, ElementSlice, Split, StoreWriter, UndoLog};
+use crate::paint::split::{ElementSlice, Split, UndoLog};
+use crate::paint::undo::{Element, StoreWriter};
 
 use super::footprint::Coverage;
 use super::kernels::{DabStats, PARALLEL_MIN_SAMPLES, Runs};

@@ -17,7 +17,8 @@ use crate::packing::sampler::{self, Filter};
 use rayon::prelude::*;
 
 use crate::mesh::topology::Topology;
-use crate::paint::undo::{Element, ElementSlice, Split, StoreWriter, UndoLog};
+use crate::paint::split::{ElementSlice, Split, UndoLog};
+use crate::paint::undo::{Element, StoreWriter};
 
 use super::footprint::Coverage;
 use super::scratch::{Scratch, accumulate_masks, position, visit_mask};
