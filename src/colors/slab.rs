@@ -87,7 +87,10 @@ impl Slab {
         }
         // Empty runs share `Slot::default()`; they need no storage.
         order.retain(|&(_, _, len, _)| len > 0);
-        order.sort_unstable();
+        // Often already in order (faces by id, a stroke's elements in their first dab's order).
+        if !order.is_sorted() {
+            order.sort_unstable();
+        }
         let mut out: Vec<&mut [Rgba]> = Vec::with_capacity(ids.len());
         out.resize_with(ids.len(), || &mut []);
         let mut chunks = self.chunks.iter_mut().enumerate();

@@ -755,7 +755,9 @@ impl ElementWriter<'_> {
 /// repeated or past the end), in the order of `indices`.
 fn pick_mut<'a, T>(items: &'a mut [T], indices: &[usize]) -> Option<Vec<&'a mut T>> {
     let mut order: Vec<(usize, usize)> = indices.iter().copied().zip(0..).collect();
-    order.sort_unstable();
+    if !order.is_sorted() {
+        order.sort_unstable();
+    }
     let mut out: Vec<Option<&'a mut T>> = Vec::with_capacity(indices.len());
     out.resize_with(indices.len(), || None);
     let mut iter = items.iter_mut().enumerate();
