@@ -16,7 +16,8 @@
 use rayon::prelude::*;
 
 use crate::colors::format::Rgba;
-use crate::colors::store::{ColorStore, SampleRef};
+use crate::colors::layout::{self, Resolution};
+use crate::colors::store::ColorStore;
 use crate::paint::split::{ElementSlice, Split, UndoLog};
 use crate::paint::undo::{Element, StoreWriter};
 
@@ -47,64 +48,70 @@ fn grid_index(res: u32, i: u32, j: u32) -> usize {
 }
 
 /// Where the boundary points of one face's lattice are stored: per face edge its edge, the
-/// edge's resolution as a shift over the face's (`r_edge = r << shift`), its samples and
+/// edge's resolution and the shift from the face's (`r_edge = r << shift`), its samples and
 /// whether the face walks it reversed; per corner its vertex.
 struct Boundary<'a> {
     corners: [u32; 3],
-    edges: [(u32, u32, &'a [Rgba], bool); 3],
+    edges: [(u32, Resolution, u32, &'a [Rgba], bool); 3],
     res: u32,
 }
 
+/// A boundary point of a face's lattice: a corner's vertex, or sample `offset` of face edge `k`.
+#[derive(Clone, Copy)]
+enum BoundaryPoint {
+    Vertex(u32),
+    Edge { k: usize, offset: u32 },
+}
+
 impl<'a> Boundary<'a> {
-    /// The boundary of `face` at resolution `res` (`None` when the store disagrees).
-    fn of(store: &'a ColorStore, face: u32, res: u32, corners: [u32; 3], edges: [u32; 3]) -> Option<Self> {
+    /// The boundary of `face` at resolution `r` (`None` when the store disagrees).
+    fn of(store: &'a ColorStore, face: u32, r: Resolution, corners: [u32; 3], edges: [u32; 3]) -> Option<Self> {
         let topology = store.topology();
-        let face_log2 = res.trailing_zeros();
-        let mut out = [(0, 0, &[][..], false); 3];
+        let mut out = [(0, r, 0, &[][..], false); 3];
         for (k, slot) in out.iter_mut().enumerate() {
             let edge = edges[k];
-            let edge_log2 = store.edge_resolution(edge)?.log2();
-            let shift = edge_log2.checked_sub(face_log2)?;
-            *slot = (edge, shift, store.edge_samples(edge), topology.is_reversed(face, k));
+            let r_edge = store.edge_resolution(edge)?;
+            let shift = r_edge.log2().checked_sub(r.log2())?;
+            *slot = (edge, r_edge, shift, store.edge_samples(edge), topology.is_reversed(face, k));
         }
-        Some(Boundary { corners, edges: out, res })
+        Some(Boundary { corners, edges: out, res: r.get() })
     }
 
-    /// The stored sample at boundary point `(i, j)` of the lattice (thesis eq. 2.2 with
-    /// [`crate::colors::layout::classify_sample`]'s conventions: face edge 0 is `j = 0`, 1 is
-    /// `i + j = R`, 2 is `i = 0` walked from corner 2); `None` for interior points.
+    /// Boundary point `(i, j)` of the lattice ([`layout::classify_sample`]'s conventions:
+    /// face edge 0 is `j = 0`, 1 is `i + j = R`, 2 is `i = 0` walked from corner 2; positions
+    /// on a finer edge as [`ColorStore::face_sample_ref`] maps them); `None` for interior
+    /// points.
     #[inline(always)]
-    fn locate(&self, i: u32, j: u32) -> Option<SampleRef> {
+    fn locate(&self, i: u32, j: u32) -> Option<BoundaryPoint> {
         let res = self.res;
         let (k, position) = match (i, j) {
-            (0, 0) => return Some(SampleRef::Vertex(self.corners[0])),
-            (i, 0) if i == res => return Some(SampleRef::Vertex(self.corners[1])),
-            (0, j) if j == res => return Some(SampleRef::Vertex(self.corners[2])),
+            (0, 0) => return Some(BoundaryPoint::Vertex(self.corners[0])),
+            (i, 0) if i == res => return Some(BoundaryPoint::Vertex(self.corners[1])),
+            (0, j) if j == res => return Some(BoundaryPoint::Vertex(self.corners[2])),
             (i, 0) => (0, i),
             (i, j) if i + j == res => (1, j),
             (0, j) => (2, res - j),
             _ => return None,
         };
-        let (edge, shift, _, reversed) = self.edges[k];
-        let along = position << shift;
-        let offset = if reversed { (res << shift) - along - 1 } else { along - 1 };
-        Some(SampleRef::Edge { edge, offset })
+        let (_, r_edge, shift, _, reversed) = self.edges[k];
+        Some(BoundaryPoint::Edge { k, offset: layout::edge_storage_offset(r_edge, position << shift, reversed) })
     }
 
     /// The colour at boundary point `(i, j)`.
     #[inline(always)]
     fn color(&self, store: &ColorStore, i: u32, j: u32) -> Option<Rgba> {
         match self.locate(i, j)? {
-            SampleRef::Vertex(v) => store.vertex_color(v),
-            SampleRef::Edge { edge: _, offset } => {
-                let k = match (i, j) {
-                    (_, 0) => 0,
-                    (0, _) => 2,
-                    _ => 1,
-                };
-                self.edges[k].2.get(offset as usize).copied()
-            }
-            SampleRef::Interior { .. } => None,
+            BoundaryPoint::Vertex(v) => store.vertex_color(v),
+            BoundaryPoint::Edge { k, offset } => self.edges[k].3.get(offset as usize).copied(),
+        }
+    }
+
+    /// The blur accumulator slot of boundary point `(i, j)` (`scratch`'s per-dab tables).
+    #[inline(always)]
+    fn slot(&self, scratch: &Scratch, i: u32, j: u32) -> Option<u32> {
+        match self.locate(i, j)? {
+            BoundaryPoint::Vertex(v) => scratch.vertex_slot.get(v as usize).copied(),
+            BoundaryPoint::Edge { k, offset } => scratch.edge_slot.get(self.edges[k].0 as usize).map(|&s| s + offset),
         }
     }
 }
@@ -198,9 +205,7 @@ fn write_blurred(
                         continue;
                     }
                     let old = slice.samples()[k];
-                    let inv = 1.0 / acc.count as f32;
-                    let mean = acc.sum.map(|s| s * inv);
-                    slice.write(k as u32, BlendMode::Mix.blend(old, mean, old, acc.weight), &mut log);
+                    slice.write(k as u32, towards_mean(old, acc.sum, acc.count, acc.weight), &mut log);
                 }
             }
             (log, covered)
@@ -237,9 +242,7 @@ fn write_blurred(
         if acc.count == 0 {
             continue;
         }
-        let inv = 1.0 / acc.count as f32;
-        let mean = acc.sum.map(|s| s * inv);
-        let new = BlendMode::Mix.blend(old, mean, old, acc.weight);
+        let new = towards_mean(old, acc.sum, acc.count, acc.weight);
         if out.write(v, old, new) {
             stats.samples_changed += 1;
         }
@@ -302,7 +305,7 @@ fn blur_face<C: Coverage>(
     if all == 0 {
         return;
     }
-    let Some(boundary) = Boundary::of(store, face, res, corners, edges) else {
+    let Some(boundary) = Boundary::of(store, face, r, corners, edges) else {
         return;
     };
     if !gather_lattice(store, face, &boundary, grid) {
@@ -346,22 +349,24 @@ fn blur_face<C: Coverage>(
             let (sum, count) =
                 if interior_point { interior_sum(grid, res, i, j) } else { boundary_sum(grid, res, i, j) };
             if interior_point {
-                let old = grid[grid_index(res, i, j)];
-                let inv = 1.0 / count as f32;
-                let mean = sum.map(|s| s * inv);
-                let new = BlendMode::Mix.blend(old, mean, old, weight);
+                let new = towards_mean(grid[grid_index(res, i, j)], sum, count, weight);
                 let index = (i - 1) * (2 * res - 2 - i) / 2 + (j - 1);
                 out.interiors.push(Element::Interior(face), index, new);
                 continue;
             }
-            let slot = match boundary.locate(i, j) {
-                Some(SampleRef::Vertex(v)) => scratch.vertex_slot[v as usize],
-                Some(SampleRef::Edge { edge, offset }) => scratch.edge_slot[edge as usize] + offset,
-                _ => continue,
+            let Some(slot) = boundary.slot(scratch, i, j) else {
+                continue;
             };
             out.shared.push((slot, sum, count, weight));
         }
     }
+}
+
+/// `old` moved towards the mean `sum / count` of its neighbours by `weight` (`count > 0`).
+#[inline(always)]
+fn towards_mean(old: Rgba, sum: Rgba, count: u32, weight: f32) -> Rgba {
+    let inv = 1.0 / count as f32;
+    BlendMode::Mix.blend(old, sum.map(|s| s * inv), old, weight)
 }
 
 /// The sum of the six neighbours of interior point `(i, j)` (all inside the lattice).
