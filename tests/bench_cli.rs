@@ -64,7 +64,9 @@ fn bench_load_reports_every_phase_the_total_and_peak_memory() {
     assert_eq!(report["bench"], "load");
     assert_eq!(report["triangles"], 4 * 4212);
     let phases = &report["phases"];
-    for phase in ["import", "weld", "topology", "store", "pack", "upload", "bvh", "first_frame"] {
+    for phase in
+        ["import", "weld", "topology", "store", "pack", "upload", "bvh", "first_frame", "enter_paint", "paint_frame"]
+    {
         let seconds = phases[format!("{phase}_seconds")].as_f64().unwrap();
         assert!(seconds > 0.0, "{phase}: {seconds}");
     }
@@ -74,5 +76,8 @@ fn bench_load_reports_every_phase_the_total_and_peak_memory() {
         .map(|p| phases[format!("{p}_seconds")].as_f64().unwrap())
         .sum::<f64>();
     assert!(total >= sum_serial, "{total} < {sum_serial}");
+    let to_paint = report["total_to_paint_seconds"].as_f64().unwrap();
+    let entering = phases["enter_paint_seconds"].as_f64().unwrap() + phases["paint_frame_seconds"].as_f64().unwrap();
+    assert!(to_paint + 1e-9 >= total + entering, "{to_paint} < {total} + {entering}");
     assert!(report["peak_resident_bytes"].as_u64().unwrap() > 1 << 20);
 }

@@ -13,7 +13,7 @@ use std::time::Instant;
 use crate::colors::layout::Resolution;
 use crate::colors::store::{ColorStore, DirtyAccumulator};
 use crate::packing::packer::PackCache;
-use crate::packing::paint_layout::{EncodedBuffer, PaintLayout};
+use crate::packing::paint_layout::PaintLayout;
 use crate::paint::brush::{
     self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, ResolutionOp, StrokeUpdate,
     Tool,
@@ -59,12 +59,11 @@ impl Editor {
         let layout = PaintLayout::new(&document.store);
         let (mut compact_gpu_mesh, mut encoded) = (None, None);
         if let Some(gpu) = &self.gpu {
-            let packed = layout.packed(&document.store, &document.positions, open.format);
-            match gpu.upload(&packed) {
-                Ok(mesh) => {
-                    self.upload_bytes_this_frame += packed.color_bytes() + packed.face_record_bytes();
-                    compact_gpu_mesh = open.gpu_mesh.replace(mesh);
-                    encoded = Some(EncodedBuffer::from_packed(&packed));
+            match gpu.upload_paint_layout(&layout, &document.store, &document.positions, open.format) {
+                Ok(upload) => {
+                    self.upload_bytes_this_frame += upload.bytes;
+                    compact_gpu_mesh = open.gpu_mesh.replace(upload.mesh);
+                    encoded = Some(upload.encoded);
                 }
                 Err(error) => {
                     let text = format!("Cannot enter paint mode: uploading the paint layout failed: {error}");
@@ -289,17 +288,14 @@ impl Editor {
                         Err(e) => error = Some(e.to_string()),
                     }
                 }
-                _ => {
-                    let packed = session.layout.packed(&doc.store, &doc.positions, open.format);
-                    match gpu.upload(&packed) {
-                        Ok(new_mesh) => {
-                            *mesh = new_mesh;
-                            bytes += packed.color_bytes() + packed.face_record_bytes();
-                            session.encoded = Some(EncodedBuffer::from_packed(&packed));
-                        }
-                        Err(e) => error = Some(e.to_string()),
+                _ => match gpu.upload_paint_layout(&session.layout, &doc.store, &doc.positions, open.format) {
+                    Ok(upload) => {
+                        *mesh = upload.mesh;
+                        bytes += upload.bytes;
+                        session.encoded = Some(upload.encoded);
                     }
-                }
+                    Err(e) => error = Some(e.to_string()),
+                },
             }
         }
         session.stroke_upload_bytes += bytes;

@@ -16,7 +16,7 @@ use crate::colors::format::ColorFormat;
 use crate::colors::store::ColorStore;
 use crate::io::document::Document;
 use crate::packing::linear::FaceRecord;
-use crate::packing::paint_layout::{EncodedBuffer, PaintLayout};
+use crate::packing::paint_layout::PaintLayout;
 use crate::paint::brush::{BlendMode, BrushError, BrushSettings, Falloff, PaintView, Painter, Tool, samples_within};
 use crate::paint::picking::{BvhPreset, MeshBvh};
 use crate::paint::undo::UndoHistory;
@@ -337,7 +337,7 @@ fn upload_like_the_editor(layout: &mut PaintLayout, store: &mut ColorStore) -> (
 
 /// Times `dabs` dabs of `settings` (the editor's defaults) at `sphere` as the editor runs
 /// them, each followed by the paint-mode upload it triggers ([`PaintLayout::sync`],
-/// [`EncodedBuffer::apply`], [`crate::render::GpuMesh::write_paint_upload`] and the
+/// [`crate::packing::paint_layout::EncodedBuffer::apply`], [`crate::render::GpuMesh::write_paint_upload`] and the
 /// queue submitted and waited for): the dab, the encode and the GPU write apart, and the
 /// samples per second of the whole.
 fn measure_gpu_upload(
@@ -351,13 +351,10 @@ fn measure_gpu_upload(
 ) -> Result<serde_json::Value, BrushError> {
     let format = ColorFormat::Rgba8Srgb;
     let mut layout = PaintLayout::new(store);
-    let packed = layout.packed(store, view.positions, format);
-    let mesh = match gpu.upload(&packed) {
-        Ok(mesh) => mesh,
+    let (mesh, mut encoded) = match gpu.upload_paint_layout(&layout, store, view.positions, format) {
+        Ok(upload) => (upload.mesh, upload.encoded),
         Err(error) => return Ok(serde_json::json!({ "skipped": error.to_string() })),
     };
-    let mut encoded = EncodedBuffer::from_packed(&packed);
-    drop(packed);
     let mut history = UndoHistory::new(crate::paint::undo::DEFAULT_CAP_BYTES);
     store.take_dirty();
     history.begin_step(store, "bench")?;

@@ -357,6 +357,11 @@ impl EncodedBuffer {
         EncodedBuffer { format: packed.format, bytes: packed.colors.clone() }
     }
 
+    /// [`EncodedBuffer::from_packed`] keeping `packed`'s bytes (no copy).
+    pub fn from_packed_owned(packed: PackedMesh) -> Self {
+        EncodedBuffer { format: packed.format, bytes: packed.colors }
+    }
+
     /// The encoded samples, `bytes_per_sample` each.
     pub fn bytes(&self) -> &[u8] {
         &self.bytes

@@ -10,9 +10,23 @@ use super::{
     BaselineMesh, BaselineSource, DrawItem, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderError,
 };
 use super::{RenderSettings, Renderer};
+use crate::colors::format::ColorFormat;
+use crate::colors::store::ColorStore;
 use crate::mesh::scene::Scene;
 use crate::mesh::weld::weld_scene;
 use crate::packing::linear::PackedMesh;
+use crate::packing::paint_layout::{EncodedBuffer, PaintLayout};
+
+/// A paint layout's buffers on the GPU ([`Gpu::upload_paint_layout`]).
+#[derive(Debug)]
+pub struct PaintUpload {
+    /// The layout's level-0 packing on the GPU.
+    pub mesh: GpuMesh,
+    /// The CPU copy of the encoded buffer that a dab's uploads copy their spans from.
+    pub encoded: EncodedBuffer,
+    /// Bytes uploaded: colours and face records.
+    pub bytes: u64,
+}
 
 /// A GPU context with the renderer built for offscreen targets ([`OFFSCREEN_FORMAT`]).
 #[derive(Debug)]
@@ -38,6 +52,21 @@ impl Gpu {
     /// Uploads packed buffers (face records, positions, colour atlas with MIP chains).
     pub fn upload(&self, packed: &PackedMesh) -> Result<GpuMesh, RenderError> {
         GpuMesh::upload(&self.ctx, &self.renderer, packed, &MeshUploadOptions::default())
+    }
+
+    /// Puts `store` on the GPU in its paint `layout`, encoded in `format` (the one path of
+    /// entering paint mode, of a layout that grew, and of `bench load` / `bench paint`).
+    pub fn upload_paint_layout(
+        &self,
+        layout: &PaintLayout,
+        store: &ColorStore,
+        positions: &[[f32; 3]],
+        format: ColorFormat,
+    ) -> Result<PaintUpload, RenderError> {
+        let packed = layout.packed(store, positions, format);
+        let mesh = self.upload(&packed)?;
+        let bytes = packed.color_bytes() + packed.face_record_bytes();
+        Ok(PaintUpload { mesh, encoded: EncodedBuffer::from_packed_owned(packed), bytes })
     }
 
     /// Uploads the UV-texture baseline of `scene`: its welded mesh, every face with its own

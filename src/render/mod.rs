@@ -44,7 +44,7 @@ mod uniforms;
 
 pub use baseline::{BaselineMesh, BaselineSource, BaselineVertex, mip_chain_linear};
 pub use context::{GpuContext, backends_from_env};
-pub use gpu::Gpu;
+pub use gpu::{Gpu, PaintUpload};
 pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshUploadOptions, atlas_texture_format, default_atlas_width};
 pub use renderer::{
     DrawItem, FRAME_WGSL, FilterMode, MESH_COLORS_WGSL, Overlays, RenderSettings, RenderTarget, Renderer, Shading,
