@@ -6,6 +6,12 @@
 //! new run goes to the end of the last chunk (or a new one), the old one becomes dead space,
 //! and a chunk more than half dead is compacted (its live runs move down, nothing else), so
 //! no global array shifts and dead space stays under half of each chunk.
+//!
+//! Chunks are shared between clones and copied on their first write (`Arc::make_mut`): a
+//! snapshot of the store (paint mode's base colours, a document handed to autosave) costs
+//! one pointer per chunk, and the first dab that writes into a chunk copies that chunk only.
+
+use std::sync::Arc;
 
 use rayon::prelude::*;
 
@@ -25,7 +31,7 @@ struct Slot {
 /// The samples of `slots.len()` elements, each a contiguous run.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Slab {
-    chunks: Vec<Vec<Rgba>>,
+    chunks: Vec<Arc<Vec<Rgba>>>,
     /// Dead samples per chunk.
     dead: Vec<usize>,
     slots: Vec<Slot>,
@@ -52,7 +58,7 @@ impl Slab {
             slots.push(Slot { chunk: chunk as u32, start: start as u32, len });
             live += u64::from(len);
         }
-        let chunks: Vec<Vec<Rgba>> = chunk_lens.par_iter().map(|&n| vec![color; n]).collect();
+        let chunks: Vec<Arc<Vec<Rgba>>> = chunk_lens.par_iter().map(|&n| Arc::new(vec![color; n])).collect();
         Slab { dead: vec![0; chunks.len()], chunks, slots, live }
     }
 
@@ -74,7 +80,7 @@ impl Slab {
     pub(crate) fn get_mut(&mut self, id: usize) -> Option<&mut [Rgba]> {
         let slot = *self.slots.get(id)?;
         let start = slot.start as usize;
-        self.chunks.get_mut(slot.chunk as usize)?.get_mut(start..start + slot.len as usize)
+        Arc::make_mut(self.chunks.get_mut(slot.chunk as usize)?).get_mut(start..start + slot.len as usize)
     }
 
     /// The samples of each element of `ids`, all writable at once (for writers that work on
@@ -99,9 +105,13 @@ impl Slab {
         let mut current: Option<(usize, &mut [Rgba], usize)> = None;
         for (chunk, start, len, position) in order {
             let (chunk, start, len) = (chunk as usize, start as usize, len as usize);
-            while current.as_ref().is_none_or(|(index, _, _)| *index != chunk) {
-                let (index, data) = chunks.next()?;
-                current = Some((index, data.as_mut_slice(), 0));
+            if current.as_ref().is_none_or(|(index, _, _)| *index != chunk) {
+                // Only the chunks written into are made unique (copied if shared).
+                let (index, data) = chunks.find(|(index, _)| *index >= chunk)?;
+                if index != chunk {
+                    return None;
+                }
+                current = Some((index, Arc::make_mut(data).as_mut_slice(), 0));
             }
             let (_, rest, offset) = current.as_mut()?;
             // A run starting before the end of the previous one: an id listed twice.
@@ -142,11 +152,11 @@ impl Slab {
         } else {
             let fits = self.chunks.last().is_some_and(|last| last.len() + n <= CHUNK.max(last.capacity()));
             if !fits {
-                self.chunks.push(Vec::with_capacity(CHUNK.max(n)));
+                self.chunks.push(Arc::new(Vec::with_capacity(CHUNK.max(n))));
                 self.dead.push(0);
             }
             let chunk = self.chunks.len() - 1;
-            let last = &mut self.chunks[chunk];
+            let last = Arc::make_mut(&mut self.chunks[chunk]);
             if last.capacity() < CHUNK {
                 last.reserve_exact(CHUNK - last.len());
             }
@@ -174,7 +184,7 @@ impl Slab {
             .map(|id| (self.slots[id].start, id))
             .collect();
         members.sort_unstable();
-        let data = &mut self.chunks[chunk];
+        let data = Arc::make_mut(&mut self.chunks[chunk]);
         let mut next = 0usize;
         for (start, id) in members {
             let len = self.slots[id].len as usize;
@@ -190,6 +200,37 @@ impl Slab {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A clone shares every chunk until one side writes: then only the chunks written are
+    /// copied, and neither side sees the other's writes (get_mut, many_mut, resizes).
+    #[test]
+    fn clones_share_chunks_until_written() {
+        let lens = vec![1000u32; 3 * CHUNK / 1000];
+        let original = Slab::filled(lens.iter().copied(), [0.25; 4]);
+        assert!(original.chunks.len() >= 3);
+        let mut copy = original.clone();
+        assert!(original.chunks.iter().zip(&copy.chunks).all(|(a, b)| Arc::ptr_eq(a, b)));
+        copy.get_mut(0).unwrap()[0] = [1.0; 4];
+        let last = lens.len() - 1;
+        copy.many_mut(&[last as u32]).unwrap()[0][999] = [2.0; 4];
+        copy.set(1, &[[3.0; 4]; 7]);
+        assert_eq!(original.get(0).unwrap()[0], [0.25; 4]);
+        assert_eq!(original.get(last).unwrap()[999], [0.25; 4]);
+        assert_eq!(original.get(1).unwrap(), &[[0.25; 4]; 1000][..]);
+        assert_eq!(copy.get(0).unwrap()[0], [1.0; 4]);
+        assert_eq!(copy.get(last).unwrap()[999], [2.0; 4]);
+        assert_eq!(copy.get(1).unwrap(), &[[3.0; 4]; 7][..]);
+        // The first chunk and the last were written (and the one the resize appended to);
+        // a chunk in between nobody wrote is still shared.
+        assert!(!Arc::ptr_eq(&original.chunks[0], &copy.chunks[0]));
+        let middle = copy.slots[lens.len() / 2].chunk as usize;
+        assert!(middle != 0 && middle + 1 < original.chunks.len());
+        assert!(Arc::ptr_eq(&original.chunks[middle], &copy.chunks[middle]));
+        // Writing the original afterwards leaves the copy as it was.
+        let mut original = original;
+        original.get_mut(lens.len() / 2).unwrap()[0] = [4.0; 4];
+        assert_eq!(copy.get(lens.len() / 2).unwrap()[0], [0.25; 4]);
+    }
 
     /// The slab against a `Vec<Vec<_>>` (the obvious map), through many resizes that move,
     /// kill and compact runs.
@@ -222,7 +263,7 @@ mod tests {
             assert_eq!(slab.get(id).unwrap(), want.as_slice(), "element {id}");
         }
         assert_eq!(slab.live_samples(), truth.iter().map(|t| t.len() as u64).sum::<u64>());
-        let held: usize = slab.chunks.iter().map(Vec::len).sum();
+        let held: usize = slab.chunks.iter().map(|chunk| chunk.len()).sum();
         assert!(held as u64 <= 2 * slab.live_samples() + 2 * CHUNK as u64, "dead space bounded");
         assert!(slab.get(truth.len()).is_none());
         // Many runs at once, in any order, are the runs `get` returns; a repeat is refused.

@@ -15,7 +15,11 @@
 //!   shared sample position;
 //! - raising `R_f` interpolates the current signal (old samples unchanged), lowering it
 //!   filters ([`crate::colors::resample`]), and raising then lowering restores the samples exactly;
-//! - every write and every resolution change is recorded as dirty until [`ColorStore::take_dirty`].
+//! - every write and every resolution change is recorded as dirty until [`ColorStore::take_dirty`];
+//! - a clone is cheap: it shares the topology and the sample chunks, and a chunk is copied
+//!   on its first write (`colors/slab.rs`).
+
+use std::sync::Arc;
 
 use thiserror::Error;
 
@@ -212,7 +216,8 @@ impl DirtyAccumulator {
 /// The editable mesh-colors store.
 #[derive(Debug, Clone)]
 pub struct ColorStore {
-    topology: Topology,
+    /// Shared between clones (it never changes), like the slabs' chunks until written.
+    topology: Arc<Topology>,
     face_resolution: Vec<Resolution>,
     edge_resolution: Vec<Resolution>,
     vertex_colors: Vec<Rgba>,
@@ -279,7 +284,7 @@ impl ColorStore {
             vertex_owner_face,
             face_resolution,
             edge_resolution,
-            topology,
+            topology: Arc::new(topology),
         }
     }
 

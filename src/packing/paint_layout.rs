@@ -304,26 +304,31 @@ impl PaintLayout {
         let size = format.bytes_per_sample();
         let capacity = self.capacity.min(u64::from(u32::MAX)) as usize;
         let mut bytes = vec![0u8; capacity * size];
-        let mut put = |base: u32, samples: &[Rgba]| {
-            let start = base as usize * size;
-            if let Some(out) = bytes.get_mut(start..start + samples.len() * size) {
-                format.encode_slice(samples, out);
-            }
-        };
         let topology = store.topology();
         let vertices: Vec<Rgba> =
             (0..topology.vertex_count).map(|v| store.vertex_color(v).unwrap_or([0.0; 4])).collect();
-        put(0, &vertices);
-        for (edge, block) in self.edge_blocks.iter().enumerate() {
-            if block.capacity > 0 {
-                put(block.base, store.edge_samples(edge as u32));
+        // Every run: the vertices (blocks of `RUN` at their own index), then each edge's and
+        // each interior's block, with the samples that go there.
+        const RUN: u32 = 4096;
+        let vertex_runs = (0..topology.vertex_count.div_ceil(RUN)).map(|k| {
+            let first = k * RUN;
+            (Block { base: first, capacity: RUN.min(topology.vertex_count - first) }, Element::Vertices(first))
+        });
+        let edge_runs = self.edge_blocks.iter().enumerate().map(|(e, &b)| (b, Element::Edge(e as u32)));
+        let face_runs = self.interior_blocks.iter().enumerate().map(|(f, &b)| (b, Element::Interior(f as u32)));
+        let runs: Vec<(Block, Element)> =
+            vertex_runs.chain(edge_runs).chain(face_runs).filter(|(b, _)| b.capacity > 0).collect();
+        let samples = |element: Element| -> &[Rgba] {
+            match element {
+                Element::Vertices(first) => {
+                    let first = first as usize;
+                    vertices.get(first..(first + RUN as usize).min(vertices.len())).unwrap_or(&[])
+                }
+                Element::Edge(e) => store.edge_samples(e),
+                Element::Interior(f) => store.interior_samples(f),
             }
-        }
-        for (face, block) in self.interior_blocks.iter().enumerate() {
-            if block.capacity > 0 {
-                put(block.base, store.interior_samples(face as u32));
-            }
-        }
+        };
+        encode_runs(&mut bytes, format, &runs, &samples);
         PackedMesh {
             positions: positions.to_vec(),
             indices: store.topology().face_vertices.clone(),
@@ -333,6 +338,55 @@ impl PaintLayout {
             colors: bytes,
         }
     }
+}
+
+/// Whose samples a run of [`PaintLayout::packed`] holds.
+#[derive(Debug, Clone, Copy)]
+enum Element {
+    /// Vertices from this id on (a run of them).
+    Vertices(u32),
+    Edge(u32),
+    Interior(u32),
+}
+
+/// Encodes each run's samples at the start of its block of `bytes`. Blocks that come in
+/// ascending, disjoint order (a layout as [`PaintLayout::new`] makes it) are cut into
+/// disjoint pieces and encoded in parallel; any other order (blocks moved by growth) in
+/// one pass. Either way each byte is written by the same encode, so the result is the same.
+fn encode_runs<'s>(
+    bytes: &mut [u8],
+    format: ColorFormat,
+    runs: &[(Block, Element)],
+    samples: &(impl Fn(Element) -> &'s [Rgba] + Sync),
+) {
+    use rayon::prelude::*;
+    let size = format.bytes_per_sample();
+    let put = |bytes: &mut [u8], first: usize, runs: &[(Block, Element)]| {
+        for &(block, element) in runs {
+            let colors = samples(element);
+            let start = (block.base as usize).saturating_sub(first) * size;
+            if let Some(out) = bytes.get_mut(start..start + colors.len() * size) {
+                format.encode_slice(colors, out);
+            }
+        }
+    };
+    let ordered =
+        runs.windows(2).all(|w| u64::from(w[0].0.base) + u64::from(w[0].0.capacity) <= u64::from(w[1].0.base));
+    if !ordered {
+        put(bytes, 0, runs);
+        return;
+    }
+    // Pieces of about `PIECE` runs; each piece's bytes end where the next piece's first block starts.
+    const PIECE: usize = 2048;
+    let pieces: Vec<&[(Block, Element)]> = runs.chunks(PIECE).collect();
+    let mut bounds: Vec<usize> = pieces.iter().map(|p| p[0].0.base as usize * size).collect();
+    bounds.push(bytes.len());
+    let first_samples: Vec<usize> = pieces.iter().map(|p| p[0].0.base as usize).collect();
+    crate::packing::interiors::split_at_bounds(bytes, &bounds)
+        .into_par_iter()
+        .zip(pieces)
+        .zip(first_samples)
+        .for_each(|((out, piece), first)| put(out, first, piece));
 }
 
 /// Samples of unchanged colour an upload span may bridge between two dirty ranges: one
