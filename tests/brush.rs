@@ -1095,6 +1095,9 @@ fn bench_paint_reports_every_measurement() {
             assert!(row[name]["samples_covered"].as_u64().unwrap() > 0, "{name}");
         }
     }
+    let first = &report["session_first_dab"];
+    assert!(first["samples_per_second_best"].as_f64().unwrap() > 0.0, "{first}");
+    assert!(first["samples_covered"].as_u64().unwrap() > 0, "{first}");
     assert_eq!(report["headline"]["row"], "occlusion");
     assert_eq!(report["headline"]["target_samples"], 100_000);
     assert!(report["headline"]["samples_per_second_median"].as_f64().unwrap() > 0.0);

@@ -92,6 +92,16 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
     let (depth_timing, built) = Timing::measure(1, || painter.prepare_occlusion(&view, &store, false));
     let mut brushes = Vec::new();
     let scene_radius = camera.scene_radius.max(1e-12);
+    // The first dab of a paint session: `store` still shares every chunk with the base
+    // snapshot, so this dab also copies the chunks it writes (once per session).
+    let session_first_dab = match options.target_samples.iter().max() {
+        Some(&target) => {
+            let radius = radius_covering(&view, &store, center, scene_radius, target);
+            let settings = BrushSettings::default();
+            measure_dabs(&view, &mut store, &mut painter, settings, (center, radius), 1, true)?
+        }
+        None => serde_json::Value::Null,
+    };
     for &target in &options.target_samples {
         let radius = radius_covering(&view, &store, center, scene_radius, target);
         let mut row = serde_json::json!({ "target_samples": target, "radius_world": radius,
@@ -153,6 +163,8 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
         "bvh_presets": presets,
         "pick_latency": pick_timing.to_json(),
         "brushes": brushes,
+        "session_first_dab": session_first_dab,
+        "session_first_dab_note": "the first dab after entering paint mode (editor defaults, largest brush): it also copies the store chunks it writes, shared with the base snapshot until then",
         "gpu_upload": gpu_upload,
         "repack_rgba8": {
             "timing": pack_timing.to_json(),
