@@ -64,9 +64,19 @@ fn bench_load_reports_every_phase_the_total_and_peak_memory() {
     assert_eq!(report["bench"], "load");
     assert_eq!(report["triangles"], 4 * 4212);
     let phases = &report["phases"];
-    for phase in
-        ["import", "weld", "topology", "store", "pack", "upload", "bvh", "first_frame", "enter_paint", "paint_frame"]
-    {
+    for phase in [
+        "import",
+        "weld",
+        "topology",
+        "store",
+        "pack",
+        "upload",
+        "bvh",
+        "first_frame",
+        "enter_paint",
+        "paint_frame",
+        "paint_redraw",
+    ] {
         let seconds = phases[format!("{phase}_seconds")].as_f64().unwrap();
         assert!(seconds > 0.0, "{phase}: {seconds}");
     }

@@ -92,16 +92,8 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
     let (depth_timing, built) = Timing::measure(1, || painter.prepare_occlusion(&view, &store, false));
     let mut brushes = Vec::new();
     let scene_radius = camera.scene_radius.max(1e-12);
-    // The first dab of a paint session: `store` still shares every chunk with the base
-    // snapshot, so this dab also copies the chunks it writes (once per session).
-    let session_first_dab = match options.target_samples.iter().max() {
-        Some(&target) => {
-            let radius = radius_covering(&view, &store, center, scene_radius, target);
-            let settings = BrushSettings::default();
-            measure_dabs(&view, &mut store, &mut painter, settings, (center, radius), 1, true)?
-        }
-        None => serde_json::Value::Null,
-    };
+    let session_first_dab =
+        measure_session_first_dab(&view, &mut store, &mut painter, center, scene_radius, &options.target_samples)?;
     for &target in &options.target_samples {
         let radius = radius_covering(&view, &store, center, scene_radius, target);
         let mut row = serde_json::json!({ "target_samples": target, "radius_world": radius,
@@ -284,6 +276,24 @@ fn bvh_presets(
 /// Times `dabs` dabs of `settings` at `sphere` (centre, world radius) as the editor paints
 /// them (colours alternating, all in one undo step or one step per dab), with the bytes the
 /// last dab uploads.
+/// The first dab of a paint session, with the editor's defaults on the largest brush of
+/// `targets`: `store` still shares every chunk with the base snapshot, so this dab also
+/// copies the chunks it writes (once per session).
+fn measure_session_first_dab(
+    view: &PaintView,
+    store: &mut ColorStore,
+    painter: &mut Painter,
+    center: DVec3,
+    scene_radius: f64,
+    targets: &[u64],
+) -> Result<serde_json::Value, BrushError> {
+    let Some(&target) = targets.iter().max() else {
+        return Ok(serde_json::Value::Null);
+    };
+    let radius = radius_covering(view, store, center, scene_radius, target);
+    measure_dabs(view, store, painter, BrushSettings::default(), (center, radius), 1, true)
+}
+
 fn measure_dabs(
     view: &PaintView,
     store: &mut ColorStore,
