@@ -31,8 +31,9 @@ pub(super) enum BenchCommand {
         #[arg(long, default_value_t = 100_000)]
         stroke_samples: u64,
     },
-    /// Seconds per phase from a mesh file to the first paintable frame (import, weld,
-    /// topology, store, pack, upload, BVH, first frame), total and peak memory.
+    /// Seconds per phase from a mesh file to the document on screen (import, weld, topology,
+    /// store, pack, upload, BVH, first frame) and on to the first frame in paint mode (enter
+    /// paint mode, its first frame), both totals and peak memory.
     Load {
         /// A .glb / .gltf / OBJ / PLY / STL file.
         file: PathBuf,
