@@ -1,6 +1,7 @@
 //! `meshpaint bench load`: the seconds from a mesh file to the document on screen and on to
-//! the first frame in paint mode, phase by phase, on the editor's own opening path ([`crate::app::document::load`] does the
-//! same: pack and upload in parallel with the picking BVH), and the peak memory.
+//! the first frame in paint mode, phase by phase, on the editor's own opening path
+//! ([`crate::app::document::load`] does the same: pack and upload in parallel with the
+//! picking BVH), and the peak memory.
 //!
 //! Phases: import (read and parse), subdivide (only with `--subdivide N`, not counted in
 //! the total: it stands in for a larger file), weld, topology, store (allocate and colour),

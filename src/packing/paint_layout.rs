@@ -381,12 +381,10 @@ fn encode_runs<'s>(
     let pieces: Vec<&[(Block, Element)]> = runs.chunks(PIECE).collect();
     let mut bounds: Vec<usize> = pieces.iter().map(|p| p[0].0.base as usize * size).collect();
     bounds.push(bytes.len());
-    let first_samples: Vec<usize> = pieces.iter().map(|p| p[0].0.base as usize).collect();
     crate::packing::interiors::split_at_bounds(bytes, &bounds)
         .into_par_iter()
         .zip(pieces)
-        .zip(first_samples)
-        .for_each(|((out, piece), first)| put(out, first, piece));
+        .for_each(|(out, piece)| put(out, piece[0].0.base as usize, piece));
 }
 
 /// Samples of unchanged colour an upload span may bridge between two dirty ranges: one
