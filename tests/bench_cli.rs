@@ -37,6 +37,12 @@ fn bench_pack_reports_threads_formats_and_the_incremental_repack() {
     for result in results {
         assert!(result["pack"]["best_seconds"].as_f64().unwrap() > 0.0);
         assert!(result["ratio_to_memcpy"].as_f64().unwrap() > 0.0);
+        // The repack into reused buffers (checked equal to the fresh pack, else the command
+        // fails) and the input-reading floor.
+        for key in ["rebuild", "store_read"] {
+            assert!(result[key]["best_seconds"].as_f64().unwrap() > 0.0, "{key}");
+            assert!(result[format!("{key}_ratio_to_memcpy")].as_f64().unwrap() > 0.0, "{key}");
+        }
         let incremental = &result["incremental_after_stroke"];
         assert_eq!(incremental["equal_to_full_pack"], true, "{incremental}");
         assert!(incremental["samples_changed"].as_u64().unwrap() >= 2000);

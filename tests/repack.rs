@@ -160,13 +160,39 @@ fn a_resolution_change_asks_for_a_full_repack_and_that_matches_the_reference() {
             stroke(&mut store, &mut rng);
             let dirty = store.take_dirty();
             assert!(cache.update(&store, &dirty).is_none(), "{name}: a resolution change must not be patched");
-            cache = PackCache::build(&store, &positions, format).unwrap();
+            // The editor's path: the full repack into the old packing's buffers.
+            cache = cache.rebuild(&store, &positions, format).unwrap();
             assert_eq!(*cache.packed(), pack_reference(&store, &positions, format).unwrap(), "{name}");
             // And an R change followed by strokes only: incremental again.
             stroke(&mut store, &mut rng);
             let dirty = store.take_dirty();
             cache.update(&store, &dirty).expect("no resolution changed");
             assert_eq!(*cache.packed(), pack_reference(&store, &positions, format).unwrap(), "{name}");
+        }
+    }
+}
+
+#[test]
+fn a_repack_into_reused_buffers_equals_the_reference_packer_whatever_they_held() {
+    // Every case into the buffers of every case (smaller and larger, other formats, other
+    // random colours): a sample the pack did not rewrite would keep the old colour.
+    let cases = cases();
+    for (old_name, old_positions, old_store) in &cases {
+        for old_format in ColorFormat::ALL {
+            for (name, positions, store) in &cases {
+                for format in ColorFormat::ALL {
+                    let old = PackCache::build(old_store, old_positions, old_format).unwrap();
+                    let rebuilt = old.rebuild(store, positions, format).unwrap();
+                    let reference = pack_reference(store, positions, format).unwrap();
+                    assert!(*rebuilt.packed() == reference, "{name} {format:?} into {old_name} {old_format:?}");
+                    // And it still repacks incrementally.
+                    let mut store = store.clone();
+                    let mut rebuilt = rebuilt;
+                    stroke(&mut store, &mut Rng(7));
+                    rebuilt.update(&store, &store.clone().take_dirty()).expect("no resolution changed");
+                    assert!(*rebuilt.packed() == pack_reference(&store, positions, format).unwrap(), "{name}");
+                }
+            }
         }
     }
 }

@@ -124,18 +124,17 @@ impl Editor {
             job.progress(0.1, "packing colours with MIP chains");
             let started = Instant::now();
             let dirty = dirty.take();
-            // Only the chains the session changed when no resolution changed; else all.
-            let patched = cache.filter(|cache| cache.packed().format == format).and_then(|mut cache| {
-                let ranges = cache.update(&document.store, &dirty)?;
-                Some((cache, ranges))
-            });
-            let (cache, ranges) = match patched {
-                Some((cache, ranges)) => (cache, Some(ranges)),
-                None => (
-                    PackCache::build(&document.store, &document.positions, format)
-                        .map_err(|error| format!("repacking failed: {error}"))?,
-                    None,
-                ),
+            // Only the chains the session changed when no resolution changed; else all, into
+            // the old packing's buffers when there is one.
+            let failed = |error: crate::packing::PackError| format!("repacking failed: {error}");
+            let (store, positions) = (&document.store, &document.positions);
+            let (cache, ranges) = match cache {
+                Some(mut cache) if cache.packed().format == format => match cache.update(store, &dirty) {
+                    Some(ranges) => (cache, Some(ranges)),
+                    None => (cache.rebuild(store, positions, format).map_err(failed)?, None),
+                },
+                Some(cache) => (cache.rebuild(store, positions, format).map_err(failed)?, None),
+                None => (PackCache::build(store, positions, format).map_err(failed)?, None),
             };
             let pack_time = started.elapsed();
             job.progress(0.7, "uploading to the GPU");

@@ -5,10 +5,13 @@
 
 use std::time::{Duration, Instant};
 
-use crate::colors::format::ColorFormat;
+use rayon::prelude::*;
+
+use crate::colors::format::{ColorFormat, Rgba};
+use crate::colors::store::ColorStore;
 use crate::io::document::Document;
 use crate::packing::linear::PackedMesh;
-use crate::packing::packer::PackError;
+use crate::packing::packer::{PackCache, PackError};
 
 /// Best and median of repeated timings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -68,6 +71,12 @@ pub struct PackBench {
     pub pack: Timing,
     /// `memcpy` of the same number of bytes, same run.
     pub memcpy: Timing,
+    /// The same full repack into the buffers of the previous one (`PackCache::rebuild`,
+    /// what leaving paint mode runs after a resolution change).
+    pub rebuild: Timing,
+    /// Reading every level-0 sample of the store once, on the packer's threads, and
+    /// nothing else: the least any repack does (its input is `f32`, 16 bytes a sample).
+    pub store_read: Timing,
 }
 
 impl PackBench {
@@ -86,6 +95,16 @@ impl PackBench {
         self.pack.best_seconds / self.memcpy.best_seconds
     }
 
+    /// How many times slower than a plain copy of the output the repack into reused buffers is.
+    pub fn rebuild_ratio_to_memcpy(&self) -> f64 {
+        self.rebuild.best_seconds / self.memcpy.best_seconds
+    }
+
+    /// How many times slower than a plain copy of the output reading the input alone is.
+    pub fn store_read_ratio_to_memcpy(&self) -> f64 {
+        self.store_read.best_seconds / self.memcpy.best_seconds
+    }
+
     /// As a JSON object.
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::json!({
@@ -98,6 +117,10 @@ impl PackBench {
             "pack_bytes_per_second": self.pack_bytes_per_second(),
             "memcpy_bytes_per_second": self.memcpy_bytes_per_second(),
             "ratio_to_memcpy": self.ratio_to_memcpy(),
+            "rebuild": self.rebuild.to_json(),
+            "rebuild_ratio_to_memcpy": self.rebuild_ratio_to_memcpy(),
+            "store_read": self.store_read.to_json(),
+            "store_read_ratio_to_memcpy": self.store_read_ratio_to_memcpy(),
         })
     }
 }
@@ -113,14 +136,59 @@ pub fn bench_pack(document: &Document, format: ColorFormat, runs: usize) -> Resu
         destination.copy_from_slice(std::hint::black_box(&source));
         std::hint::black_box(&mut destination);
     });
+    let mut cache = Some(PackCache::build(&document.store, &document.positions, format)?);
+    let mut failure = None;
+    let (rebuild, ()) = Timing::measure(runs, || {
+        if let Some(previous) = cache.take() {
+            match previous.rebuild(&document.store, &document.positions, format) {
+                Ok(next) => cache = Some(next),
+                Err(error) => failure = Some(error),
+            }
+        }
+    });
+    if let Some(error) = failure {
+        return Err(error);
+    }
+    if cache.as_ref().map(PackCache::packed) != Some(&packed) {
+        return Err(PackError::NotCanonical("the repack into reused buffers differs from a fresh pack".into()));
+    }
+    drop(cache);
+    let (store_read, _) = Timing::measure(runs.max(5), || read_store(std::hint::black_box(&document.store)));
     Ok(PackBench {
+        rebuild,
         format,
         store_samples: document.store.sample_count(),
         packed_samples: packed.sample_count(),
         bytes_written,
         pack: pack_timing,
         memcpy: memcpy_timing,
+        store_read,
     })
+}
+
+/// Reads every level-0 sample of `store` (vertices, edges, interiors, in the packer's
+/// order and on its threads) into a checksum of their bits: integer sums, so the loop
+/// vectorises and is bound by memory, not by adds.
+fn read_store(store: &ColorStore) -> u32 {
+    let topology = store.topology();
+    let sum =
+        |samples: &[Rgba]| bytemuck::cast_slice::<Rgba, u32>(samples).iter().fold(0u32, |a, &b| a.wrapping_add(b));
+    let vertices = (0..topology.vertex_count)
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|v| sum(&[store.vertex_color(v).unwrap_or_default()]))
+        .reduce(|| 0, u32::wrapping_add);
+    let edges = (0..topology.edge_count())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|e| sum(store.edge_samples(e)))
+        .reduce(|| 0, u32::wrapping_add);
+    let interiors = (0..topology.face_count())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|f| sum(store.interior_samples(f)))
+        .reduce(|| 0, u32::wrapping_add);
+    vertices.wrapping_add(edges).wrapping_add(interiors)
 }
 
 /// Result of the incremental-repack benchmark: a stroke painted, then leaving paint mode.

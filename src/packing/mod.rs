@@ -5,6 +5,7 @@
 //! | file | holds |
 //! |---|---|
 //! | [`linear`] | the linear GPU layout: 16-byte face records, colour buffer with MIP chains |
+//! | [`canonical`] | the canonical layout: where each element's chain starts, each face's record |
 //! | [`packer`] | store → linear (MIP chains, eq. 2.5/2.6) and linear → store |
 //! | [`paint_layout`] | paint mode: level 0 in blocks with slack; dirty ranges and patched records |
 //! | [`lod`] | the level of detail of trilinear filtering, continuous over the mesh (per-vertex density and normal) |
@@ -14,6 +15,7 @@
 //! | [`file`] | the packed file format (docs/FORMAT.md): writer and hostile-input-proof reader |
 
 pub(crate) mod blocks;
+pub mod canonical;
 pub(crate) mod chains_view;
 pub mod file;
 pub(crate) mod interiors;

@@ -29,98 +29,18 @@
 //!   (so meshes of one resolution give the same bytes as before coarser faces counted).
 
 use rayon::prelude::*;
-use thiserror::Error;
 
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::{self, Resolution};
 use crate::colors::store::{ColorStore, DirtyElements};
-use crate::mesh::topology::TopologyError;
 use crate::packing::blocks::{BLOCK, split_blocks};
 use crate::packing::chains_view::ChainsView;
 use crate::packing::interiors::{FaceLevel, InteriorPrefix, InteriorReader, dirty_pieces, split_at_bounds};
-use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
+use crate::packing::linear::{FaceRecord, PackedMesh};
 use crate::packing::mip::{inside_neighbours, interior_row_start, mip_filter, reduce_interior_chain, vertex_edges};
 use crate::packing::sampler::{self, Filter};
 
-/// Errors of packing and unpacking.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
-pub enum PackError {
-    /// The colour buffer would exceed the 28-bit sample addressing of face records.
-    #[error("{samples} samples exceed the packed limit of {MAX_SAMPLES} (lower some face resolutions)")]
-    TooManySamples {
-        /// Samples the layout needs.
-        samples: u64,
-    },
-    /// Positions and topology disagree.
-    #[error("{positions} positions for a mesh with {vertices} vertices")]
-    PositionCount {
-        /// Positions given.
-        positions: usize,
-        /// Vertices in the topology.
-        vertices: u32,
-    },
-    /// The packed mesh's triangles do not form a valid topology.
-    #[error("packed mesh: {0}")]
-    Topology(#[from] TopologyError),
-    /// The store the packed data describes is past the budget (checked before unpacking).
-    #[error(transparent)]
-    Budget(#[from] crate::colors::budget::BudgetError),
-    /// The packed data is not in the canonical layout this packer writes.
-    #[error("packed mesh is not in the canonical layout: {0}")]
-    NotCanonical(String),
-}
-
-/// Where every element's chain starts in the colour buffer.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct PackLayout {
-    /// Colours per vertex (levels), `1 + log2(max R_f)`.
-    pub vertex_levels: u32,
-    /// First sample of each edge's chain (0 for edges without samples).
-    pub edge_base: Vec<u32>,
-    /// First sample of each face's interior chain (0 for faces without interior samples).
-    pub interior_base: Vec<u32>,
-    /// Total samples.
-    pub sample_count: u64,
-}
-
-impl PackLayout {
-    /// The canonical layout for the store's resolutions.
-    pub fn of(store: &ColorStore) -> Result<Self, PackError> {
-        let topology = store.topology();
-        let max_log2 = store.face_resolutions().iter().map(|r| r.log2()).max().unwrap_or(0);
-        let vertex_levels = max_log2 + 1;
-        let mut next = u64::from(topology.vertex_count) * u64::from(vertex_levels);
-        let mut place = |len: u32| -> u32 {
-            if len == 0 {
-                return 0;
-            }
-            let base = next;
-            next += u64::from(len);
-            // Bases past the limit are caught below, before anyone uses them.
-            base.min(u64::from(u32::MAX)) as u32
-        };
-        let edge_base: Vec<u32> = (0..topology.edge_count())
-            .map(|e| place(store.edge_resolution(e).map_or(0, layout::edge_chain_len)))
-            .collect();
-        let interior_base: Vec<u32> =
-            store.face_resolutions().iter().map(|&r| place(layout::interior_chain_len(r))).collect();
-        if next > MAX_SAMPLES {
-            return Err(PackError::TooManySamples { samples: next });
-        }
-        Ok(PackLayout { vertex_levels, edge_base, interior_base, sample_count: next })
-    }
-
-    /// The 16-byte record of `face`.
-    pub fn face_record(&self, store: &ColorStore, face: u32) -> FaceRecord {
-        let topology = store.topology();
-        let r = store.face_resolution(face).unwrap_or(Resolution::ONE);
-        let edges = topology.face_edges[face as usize].map(|edge| {
-            let r_edge = store.edge_resolution(edge).unwrap_or(Resolution::ONE);
-            pack_word(self.edge_base[edge as usize], r_edge.log2())
-        });
-        FaceRecord { interior: pack_word(self.interior_base[face as usize], r.log2()), edges }
-    }
-}
+pub use crate::packing::canonical::{PackError, PackLayout};
 
 /// Worker threads the packer runs on (rayon's global pool).
 pub fn pack_threads() -> usize {
@@ -534,36 +454,91 @@ pub struct PackCache {
     packed: PackedMesh,
 }
 
+/// The buffers of an earlier pack, reused by [`PackCache::rebuild`] (empty for a first pack).
+#[derive(Default)]
+struct Buffers {
+    chains: Vec<Rgba>,
+    upper: Vec<Rgba>,
+    colors: Vec<u8>,
+    records: Vec<FaceRecord>,
+    positions: Vec<[f32; 3]>,
+    indices: Vec<[u32; 3]>,
+}
+
+/// `buffer` cut or grown to `len` elements. Kept elements keep their old values (the
+/// caller overwrites every element); when the capacity does not suffice the old memory is
+/// released first, so the peak holds one buffer, not two.
+fn reuse<T: Copy>(mut buffer: Vec<T>, len: usize, fill: T) -> Vec<T> {
+    if buffer.capacity() < len {
+        drop(buffer);
+        return vec![fill; len];
+    }
+    buffer.truncate(len);
+    buffer.resize(len, fill);
+    buffer
+}
+
 /// Samples an incremental repack rewrote, as sorted, merged `(first, count)` ranges.
 pub type SampleRanges = Vec<(u64, u64)>;
 
 impl PackCache {
     /// Packs `store` (a full pack) and keeps what an incremental repack needs.
     pub fn build(store: &ColorStore, positions: &[[f32; 3]], format: ColorFormat) -> Result<Self, PackError> {
+        Self::build_into(store, positions, format, Buffers::default())
+    }
+
+    /// A full pack of `store` into this cache's buffers (what leaving paint mode runs when
+    /// a resolution changed): memory already written is written again instead of fresh
+    /// memory being mapped, which on this kind of machine costs more than the writes
+    /// (about 2.5 µs a 4 KiB page). Gives exactly the bytes of [`PackCache::build`]: every
+    /// sample of every buffer is rewritten.
+    pub fn rebuild(self, store: &ColorStore, positions: &[[f32; 3]], format: ColorFormat) -> Result<Self, PackError> {
+        let PackCache { chains, upper, packed, .. } = self;
+        let PackedMesh { positions: old_positions, indices, face_records, colors, .. } = packed;
+        Self::build_into(
+            store,
+            positions,
+            format,
+            Buffers { chains, upper, colors, records: face_records, positions: old_positions, indices },
+        )
+    }
+
+    /// The full pack, into `buffers` (reused where their capacity suffices).
+    fn build_into(
+        store: &ColorStore,
+        positions: &[[f32; 3]],
+        format: ColorFormat,
+        buffers: Buffers,
+    ) -> Result<Self, PackError> {
         let topology = store.topology();
         if positions.len() != topology.vertex_count as usize {
             return Err(PackError::PositionCount { positions: positions.len(), vertices: topology.vertex_count });
         }
         let layout = PackLayout::of(store)?;
         let sections = Sections::of(store, &layout);
-        let records: Vec<FaceRecord> = (0..topology.face_count())
-            .into_par_iter()
-            .with_min_len(BLOCK)
-            .map(|f| layout.face_record(store, f))
-            .collect();
+        let Buffers { chains, upper, colors, mut records, positions: mut position_copy, mut indices } = buffers;
+        records.clear();
+        records.par_extend(
+            (0..topology.face_count()).into_par_iter().with_min_len(BLOCK).map(|f| layout.face_record(store, f)),
+        );
         let size = format.bytes_per_sample();
         let prefix = InteriorPrefix::of(store);
-        let mut chains = vec![[0.0f32; 4]; sections.edge_end];
-        let mut upper = vec![[0.0f32; 4]; prefix.upper_len()];
-        let mut colors = vec![0u8; sections.total * size];
+        // Every sample of these three is written by `build_all`: stale contents never show.
+        let mut chains = reuse(chains, sections.edge_end, [0.0f32; 4]);
+        let mut upper = reuse(upper, prefix.upper_len(), [0.0f32; 4]);
+        let mut colors = reuse(colors, sections.total * size, 0u8);
         let vertex_edge = vertex_edges(topology);
         {
             let ctx = Context { store, layout: &layout, records: &records, sections, format, prefix: &prefix };
             build_all(&ctx, &mut chains, &mut upper, &mut colors, &vertex_edge);
         }
+        position_copy.clear();
+        position_copy.extend_from_slice(positions);
+        indices.clear();
+        indices.extend_from_slice(&topology.face_vertices);
         let packed = PackedMesh {
-            positions: positions.to_vec(),
-            indices: topology.face_vertices.clone(),
+            positions: position_copy,
+            indices,
             vertex_levels: layout.vertex_levels,
             face_records: records,
             format,
