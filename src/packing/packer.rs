@@ -200,7 +200,6 @@ fn reduce_edge_level(
     coarse: &[Rgba],
     chain: &mut [Rgba],
     level: u32,
-    vertex_colors: &[Rgba],
     interiors: &InteriorReader,
     neighbours: &mut Vec<Rgba>,
 ) {
@@ -210,15 +209,11 @@ fn reduce_edge_level(
     }
     let store = ctx.store;
     let topology = store.topology();
-    let levels = ctx.sections.levels;
     let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
     let r_level = 1u32 << (log2 - level);
     let r_previous = 2 * r_level;
     let previous_start = layout::edge_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
     let level_start = layout::edge_level_offset(r_edge, level).unwrap_or(0) as usize;
-    let [lower, higher] = topology.edge_vertices[edge as usize];
-    let lower_color = vertex_colors[lower as usize * levels + level as usize - 1];
-    let higher_color = vertex_colors[higher as usize * levels + level as usize - 1];
     let face_level_offset = layout::interior_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
     let rp = r_previous as usize;
     let faces = topology.faces_of_edge(edge);
@@ -238,15 +233,8 @@ fn reduce_edge_level(
     let few_faces = faces.len() - coarse_count <= 2;
     for k in 1..r_level {
         let position = 2 * k;
-        let at = |p: u32| -> Rgba {
-            if p == 0 {
-                lower_color
-            } else if p >= r_previous {
-                higher_color
-            } else {
-                chain[previous_start + p as usize - 1]
-            }
-        };
+        // Positions 2k − 1 … 2k + 1 lie in 1..r_previous: edge samples, never a vertex.
+        let at = |p: u32| chain[previous_start + p as usize - 1];
         let center = at(position);
         neighbours.clear();
         neighbours.push(at(position - 1));
@@ -364,9 +352,58 @@ fn build_all(
         });
     ctx.all_interior_chains(interior_bytes, upper);
     let interiors = ctx.interiors(interior_bytes, upper);
-    // Whether an edge has coarser faces does not change from level to level.
-    let coarse_edges: Vec<u32> =
-        (0..topology.edge_count()).into_par_iter().filter(|&e| ctx.has_coarse_faces(e)).collect();
+    // An edge without coarser faces reads only its own previous level and its faces'
+    // interiors (never a vertex: its neighbours along the edge sit at 2k ± 1, inside
+    // 1..r), so all its levels are computed, and encoded, in one pass while its faces are
+    // in cache. Edges with coarser faces read what those faces show at the previous level,
+    // which reads vertices: they, and the vertices next to them, go level by level after.
+    let coarse_flag: Vec<bool> = (0..topology.edge_count()).into_par_iter().map(|e| ctx.has_coarse_faces(e)).collect();
+    let coarse_edges: Vec<u32> = (0..topology.edge_count()).filter(|&e| coarse_flag[e as usize]).collect();
+    let mut simple = vec![true; topology.vertex_count as usize];
+    for &e in &coarse_edges {
+        for v in topology.edge_vertices[e as usize] {
+            simple[v as usize] = false;
+        }
+    }
+    split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base)
+        .into_par_iter()
+        .for_each(|block| {
+            let mut neighbours = Vec::with_capacity(16);
+            for e in block.ids.clone() {
+                if let (Some(b), false) = (edge_base(e), coarse_flag[e as usize]) {
+                    let (at, len) = (b - block.offset, edge_len(e));
+                    let chain = &mut block.chains[at..at + len];
+                    for level in 1..=ctx.edge_log2(e).saturating_sub(1) {
+                        reduce_edge_level(ctx, e, &[], chain, level, &interiors, &mut neighbours);
+                    }
+                    ctx.encode_edge_upper(e, chain, &mut block.bytes[at * size..(at + len) * size]);
+                }
+            }
+        });
+    let (offsets, list) = vertex_edge;
+    let incident = |v: usize| &list[offsets[v] as usize..offsets[v + 1] as usize];
+    {
+        let edge_colors: &[Rgba] = edge_colors;
+        vertex_colors
+            .par_chunks_mut(levels)
+            .zip(vertex_bytes.par_chunks_mut(levels * size))
+            .enumerate()
+            .with_min_len(BLOCK)
+            .for_each_init(
+                || Vec::with_capacity(16),
+                |neighbours, (v, (slot, out))| {
+                    if simple[v] && levels > 1 {
+                        for level in 1..levels {
+                            reduce_vertex_level(ctx, incident(v), v as u32, slot, level, edge_colors, neighbours);
+                        }
+                        ctx.format.encode_slice(&slot[1..], &mut out[size..]);
+                    }
+                },
+            );
+    }
+    if coarse_edges.is_empty() {
+        return;
+    }
     for level in 1..levels {
         let coarse = {
             let view = ChainsView {
@@ -381,49 +418,44 @@ fn build_all(
             };
             coarse_table(ctx, &view, &coarse_edges, level as u32)
         };
-        {
-            let vertex_colors: &[Rgba] = vertex_colors;
-            // The byte halves are not written here: split a throwaway empty buffer.
-            let mut no_bytes: [u8; 0] = [];
-            split_blocks(edge_colors, &mut no_bytes, 0, s.vertex_end, topology.edge_count(), edge_base)
-                .into_par_iter()
-                .for_each(|block| {
-                    let mut neighbours = Vec::with_capacity(16);
-                    for e in block.ids.clone() {
-                        if let Some(b) = edge_base(e) {
-                            let at = b - block.offset;
-                            reduce_edge_level(
-                                ctx,
-                                e,
-                                coarse_of(&coarse, e),
-                                &mut block.chains[at..at + edge_len(e)],
-                                level as u32,
-                                vertex_colors,
-                                &interiors,
-                                &mut neighbours,
-                            );
-                        }
+        // The byte halves are not written here: split a throwaway empty buffer.
+        let mut no_bytes: [u8; 0] = [];
+        split_blocks(edge_colors, &mut no_bytes, 0, s.vertex_end, topology.edge_count(), edge_base)
+            .into_par_iter()
+            .for_each(|block| {
+                let mut neighbours = Vec::with_capacity(16);
+                for e in block.ids.clone() {
+                    if let (Some(b), true) = (edge_base(e), coarse_flag[e as usize]) {
+                        let chain = &mut block.chains[b - block.offset..b - block.offset + edge_len(e)];
+                        reduce_edge_level(
+                            ctx,
+                            e,
+                            coarse_of(&coarse, e),
+                            chain,
+                            level as u32,
+                            &interiors,
+                            &mut neighbours,
+                        );
                     }
-                });
-        }
+                }
+            });
         let edge_colors: &[Rgba] = edge_colors;
-        let (offsets, list) = vertex_edge;
         vertex_colors.par_chunks_mut(levels).enumerate().with_min_len(BLOCK).for_each_init(
             || Vec::with_capacity(16),
             |neighbours, (v, slot)| {
-                let incident = &list[offsets[v] as usize..offsets[v + 1] as usize];
-                reduce_vertex_level(ctx, incident, v as u32, slot, level, edge_colors, neighbours);
+                if !simple[v] {
+                    reduce_vertex_level(ctx, incident(v), v as u32, slot, level, edge_colors, neighbours);
+                }
             },
         );
     }
-    // Levels 1.. of edges and vertices, encoded once they are final.
+    // Levels 1.. of the edges and vertices done level by level, encoded once final.
     split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base)
         .into_par_iter()
         .for_each(|block| {
             for e in block.ids.clone() {
-                if let Some(b) = edge_base(e) {
-                    let at = b - block.offset;
-                    let len = edge_len(e);
+                if let (Some(b), true) = (edge_base(e), coarse_flag[e as usize]) {
+                    let (at, len) = (b - block.offset, edge_len(e));
                     ctx.encode_edge_upper(
                         e,
                         &block.chains[at..at + len],
@@ -433,9 +465,13 @@ fn build_all(
             }
         });
     if levels > 1 {
-        vertex_colors.par_chunks(levels).zip(vertex_bytes.par_chunks_mut(levels * size)).for_each(|(chain, out)| {
-            ctx.format.encode_slice(&chain[1..], &mut out[size..]);
-        });
+        vertex_colors.par_chunks(levels).zip(vertex_bytes.par_chunks_mut(levels * size)).enumerate().for_each(
+            |(v, (chain, out))| {
+                if !simple[v] {
+                    ctx.format.encode_slice(&chain[1..], &mut out[size..]);
+                }
+            },
+        );
     }
 }
 
@@ -699,7 +735,6 @@ impl PackCache {
                     coarse_of(&coarse, e),
                     &mut edge_colors[at..at + len],
                     level as u32,
-                    vertex_colors,
                     &interiors,
                     &mut neighbours,
                 );
