@@ -58,6 +58,25 @@ pub(crate) struct InteriorReader<'a> {
 }
 
 impl InteriorReader<'_> {
+    /// Asks the CPU to start loading `face`'s whole interior chain (its level-0 bytes and
+    /// its upper levels) into cache, so a pass that visits faces out of order overlaps
+    /// those loads with work instead of waiting for each (a hint: no effect on results).
+    #[inline]
+    pub(crate) fn prefetch(&self, face: u32) {
+        let f = face as usize;
+        let size = self.format.bytes_per_sample();
+        if let (Some(c), Some(u)) = (self.prefix.chain.get(f..f + 2), self.prefix.upper.get(f..f + 2)) {
+            let r = self.store.face_resolution(face).unwrap_or(Resolution::ONE);
+            let n0 = (layout::interior_sample_count(r) as usize).min((c[1] - c[0]) as usize);
+            if let Some(bytes) = self.bytes.get(c[0] as usize * size..(c[0] as usize + n0) * size) {
+                prefetch_lines(bytes);
+            }
+            if let Some(upper) = self.upper.get(u[0] as usize..u[1] as usize) {
+                prefetch_lines(upper);
+            }
+        }
+    }
+
     /// Sample `offset` of `face`'s interior chain, as the `f32` chain holds it.
     #[inline]
     pub(crate) fn get(&self, face: u32, offset: usize) -> Option<Rgba> {
@@ -72,6 +91,21 @@ impl InteriorReader<'_> {
             self.upper.get(*self.prefix.upper.get(f)? as usize + offset - n0).copied()
         }
     }
+}
+
+/// Prefetches every 64-byte cache line `slice` touches (x86-64; elsewhere nothing).
+#[inline]
+fn prefetch_lines<T>(slice: &[T]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        // One item per 64 bytes from the first, and the last (whose line the steps may miss).
+        let step = 64 / std::mem::size_of::<T>().clamp(1, 64);
+        for item in slice.iter().step_by(step.max(1)).chain(slice.last()) {
+            safe_arch::prefetch_t0(item);
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = slice;
 }
 
 /// One face's interior chain at one level, as [`InteriorReader::level`] finds it.

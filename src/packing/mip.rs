@@ -8,14 +8,37 @@ use crate::mesh::topology::Topology;
 /// `(C + ½ Σ N) / (1 + n/2)`: the thesis' MIP filter with the weights taken.
 #[inline]
 pub(crate) fn mip_filter(center: Rgba, neighbours: &[Rgba]) -> Rgba {
-    let mut sum = [0.0f32; 4];
-    for n in neighbours {
-        for c in 0..4 {
-            sum[c] += n[c];
-        }
+    let mut sum = MipSum::default();
+    for &n in neighbours {
+        sum.add(n);
     }
-    let norm = 1.0 / (1.0 + 0.5 * neighbours.len() as f32);
-    std::array::from_fn(|c| (center[c] + 0.5 * sum[c]) * norm)
+    sum.finish(center)
+}
+
+/// [`mip_filter`] one neighbour at a time: the same sums in the same order, so the same
+/// bits, for loops that would otherwise collect their neighbours in a list first.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct MipSum {
+    sum: [f32; 4],
+    count: u32,
+}
+
+impl MipSum {
+    /// Adds one neighbour.
+    #[inline(always)]
+    pub(crate) fn add(&mut self, n: Rgba) {
+        for (sum, n) in self.sum.iter_mut().zip(n) {
+            *sum += n;
+        }
+        self.count += 1;
+    }
+
+    /// The filtered colour of `center` with the neighbours added so far.
+    #[inline(always)]
+    pub(crate) fn finish(self, center: Rgba) -> Rgba {
+        let norm = 1.0 / (1.0 + 0.5 * self.count as f32);
+        std::array::from_fn(|c| (center[c] + 0.5 * self.sum[c]) * norm)
+    }
 }
 
 /// For each vertex, its incident edges (CSR).

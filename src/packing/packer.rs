@@ -17,8 +17,10 @@
 //!   colour.
 //! - **interior** (eq. 2.6): `C'_ij = ¼ (C_(2i)(2j) + ½ Σ six neighbours)`; the six
 //!   neighbours of an interior point of level `l` are interior points of level `l − 1`.
-//! - **edge** (eq. 2.6 on the edge): the centre, its two neighbours along the edge (an
-//!   endpoint vertex at the ends) and, for every incident face, that face's two lattice
+//! - **edge** (eq. 2.6 on the edge): the centre, its two neighbours along the edge (at
+//!   `2k ± 1` on the finer level: edge samples, never an endpoint vertex, so edges next to
+//!   faces of their own resolution only need their faces' interiors and compute every level
+//!   in one pass) and, for every incident face, that face's two lattice
 //!   neighbours inside it at the edge's level-`(l − 1)` spacing. A face whose resolution
 //!   equals the edge's has interior samples there; a **coarser** face has none, and
 //!   contributes what it shows there at level `l − 1` — its linear filter with the seam
@@ -37,7 +39,7 @@ use crate::packing::blocks::{BLOCK, split_blocks};
 use crate::packing::chains_view::ChainsView;
 use crate::packing::interiors::{FaceLevel, InteriorPrefix, InteriorReader, dirty_pieces, split_at_bounds};
 use crate::packing::linear::{FaceRecord, PackedMesh};
-use crate::packing::mip::{inside_neighbours, interior_row_start, mip_filter, reduce_interior_chain, vertex_edges};
+use crate::packing::mip::{MipSum, inside_neighbours, interior_row_start, reduce_interior_chain, vertex_edges};
 use crate::packing::sampler::{self, Filter};
 
 pub use crate::packing::canonical::{PackError, PackLayout};
@@ -46,6 +48,9 @@ pub use crate::packing::canonical::{PackError, PackLayout};
 pub fn pack_threads() -> usize {
     rayon::current_num_threads()
 }
+
+/// How many edges ahead the one-pass edge chains prefetch their faces' interiors.
+const PREFETCH_AHEAD: u32 = 24;
 
 /// The colour buffer's three sections.
 #[derive(Debug, Clone, Copy)]
@@ -201,7 +206,6 @@ fn reduce_edge_level(
     chain: &mut [Rgba],
     level: u32,
     interiors: &InteriorReader,
-    neighbours: &mut Vec<Rgba>,
 ) {
     let log2 = ctx.edge_log2(edge);
     if log2 < level + 1 {
@@ -236,14 +240,14 @@ fn reduce_edge_level(
         // Positions 2k − 1 … 2k + 1 lie in 1..r_previous: edge samples, never a vertex.
         let at = |p: u32| chain[previous_start + p as usize - 1];
         let center = at(position);
-        neighbours.clear();
-        neighbours.push(at(position - 1));
-        neighbours.push(at(position + 1));
+        let mut sum = MipSum::default();
+        sum.add(at(position - 1));
+        sum.add(at(position + 1));
         if few_faces {
             for &(face_level, face_edge, reversed) in equal.iter().flatten() {
                 let p = if reversed { r_previous - position } else { position } as usize;
                 for (i, j) in inside_neighbours(face_edge, p, rp) {
-                    neighbours.push(face_level.get(interior_row_start(rp, i) + j - 1).unwrap_or([0.0; 4]));
+                    sum.add(face_level.get(interior_row_start(rp, i) + j - 1).unwrap_or([0.0; 4]));
                 }
             }
         } else {
@@ -255,29 +259,23 @@ fn reduce_edge_level(
                 let p = if reversed { r_previous - position } else { position } as usize;
                 for (i, j) in inside_neighbours(face_edge, p, rp) {
                     let at = face_level_offset + interior_row_start(rp, i) + j - 1;
-                    neighbours.push(interiors.get(face, at).unwrap_or([0.0; 4]));
+                    sum.add(interiors.get(face, at).unwrap_or([0.0; 4]));
                 }
             }
         }
         // Coarser faces: what they show at those two points (computed beforehand).
         let per_k = 2 * coarse_count;
-        neighbours.extend_from_slice(coarse.get((k as usize - 1) * per_k..k as usize * per_k).unwrap_or(&[]));
-        chain[level_start + k as usize - 1] = mip_filter(center, neighbours);
+        for &n in coarse.get((k as usize - 1) * per_k..k as usize * per_k).unwrap_or(&[]) {
+            sum.add(n);
+        }
+        chain[level_start + k as usize - 1] = sum.finish(center);
     }
 }
 
 /// Level `level` of vertex `v` (eq. 2.5) from its incident edges' level `level − 1`.
-fn reduce_vertex_level(
-    ctx: &Context,
-    incident: &[u32],
-    v: u32,
-    slot: &mut [Rgba],
-    level: usize,
-    edge_colors: &[Rgba],
-    neighbours: &mut Vec<Rgba>,
-) {
+fn reduce_vertex_level(ctx: &Context, incident: &[u32], v: u32, slot: &mut [Rgba], level: usize, edge_colors: &[Rgba]) {
     let previous = level - 1;
-    neighbours.clear();
+    let mut sum = MipSum::default();
     for &edge in incident {
         let log2 = ctx.edge_log2(edge);
         if log2 < previous as u32 + 1 {
@@ -288,9 +286,9 @@ fn reduce_vertex_level(
         let level_start = ctx.layout.edge_base[edge as usize] as usize
             + layout::edge_level_offset(r_edge, previous as u32).unwrap_or(0) as usize;
         let position = if v == ctx.store.topology().edge_vertices[edge as usize][0] { 1 } else { r_previous - 1 };
-        neighbours.push(edge_colors[level_start - ctx.sections.vertex_end + position as usize - 1]);
+        sum.add(edge_colors[level_start - ctx.sections.vertex_end + position as usize - 1]);
     }
-    slot[level] = mip_filter(slot[previous], neighbours);
+    slot[level] = sum.finish(slot[previous]);
 }
 
 /// Sorted edge ids → what their coarse faces show at `level − 1`, for the ids of `edges`
@@ -368,13 +366,16 @@ fn build_all(
     split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base)
         .into_par_iter()
         .for_each(|block| {
-            let mut neighbours = Vec::with_capacity(16);
             for e in block.ids.clone() {
+                // The faces of the edge a few steps ahead: their loads overlap this one's work.
+                for &(face, _) in topology.faces_of_edge(e + PREFETCH_AHEAD) {
+                    interiors.prefetch(face);
+                }
                 if let (Some(b), false) = (edge_base(e), coarse_flag[e as usize]) {
                     let (at, len) = (b - block.offset, edge_len(e));
                     let chain = &mut block.chains[at..at + len];
                     for level in 1..=ctx.edge_log2(e).saturating_sub(1) {
-                        reduce_edge_level(ctx, e, &[], chain, level, &interiors, &mut neighbours);
+                        reduce_edge_level(ctx, e, &[], chain, level, &interiors);
                     }
                     ctx.encode_edge_upper(e, chain, &mut block.bytes[at * size..(at + len) * size]);
                 }
@@ -389,17 +390,14 @@ fn build_all(
             .zip(vertex_bytes.par_chunks_mut(levels * size))
             .enumerate()
             .with_min_len(BLOCK)
-            .for_each_init(
-                || Vec::with_capacity(16),
-                |neighbours, (v, (slot, out))| {
-                    if simple[v] && levels > 1 {
-                        for level in 1..levels {
-                            reduce_vertex_level(ctx, incident(v), v as u32, slot, level, edge_colors, neighbours);
-                        }
-                        ctx.format.encode_slice(&slot[1..], &mut out[size..]);
+            .for_each(|(v, (slot, out))| {
+                if simple[v] && levels > 1 {
+                    for level in 1..levels {
+                        reduce_vertex_level(ctx, incident(v), v as u32, slot, level, edge_colors);
                     }
-                },
-            );
+                    ctx.format.encode_slice(&slot[1..], &mut out[size..]);
+                }
+            });
     }
     if coarse_edges.is_empty() {
         return;
@@ -423,31 +421,19 @@ fn build_all(
         split_blocks(edge_colors, &mut no_bytes, 0, s.vertex_end, topology.edge_count(), edge_base)
             .into_par_iter()
             .for_each(|block| {
-                let mut neighbours = Vec::with_capacity(16);
                 for e in block.ids.clone() {
                     if let (Some(b), true) = (edge_base(e), coarse_flag[e as usize]) {
                         let chain = &mut block.chains[b - block.offset..b - block.offset + edge_len(e)];
-                        reduce_edge_level(
-                            ctx,
-                            e,
-                            coarse_of(&coarse, e),
-                            chain,
-                            level as u32,
-                            &interiors,
-                            &mut neighbours,
-                        );
+                        reduce_edge_level(ctx, e, coarse_of(&coarse, e), chain, level as u32, &interiors);
                     }
                 }
             });
         let edge_colors: &[Rgba] = edge_colors;
-        vertex_colors.par_chunks_mut(levels).enumerate().with_min_len(BLOCK).for_each_init(
-            || Vec::with_capacity(16),
-            |neighbours, (v, slot)| {
-                if !simple[v] {
-                    reduce_vertex_level(ctx, incident(v), v as u32, slot, level, edge_colors, neighbours);
-                }
-            },
-        );
+        vertex_colors.par_chunks_mut(levels).enumerate().with_min_len(BLOCK).for_each(|(v, slot)| {
+            if !simple[v] {
+                reduce_vertex_level(ctx, incident(v), v as u32, slot, level, edge_colors);
+            }
+        });
     }
     // Levels 1.. of the edges and vertices done level by level, encoded once final.
     split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base)
@@ -722,7 +708,6 @@ impl PackCache {
                 };
                 coarse_table(&ctx, &view, &edges, level as u32)
             };
-            let mut neighbours = Vec::with_capacity(16);
             for &e in &edges {
                 let len = edge_len(e);
                 if len == 0 {
@@ -736,21 +721,12 @@ impl PackCache {
                     &mut edge_colors[at..at + len],
                     level as u32,
                     &interiors,
-                    &mut neighbours,
                 );
             }
             for &v in &vertices {
                 let at = v as usize * levels;
                 let list = &incident[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
-                reduce_vertex_level(
-                    &ctx,
-                    list,
-                    v,
-                    &mut vertex_colors[at..at + levels],
-                    level,
-                    edge_colors,
-                    &mut neighbours,
-                );
+                reduce_vertex_level(&ctx, list, v, &mut vertex_colors[at..at + levels], level, edge_colors);
             }
         }
         // Encode what changed; report it as ranges.
