@@ -50,6 +50,71 @@ fn rgba8_srgb_round_trips_every_byte() {
     }
 }
 
+/// Every format's slice encoders against one channel at a time, on the extremes: NaN,
+/// infinities, negatives, subnormals of f32 and of f16, the f16 rounding boundary at the top
+/// (65 519.996 rounds down, 65 520 would round to infinity), values past 1 in alpha, and runs
+/// that are not a multiple of the encoders' batch sizes.
+#[test]
+fn slice_encoders_equal_one_channel_at_a_time_on_the_extremes() {
+    use half::f16;
+    let values = [
+        0.0,
+        -0.0,
+        -1.0,
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::from_bits(1),
+        f32::MIN_POSITIVE,
+        1e-8,
+        5.96e-8,
+        6.0e-5,
+        6.1e-5,
+        1.0 / 3.0,
+        0.5,
+        1.0,
+        1.0000001,
+        2.0,
+        65504.0,
+        65519.996,
+        65520.0,
+        1e9,
+    ];
+    // Independent of the crate's clamp: R, G, B to [0, 65504], alpha to [0, 1], NaN and
+    // every zero or negative (−0 included) to +0.
+    let clamp = |x: f32, max: f32| if x.is_nan() || x <= 0.0 { 0.0 } else { x.min(max) };
+    for len in [1usize, 7, 31, 32, 33, 77] {
+        let colors: Vec<Rgba> =
+            (0..len).map(|i| std::array::from_fn(|c| values[(i * 4 + c * 7 + i / 3) % values.len()])).collect();
+        for format in ColorFormat::ALL {
+            let size = format.bytes_per_sample();
+            let mut bytes = vec![0u8; len * size];
+            let mut quantized = vec![[9.0f32; 4]; len];
+            format.encode_quantized_slice(&colors, &mut bytes, &mut quantized);
+            let mut plain = vec![0u8; len * size];
+            format.encode_slice(&colors, &mut plain);
+            assert_eq!(plain, bytes, "{format:?} len {len}: encode_slice vs encode_quantized_slice");
+            for (i, color) in colors.iter().enumerate() {
+                let clamped: Rgba = std::array::from_fn(|c| clamp(color[c], if c == 3 { 1.0 } else { 65504.0 }));
+                let (want_bytes, want_value): (Vec<u8>, Rgba) = match format {
+                    ColorFormat::Rgba8Srgb => {
+                        let b = encode_rgba8_srgb(clamped);
+                        (b.to_vec(), decode_rgba8_srgb(b))
+                    }
+                    ColorFormat::Rgba16F => {
+                        let h = clamped.map(f16::from_f32);
+                        (h.iter().flat_map(|h| h.to_bits().to_le_bytes()).collect(), h.map(f16::to_f32))
+                    }
+                    ColorFormat::Rgba32F => (clamped.iter().flat_map(|c| c.to_le_bytes()).collect(), clamped),
+                };
+                assert_eq!(&bytes[i * size..(i + 1) * size], &want_bytes[..], "{format:?} {color:?}");
+                assert_eq!(quantized[i].map(f32::to_bits), want_value.map(f32::to_bits), "{format:?} {color:?}");
+                assert_eq!(format.decode(&want_bytes).map(f32::to_bits), want_value.map(f32::to_bits));
+            }
+        }
+    }
+}
+
 #[test]
 fn pack_unpack_pack_is_the_identity_for_every_format() {
     let (positions, store) = mixed_octahedron_store(5);
