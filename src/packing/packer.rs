@@ -325,29 +325,13 @@ fn build_all(
     let (vertex_colors, edge_colors) = chains.split_at_mut(s.vertex_end);
     let (vertex_bytes, rest_bytes) = bytes.split_at_mut(s.vertex_end * size);
     let (edge_bytes, interior_bytes) = rest_bytes.split_at_mut((s.edge_end - s.vertex_end) * size);
-    // Level 0 of vertices and edges (encoded once, here), every interior chain.
     let levels = s.levels;
-    vertex_colors
-        .par_chunks_mut(levels)
-        .zip(vertex_bytes.par_chunks_mut(levels * size))
-        .enumerate()
-        .for_each(|(v, (chain, out))| ctx.vertex_level0(v as u32, chain, out));
     let edge_base = |e: u32| {
         let len = store.edge_resolution(e).map_or(0, layout::edge_chain_len);
         (len > 0).then(|| layout.edge_base[e as usize] as usize)
     };
     let edge_len = |e: u32| store.edge_resolution(e).map_or(0, layout::edge_chain_len) as usize;
-    split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base)
-        .into_par_iter()
-        .for_each(|block| {
-            for e in block.ids.clone() {
-                if let Some(b) = edge_base(e) {
-                    let at = b - block.offset;
-                    let len = edge_len(e);
-                    ctx.edge_level0(e, &mut block.chains[at..at + len], &mut block.bytes[at * size..(at + len) * size]);
-                }
-            }
-        });
+    // Every interior chain first: an interior reads nothing else.
     ctx.all_interior_chains(interior_bytes, upper);
     let interiors = ctx.interiors(interior_bytes, upper);
     // An edge without coarser faces reads only its own previous level and its faces'
@@ -371,13 +355,16 @@ fn build_all(
                 for &(face, _) in topology.faces_of_edge(e + PREFETCH_AHEAD) {
                     interiors.prefetch(face);
                 }
-                if let (Some(b), false) = (edge_base(e), coarse_flag[e as usize]) {
-                    let (at, len) = (b - block.offset, edge_len(e));
-                    let chain = &mut block.chains[at..at + len];
+                let Some(b) = edge_base(e) else { continue };
+                let (at, len) = (b - block.offset, edge_len(e));
+                let (chain, out) = (&mut block.chains[at..at + len], &mut block.bytes[at * size..(at + len) * size]);
+                // Level 0 from the store (encoded once, here), then the levels above.
+                ctx.edge_level0(e, chain, out);
+                if !coarse_flag[e as usize] {
                     for level in 1..=ctx.edge_log2(e).saturating_sub(1) {
                         reduce_edge_level(ctx, e, &[], chain, level, &interiors);
                     }
-                    ctx.encode_edge_upper(e, chain, &mut block.bytes[at * size..(at + len) * size]);
+                    ctx.encode_edge_upper(e, chain, out);
                 }
             }
         });
@@ -391,6 +378,7 @@ fn build_all(
             .enumerate()
             .with_min_len(BLOCK)
             .for_each(|(v, (slot, out))| {
+                ctx.vertex_level0(v as u32, slot, out);
                 if simple[v] && levels > 1 {
                     for level in 1..levels {
                         reduce_vertex_level(ctx, incident(v), v as u32, slot, level, edge_colors);
