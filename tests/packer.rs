@@ -110,6 +110,7 @@ fn slice_encoders_equal_one_channel_at_a_time_on_the_extremes() {
                 assert_eq!(&bytes[i * size..(i + 1) * size], &want_bytes[..], "{format:?} {color:?}");
                 assert_eq!(quantized[i].map(f32::to_bits), want_value.map(f32::to_bits), "{format:?} {color:?}");
                 assert_eq!(format.decode(&want_bytes).map(f32::to_bits), want_value.map(f32::to_bits));
+                assert_eq!(format.decode_vec4(&want_bytes).to_array().map(f32::to_bits), want_value.map(f32::to_bits));
             }
         }
     }

@@ -160,6 +160,29 @@ impl ColorFormat {
         }
     }
 
+    /// [`ColorFormat::decode`] into a SIMD register (the same values), for loops that add
+    /// decoded samples as vectors.
+    #[inline(always)]
+    pub fn decode_vec4(self, bytes: &[u8]) -> glam::Vec4 {
+        match self {
+            ColorFormat::Rgba8Srgb => {
+                if let Some(b) = bytes.first_chunk::<4>() {
+                    let t = srgb_tables();
+                    let d = |k: usize| t.decode[usize::from(b[k])];
+                    return glam::Vec4::new(d(0), d(1), d(2), t.alpha[usize::from(b[3])]);
+                }
+            }
+            ColorFormat::Rgba32F => {
+                if let Some(b) = bytes.first_chunk::<16>() {
+                    let c = |k: usize| f32::from_le_bytes([b[4 * k], b[4 * k + 1], b[4 * k + 2], b[4 * k + 3]]);
+                    return glam::Vec4::new(c(0), c(1), c(2), c(3));
+                }
+            }
+            ColorFormat::Rgba16F => {}
+        }
+        glam::Vec4::from_array(self.decode(bytes))
+    }
+
     /// The colour after an encode/decode round trip (what the GPU will see), clamped first.
     pub fn quantize(self, color: Rgba) -> Rgba {
         let color = clamp_color(color);

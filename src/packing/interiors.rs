@@ -8,6 +8,8 @@
 //! a compact buffer, face after face ([`InteriorPrefix::upper`]). Each face's chain is built
 //! in a small scratch buffer (cache-resident) and written straight to both.
 
+use glam::Vec4;
+
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::{self, Resolution};
 use crate::colors::store::ColorStore;
@@ -118,15 +120,15 @@ pub(crate) enum FaceLevel<'a> {
 }
 
 impl FaceLevel<'_> {
-    /// Sample `offset` of the level.
+    /// Sample `offset` of the level, in a SIMD register (zero past the end).
     #[inline(always)]
-    pub(crate) fn get(&self, offset: usize) -> Option<Rgba> {
+    pub(crate) fn get_vec4(&self, offset: usize) -> Vec4 {
         match *self {
             FaceLevel::Bytes(bytes, format) => {
                 let size = format.bytes_per_sample();
-                Some(format.decode(bytes.get(offset * size..offset * size + size)?))
+                bytes.get(offset * size..offset * size + size).map_or(Vec4::ZERO, |b| format.decode_vec4(b))
             }
-            FaceLevel::Upper(upper) => upper.get(offset).copied(),
+            FaceLevel::Upper(upper) => upper.get(offset).map_or(Vec4::ZERO, |c| Vec4::from_array(*c)),
         }
     }
 }

@@ -1,6 +1,8 @@
 //! The MIP filters of the packer (thesis eq. 2.5 / 2.6) that need no layout: the weighted
 //! filter, one face's interior chain, and the vertex → edge incidence.
 
+use glam::Vec4;
+
 use crate::colors::format::Rgba;
 use crate::colors::layout::{self, Resolution};
 use crate::mesh::topology::Topology;
@@ -17,9 +19,14 @@ pub(crate) fn mip_filter(center: Rgba, neighbours: &[Rgba]) -> Rgba {
 
 /// [`mip_filter`] one neighbour at a time: the same sums in the same order, so the same
 /// bits, for loops that would otherwise collect their neighbours in a list first.
+///
+/// The sums live in a SIMD register (`glam::Vec4`, lane-wise IEEE adds and multiplies like
+/// the scalar code): a neighbour decoded channel by channel into an `[f32; 4]` otherwise
+/// went through the stack to be loaded as one vector, a stalled store forward per
+/// neighbour.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct MipSum {
-    sum: [f32; 4],
+    sum: Vec4,
     count: u32,
 }
 
@@ -27,9 +34,13 @@ impl MipSum {
     /// Adds one neighbour.
     #[inline(always)]
     pub(crate) fn add(&mut self, n: Rgba) {
-        for (sum, n) in self.sum.iter_mut().zip(n) {
-            *sum += n;
-        }
+        self.add_vec4(Vec4::from_array(n));
+    }
+
+    /// Adds one neighbour already in a register.
+    #[inline(always)]
+    pub(crate) fn add_vec4(&mut self, n: Vec4) {
+        self.sum += n;
         self.count += 1;
     }
 
@@ -37,7 +48,7 @@ impl MipSum {
     #[inline(always)]
     pub(crate) fn finish(self, center: Rgba) -> Rgba {
         let norm = 1.0 / (1.0 + 0.5 * self.count as f32);
-        std::array::from_fn(|c| (center[c] + 0.5 * self.sum[c]) * norm)
+        ((Vec4::from_array(center) + 0.5 * self.sum) * norm).to_array()
     }
 }
 

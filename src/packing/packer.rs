@@ -247,7 +247,7 @@ fn reduce_edge_level(
             for &(face_level, face_edge, reversed) in equal.iter().flatten() {
                 let p = if reversed { r_previous - position } else { position } as usize;
                 for (i, j) in inside_neighbours(face_edge, p, rp) {
-                    sum.add(face_level.get(interior_row_start(rp, i) + j - 1).unwrap_or([0.0; 4]));
+                    sum.add_vec4(face_level.get_vec4(interior_row_start(rp, i) + j - 1));
                 }
             }
         } else {
