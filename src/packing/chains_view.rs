@@ -4,6 +4,7 @@
 use crate::colors::format::Rgba;
 use crate::colors::layout::Resolution;
 use crate::colors::store::ColorStore;
+use crate::packing::edges::EdgeReader;
 use crate::packing::interiors::InteriorReader;
 use crate::packing::linear::FaceRecord;
 use crate::packing::sampler::{self, MeshColorSource};
@@ -15,7 +16,7 @@ pub(crate) struct ChainsView<'a> {
     pub(crate) records: &'a [FaceRecord],
     pub(crate) vertex_levels: u32,
     pub(crate) vertex_colors: &'a [Rgba],
-    pub(crate) edge_colors: &'a [Rgba],
+    pub(crate) edges: EdgeReader<'a>,
     pub(crate) interiors: InteriorReader<'a>,
     pub(crate) vertex_section: usize,
     pub(crate) interior_start: usize,
@@ -29,7 +30,9 @@ impl ChainsView<'_> {
         if index < self.vertex_section {
             self.vertex_colors.get(index).copied()
         } else if index < self.interior_start {
-            self.edge_colors.get(index - self.vertex_section).copied()
+            let local = index - self.vertex_section;
+            let edge = self.edges.edge_at(local)?;
+            self.edges.get(edge, local - *self.edges.prefix.chain.get(edge as usize)? as usize)
         } else {
             let base = self.records.get(face as usize)?.interior_base() as usize;
             self.interiors.get(face, index.checked_sub(base)?)

@@ -14,9 +14,9 @@
 //! | [`sampler`] | the CPU reference sampler (nearest, linear, MIP level) on the store and on packed buffers: the truth the GPU is tested against |
 //! | [`file`] | the packed file format (docs/FORMAT.md): writer and hostile-input-proof reader |
 
-pub(crate) mod blocks;
 pub mod canonical;
 pub(crate) mod chains_view;
+pub(crate) mod edges;
 pub mod file;
 pub(crate) mod interiors;
 pub mod linear;

@@ -35,8 +35,8 @@ use rayon::prelude::*;
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::{self, Resolution};
 use crate::colors::store::{ColorStore, DirtyElements};
-use crate::packing::blocks::{BLOCK, split_blocks};
 use crate::packing::chains_view::ChainsView;
+use crate::packing::edges::{EdgePrefix, EdgeReader};
 use crate::packing::interiors::{FaceLevel, InteriorPrefix, InteriorReader, dirty_pieces, split_at_bounds};
 use crate::packing::linear::{FaceRecord, PackedMesh};
 use crate::packing::mip::{MipSum, inside_neighbours, interior_row_start, reduce_interior_chain, vertex_edges};
@@ -48,6 +48,9 @@ pub use crate::packing::canonical::{PackError, PackLayout};
 pub fn pack_threads() -> usize {
     rayon::current_num_threads()
 }
+
+/// Elements per parallel task.
+const BLOCK: usize = 1024;
 
 /// How many edges ahead the one-pass edge chains prefetch their faces' interiors.
 const PREFETCH_AHEAD: u32 = 24;
@@ -85,6 +88,7 @@ struct Context<'a> {
     sections: Sections,
     format: ColorFormat,
     prefix: &'a InteriorPrefix,
+    edges: &'a EdgePrefix,
 }
 
 impl Context<'_> {
@@ -110,9 +114,68 @@ impl Context<'_> {
         chain[0] = self.format.encode_quantized(color, &mut bytes[..size]);
     }
 
-    /// Writes level 0 of `edge` from the store and its encoding.
-    fn edge_level0(&self, edge: u32, chain: &mut [Rgba], bytes: &mut [u8]) {
-        self.format.encode_quantized_slice(self.store.edge_samples(edge), bytes, chain);
+    /// The edge section as written so far (`bytes`: its colour bytes, `upper`: the edges'
+    /// levels ≥ 1).
+    fn edge_reader<'b>(&'b self, bytes: &'b [u8], upper: &'b [Rgba]) -> EdgeReader<'b> {
+        EdgeReader { prefix: self.edges, bytes, upper, format: self.format }
+    }
+
+    /// Builds `edge`'s chain in `scratch`: level 0 from the store, encoded into `bytes` (the
+    /// chain's bytes) and, unless it has coarser faces, every level above, encoded and
+    /// copied to `upper` (the edge's levels ≥ 1).
+    fn edge_chain(
+        &self,
+        edge: u32,
+        coarse: bool,
+        scratch: &mut Vec<Rgba>,
+        out: (&mut [u8], &mut [Rgba]),
+        interiors: &InteriorReader,
+    ) {
+        let (bytes, upper) = out;
+        scratch.clear();
+        scratch.resize(bytes.len() / self.format.bytes_per_sample(), [0.0; 4]);
+        self.format.encode_quantized_slice(self.store.edge_samples(edge), bytes, scratch);
+        if coarse {
+            return;
+        }
+        for level in 1..=self.edge_log2(edge).saturating_sub(1) {
+            reduce_edge_level(self, edge, &[], scratch, level, interiors);
+        }
+        let n0 = scratch.len() - upper.len();
+        self.format.encode_slice(&scratch[n0..], &mut bytes[n0 * self.format.bytes_per_sample()..]);
+        upper.copy_from_slice(&scratch[n0..]);
+    }
+
+    /// Builds every edge's chain ([`Context::edge_chain`]): `bytes` is the edge section,
+    /// `upper` every edge's levels ≥ 1 (blocks of edges in parallel). Each edge prefetches
+    /// the interiors of the faces [`PREFETCH_AHEAD`] edges on, so their loads overlap work.
+    fn all_edge_chains(&self, bytes: &mut [u8], upper: &mut [Rgba], coarse: &[bool], interiors: &InteriorReader) {
+        let size = self.format.bytes_per_sample();
+        let topology = self.store.topology();
+        let edges = topology.edge_count() as usize;
+        let (chain, up) = (&self.edges.chain, &self.edges.upper);
+        let block_first: Vec<usize> = (0..=edges.div_ceil(BLOCK)).map(|b| (b * BLOCK).min(edges)).collect();
+        let byte_bounds: Vec<usize> = block_first.iter().map(|&e| chain[e] as usize * size).collect();
+        let upper_bounds: Vec<usize> = block_first.iter().map(|&e| up[e] as usize).collect();
+        split_at_bounds(bytes, &byte_bounds)
+            .into_par_iter()
+            .zip(split_at_bounds(upper, &upper_bounds))
+            .enumerate()
+            .for_each(|(b, (bytes, upper))| {
+                let mut scratch = Vec::new();
+                let (first, end) = (block_first[b], block_first[b + 1]);
+                for e in first..end {
+                    for &(face, _) in topology.faces_of_edge((e as u32).saturating_add(PREFETCH_AHEAD)) {
+                        interiors.prefetch(face);
+                    }
+                    let (c, c_end) = ((chain[e] - chain[first]) as usize, (chain[e + 1] - chain[first]) as usize);
+                    let (u, u_end) = ((up[e] - up[first]) as usize, (up[e + 1] - up[first]) as usize);
+                    if c_end > c {
+                        let out = (&mut bytes[c * size..c_end * size], &mut upper[u..u_end]);
+                        self.edge_chain(e as u32, coarse[e], &mut scratch, out, interiors);
+                    }
+                }
+            });
     }
 
     /// Builds `face`'s whole interior chain in `scratch` and writes its encoding to `bytes`
@@ -158,13 +221,6 @@ impl Context<'_> {
                     }
                 }
             });
-    }
-
-    /// Encodes levels 1.. of an edge chain (level 0 was encoded with the store read).
-    fn encode_edge_upper(&self, edge: u32, chain: &[Rgba], bytes: &mut [u8]) {
-        let size = self.format.bytes_per_sample();
-        let n0 = self.store.edge_samples(edge).len().min(chain.len());
-        self.format.encode_slice(&chain[n0..], &mut bytes[n0 * size..]);
     }
 }
 
@@ -273,7 +329,7 @@ fn reduce_edge_level(
 }
 
 /// Level `level` of vertex `v` (eq. 2.5) from its incident edges' level `level − 1`.
-fn reduce_vertex_level(ctx: &Context, incident: &[u32], v: u32, slot: &mut [Rgba], level: usize, edge_colors: &[Rgba]) {
+fn reduce_vertex_level(ctx: &Context, incident: &[u32], v: u32, slot: &mut [Rgba], level: usize, edges: &EdgeReader) {
     let previous = level - 1;
     let mut sum = MipSum::default();
     for &edge in incident {
@@ -283,10 +339,9 @@ fn reduce_vertex_level(ctx: &Context, incident: &[u32], v: u32, slot: &mut [Rgba
         }
         let r_previous = 1u32 << (log2 - previous as u32);
         let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
-        let level_start = ctx.layout.edge_base[edge as usize] as usize
-            + layout::edge_level_offset(r_edge, previous as u32).unwrap_or(0) as usize;
+        let level_start = layout::edge_level_offset(r_edge, previous as u32).unwrap_or(0) as usize;
         let position = if v == ctx.store.topology().edge_vertices[edge as usize][0] { 1 } else { r_previous - 1 };
-        sum.add(edge_colors[level_start - ctx.sections.vertex_end + position as usize - 1]);
+        sum.add(edges.get(edge, level_start + position as usize - 1).unwrap_or([0.0; 4]));
     }
     slot[level] = sum.finish(slot[previous]);
 }
@@ -322,15 +377,10 @@ fn build_all(
     let layout = ctx.layout;
     let s = ctx.sections;
     let size = ctx.format.bytes_per_sample();
-    let (vertex_colors, edge_colors) = chains.split_at_mut(s.vertex_end);
+    let (vertex_colors, edge_upper) = chains.split_at_mut(s.vertex_end);
     let (vertex_bytes, rest_bytes) = bytes.split_at_mut(s.vertex_end * size);
     let (edge_bytes, interior_bytes) = rest_bytes.split_at_mut((s.edge_end - s.vertex_end) * size);
     let levels = s.levels;
-    let edge_base = |e: u32| {
-        let len = store.edge_resolution(e).map_or(0, layout::edge_chain_len);
-        (len > 0).then(|| layout.edge_base[e as usize] as usize)
-    };
-    let edge_len = |e: u32| store.edge_resolution(e).map_or(0, layout::edge_chain_len) as usize;
     // Every interior chain first: an interior reads nothing else.
     ctx.all_interior_chains(interior_bytes, upper);
     let interiors = ctx.interiors(interior_bytes, upper);
@@ -347,31 +397,11 @@ fn build_all(
             simple[v as usize] = false;
         }
     }
-    split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base)
-        .into_par_iter()
-        .for_each(|block| {
-            for e in block.ids.clone() {
-                // The faces of the edge a few steps ahead: their loads overlap this one's work.
-                for &(face, _) in topology.faces_of_edge(e + PREFETCH_AHEAD) {
-                    interiors.prefetch(face);
-                }
-                let Some(b) = edge_base(e) else { continue };
-                let (at, len) = (b - block.offset, edge_len(e));
-                let (chain, out) = (&mut block.chains[at..at + len], &mut block.bytes[at * size..(at + len) * size]);
-                // Level 0 from the store (encoded once, here), then the levels above.
-                ctx.edge_level0(e, chain, out);
-                if !coarse_flag[e as usize] {
-                    for level in 1..=ctx.edge_log2(e).saturating_sub(1) {
-                        reduce_edge_level(ctx, e, &[], chain, level, &interiors);
-                    }
-                    ctx.encode_edge_upper(e, chain, out);
-                }
-            }
-        });
+    ctx.all_edge_chains(edge_bytes, edge_upper, &coarse_flag, &interiors);
     let (offsets, list) = vertex_edge;
     let incident = |v: usize| &list[offsets[v] as usize..offsets[v + 1] as usize];
     {
-        let edge_colors: &[Rgba] = edge_colors;
+        let edges = ctx.edge_reader(edge_bytes, edge_upper);
         vertex_colors
             .par_chunks_mut(levels)
             .zip(vertex_bytes.par_chunks_mut(levels * size))
@@ -381,7 +411,7 @@ fn build_all(
                 ctx.vertex_level0(v as u32, slot, out);
                 if simple[v] && levels > 1 {
                     for level in 1..levels {
-                        reduce_vertex_level(ctx, incident(v), v as u32, slot, level, edge_colors);
+                        reduce_vertex_level(ctx, incident(v), v as u32, slot, level, &edges);
                     }
                     ctx.format.encode_slice(&slot[1..], &mut out[size..]);
                 }
@@ -391,53 +421,48 @@ fn build_all(
         return;
     }
     for level in 1..levels {
-        let coarse = {
+        // Each edge with coarser faces in a scratch chain (few edges: collected, then copied).
+        let done: Vec<(u32, Vec<Rgba>)> = {
+            let edges = ctx.edge_reader(edge_bytes, edge_upper);
             let view = ChainsView {
                 store,
                 records: ctx.records,
                 vertex_levels: layout.vertex_levels,
                 vertex_colors: &*vertex_colors,
-                edge_colors: &*edge_colors,
+                edges,
                 interiors,
                 vertex_section: s.vertex_end,
                 interior_start: s.edge_end,
             };
-            coarse_table(ctx, &view, &coarse_edges, level as u32)
+            let coarse = coarse_table(ctx, &view, &coarse_edges, level as u32);
+            coarse_edges
+                .par_iter()
+                .map(|&e| {
+                    let mut chain = Vec::new();
+                    edges.chain_into(e, &mut chain);
+                    reduce_edge_level(ctx, e, coarse_of(&coarse, e), &mut chain, level as u32, &interiors);
+                    (e, chain)
+                })
+                .collect()
         };
-        // The byte halves are not written here: split a throwaway empty buffer.
-        let mut no_bytes: [u8; 0] = [];
-        split_blocks(edge_colors, &mut no_bytes, 0, s.vertex_end, topology.edge_count(), edge_base)
-            .into_par_iter()
-            .for_each(|block| {
-                for e in block.ids.clone() {
-                    if let (Some(b), true) = (edge_base(e), coarse_flag[e as usize]) {
-                        let chain = &mut block.chains[b - block.offset..b - block.offset + edge_len(e)];
-                        reduce_edge_level(ctx, e, coarse_of(&coarse, e), chain, level as u32, &interiors);
-                    }
-                }
-            });
-        let edge_colors: &[Rgba] = edge_colors;
+        for (e, chain) in done {
+            let (c, u) = ctx.edges.ranges(e);
+            let n0 = c.len() - u.len();
+            edge_upper[u].copy_from_slice(&chain[n0..]);
+        }
+        let edges = ctx.edge_reader(edge_bytes, edge_upper);
         vertex_colors.par_chunks_mut(levels).enumerate().with_min_len(BLOCK).for_each(|(v, slot)| {
             if !simple[v] {
-                reduce_vertex_level(ctx, incident(v), v as u32, slot, level, edge_colors);
+                reduce_vertex_level(ctx, incident(v), v as u32, slot, level, &edges);
             }
         });
     }
     // Levels 1.. of the edges and vertices done level by level, encoded once final.
-    split_blocks(edge_colors, edge_bytes, size, s.vertex_end, topology.edge_count(), edge_base)
-        .into_par_iter()
-        .for_each(|block| {
-            for e in block.ids.clone() {
-                if let (Some(b), true) = (edge_base(e), coarse_flag[e as usize]) {
-                    let (at, len) = (b - block.offset, edge_len(e));
-                    ctx.encode_edge_upper(
-                        e,
-                        &block.chains[at..at + len],
-                        &mut block.bytes[at * size..(at + len) * size],
-                    );
-                }
-            }
-        });
+    for &e in &coarse_edges {
+        let (c, u) = ctx.edges.ranges(e);
+        let n0 = c.len() - u.len();
+        ctx.format.encode_slice(&edge_upper[u], &mut edge_bytes[(c.start + n0) * size..c.end * size]);
+    }
     if levels > 1 {
         vertex_colors.par_chunks(levels).zip(vertex_bytes.par_chunks_mut(levels * size)).enumerate().for_each(
             |(v, (chain, out))| {
@@ -449,16 +474,19 @@ fn build_all(
     }
 }
 
-/// A packed mesh with what an incremental repack needs: its layout, the vertex and edge
-/// chains and the interiors' levels ≥ 1 in `f32` (interior level 0 is read back from the
-/// bytes, [`crate::packing::interiors`]) and the vertex → edge incidence. Built by a full pack; [`PackCache::update`] then
-/// recomputes only the chains an edit reaches.
+/// A packed mesh with what an incremental repack needs: its layout, the vertex chains and
+/// the edges' and interiors' levels ≥ 1 in `f32` (level 0 is read back from the bytes,
+/// [`crate::packing::edges`], [`crate::packing::interiors`]) and the vertex → edge
+/// incidence. Built by a full pack; [`PackCache::update`] then recomputes only the chains
+/// an edit reaches.
 #[derive(Debug, Clone)]
 pub struct PackCache {
     layout: PackLayout,
     sections: Sections,
+    /// The vertex chains, then every edge's levels ≥ 1 ([`EdgePrefix::upper`]).
     chains: Vec<Rgba>,
     prefix: InteriorPrefix,
+    edges: EdgePrefix,
     upper: Vec<Rgba>,
     vertex_edge: (Vec<u32>, Vec<u32>),
     packed: PackedMesh,
@@ -533,13 +561,15 @@ impl PackCache {
         );
         let size = format.bytes_per_sample();
         let prefix = InteriorPrefix::of(store);
+        let edges = EdgePrefix::of(store);
         // Every sample of these three is written by `build_all`: stale contents never show.
-        let mut chains = reuse(chains, sections.edge_end, [0.0f32; 4]);
+        let mut chains = reuse(chains, sections.vertex_end + edges.upper_len(), [0.0f32; 4]);
         let mut upper = reuse(upper, prefix.upper_len(), [0.0f32; 4]);
         let mut colors = reuse(colors, sections.total * size, 0u8);
         let vertex_edge = vertex_edges(topology);
         {
-            let ctx = Context { store, layout: &layout, records: &records, sections, format, prefix: &prefix };
+            let ctx =
+                Context { store, layout: &layout, records: &records, sections, format, prefix: &prefix, edges: &edges };
             build_all(&ctx, &mut chains, &mut upper, &mut colors, &vertex_edge);
         }
         position_copy.clear();
@@ -554,7 +584,7 @@ impl PackCache {
             format,
             colors,
         };
-        Ok(PackCache { layout, sections, chains, prefix, upper, vertex_edge, packed })
+        Ok(PackCache { layout, sections, chains, prefix, edges, upper, vertex_edge, packed })
     }
 
     /// The packed mesh.
@@ -591,11 +621,18 @@ impl PackCache {
         let levels = s.levels;
         let layout = &self.layout;
         let prefix = &self.prefix;
-        let ctx = Context { store, layout, records: &self.packed.face_records, sections: s, format, prefix };
+        let ctx = Context {
+            store,
+            layout,
+            records: &self.packed.face_records,
+            sections: s,
+            format,
+            prefix,
+            edges: &self.edges,
+        };
         let chains = &mut self.chains;
         let upper = &mut self.upper;
         let bytes = &mut self.packed.colors;
-        let edge_len = |e: u32| store.edge_resolution(e).map_or(0, layout::edge_chain_len) as usize;
         let interior_len =
             |f: u32| layout::interior_chain_len(store.face_resolution(f).unwrap_or(Resolution::ONE)) as usize;
         // Level 0 and whole interior chains.
@@ -603,11 +640,12 @@ impl PackCache {
             let at = v as usize * levels;
             ctx.vertex_level0(v, &mut chains[at..at + levels], &mut bytes[at * size..(at + levels) * size]);
         }
+        let mut scratch = Vec::new();
         for &e in &dirty.edges {
-            let (at, len) = (layout.edge_base[e as usize] as usize, edge_len(e));
-            if len > 0 {
-                ctx.edge_level0(e, &mut chains[at..at + len], &mut bytes[at * size..(at + len) * size]);
-            }
+            let (c, u) = self.edges.ranges(e);
+            scratch.resize(c.len() - u.len(), [0.0; 4]);
+            let out = &mut bytes[(s.vertex_end + c.start) * size..(s.vertex_end + c.end) * size];
+            format.encode_quantized_slice(store.edge_samples(e), out, &mut scratch);
         }
         {
             let (_, interior_bytes) = bytes.split_at_mut(s.edge_end * size);
@@ -681,15 +719,16 @@ impl PackCache {
             }
             edges.sort_unstable();
             vertices.sort_unstable();
-            let (vertex_colors, edge_colors) = chains.split_at_mut(s.vertex_end);
+            let (vertex_colors, edge_upper) = chains.split_at_mut(s.vertex_end);
             let interiors = ctx.interiors(&bytes[s.edge_end * size..], upper);
+            let edge_bytes = &bytes[s.vertex_end * size..s.edge_end * size];
             let coarse = {
                 let view = ChainsView {
                     store,
                     records: ctx.records,
                     vertex_levels: layout.vertex_levels,
                     vertex_colors: &*vertex_colors,
-                    edge_colors: &*edge_colors,
+                    edges: ctx.edge_reader(edge_bytes, edge_upper),
                     interiors,
                     vertex_section: s.vertex_end,
                     interior_start: s.edge_end,
@@ -697,24 +736,20 @@ impl PackCache {
                 coarse_table(&ctx, &view, &edges, level as u32)
             };
             for &e in &edges {
-                let len = edge_len(e);
-                if len == 0 {
+                let (c, u) = self.edges.ranges(e);
+                if c.is_empty() {
                     continue;
                 }
-                let at = layout.edge_base[e as usize] as usize - s.vertex_end;
-                reduce_edge_level(
-                    &ctx,
-                    e,
-                    coarse_of(&coarse, e),
-                    &mut edge_colors[at..at + len],
-                    level as u32,
-                    &interiors,
-                );
+                ctx.edge_reader(edge_bytes, edge_upper).chain_into(e, &mut scratch);
+                reduce_edge_level(&ctx, e, coarse_of(&coarse, e), &mut scratch, level as u32, &interiors);
+                let n0 = c.len() - u.len();
+                edge_upper[u].copy_from_slice(&scratch[n0..]);
             }
+            let reader = ctx.edge_reader(edge_bytes, edge_upper);
             for &v in &vertices {
                 let at = v as usize * levels;
                 let list = &incident[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
-                reduce_vertex_level(&ctx, list, v, &mut vertex_colors[at..at + levels], level, edge_colors);
+                reduce_vertex_level(&ctx, list, v, &mut vertex_colors[at..at + levels], level, &reader);
             }
         }
         // Encode what changed; report it as ranges.
@@ -725,10 +760,12 @@ impl PackCache {
             ranges.push((at as u64, levels as u64));
         }
         for &e in &edges {
-            let (at, len) = (layout.edge_base[e as usize] as usize, edge_len(e));
-            if len > 0 {
-                ctx.encode_edge_upper(e, &chains[at..at + len], &mut bytes[at * size..(at + len) * size]);
-                ranges.push((at as u64, len as u64));
+            let (c, u) = self.edges.ranges(e);
+            if !c.is_empty() {
+                let (first, n0) = (s.vertex_end + c.start, c.len() - u.len());
+                let upper_levels = &chains[s.vertex_end + u.start..s.vertex_end + u.end];
+                format.encode_slice(upper_levels, &mut bytes[(first + n0) * size..(s.vertex_end + c.end) * size]);
+                ranges.push((first as u64, c.len() as u64));
             }
         }
         for &f in &dirty.faces {
