@@ -67,16 +67,18 @@ pub(crate) struct EdgeReader<'a> {
 
 impl EdgeReader<'_> {
     /// Sample `offset` of `edge`'s chain, as the `f32` chain holds it.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn get(&self, edge: u32, offset: usize) -> Option<Rgba> {
-        let (chain, upper) = self.prefix.ranges(edge);
-        let n0 = chain.len() - upper.len();
+        let e = edge as usize;
+        let (chain, chain_end) = (*self.prefix.chain.get(e)? as usize, *self.prefix.chain.get(e + 1)? as usize);
+        let (upper, upper_end) = (*self.prefix.upper.get(e)? as usize, *self.prefix.upper.get(e + 1)? as usize);
+        let n0 = (chain_end - chain) - (upper_end - upper);
         if offset < n0 {
             let size = self.format.bytes_per_sample();
-            let at = (chain.start + offset) * size;
+            let at = (chain + offset) * size;
             Some(self.format.decode(self.bytes.get(at..at + size)?))
         } else {
-            self.upper.get(upper.start + offset - n0).copied().filter(|_| offset < chain.len())
+            self.upper.get(upper + offset - n0).copied().filter(|_| offset < chain_end - chain)
         }
     }
 
