@@ -11,6 +11,7 @@
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout;
 use crate::colors::store::ColorStore;
+use crate::packing::interiors::prefix_sums;
 
 /// Per edge, where its chain starts in the edge section of the colour buffer (`chain`)
 /// and where its levels ≥ 1 start in the upper buffer (`upper`); both `E + 1` long (prefix
@@ -24,20 +25,10 @@ pub(crate) struct EdgePrefix {
 impl EdgePrefix {
     /// The prefixes of `store`'s edge resolutions (the canonical layout's edge order).
     pub(crate) fn of(store: &ColorStore) -> Self {
-        let edges = store.topology().edge_count() as usize;
-        let mut chain = Vec::with_capacity(edges + 1);
-        let mut upper = Vec::with_capacity(edges + 1);
-        let (mut c, mut u) = (0u32, 0u32);
-        for e in 0..edges as u32 {
-            chain.push(c);
-            upper.push(u);
-            let len = store.edge_resolution(e).map_or(0, layout::edge_chain_len);
-            let level0 = store.edge_resolution(e).map_or(0, layout::edge_sample_count).min(len);
-            c = c.saturating_add(len);
-            u = u.saturating_add(len - level0);
-        }
-        chain.push(c);
-        upper.push(u);
+        let lengths = (0..store.topology().edge_count()).map(|e| {
+            store.edge_resolution(e).map_or((0, 0), |r| (layout::edge_chain_len(r), layout::edge_sample_count(r)))
+        });
+        let (chain, upper) = prefix_sums(lengths);
         EdgePrefix { chain, upper }
     }
 

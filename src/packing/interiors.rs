@@ -25,19 +25,9 @@ pub(crate) struct InteriorPrefix {
 impl InteriorPrefix {
     /// The prefixes of `store`'s face resolutions (the canonical layout's interior order).
     pub(crate) fn of(store: &ColorStore) -> Self {
-        let faces = store.face_resolutions();
-        let mut chain = Vec::with_capacity(faces.len() + 1);
-        let mut upper = Vec::with_capacity(faces.len() + 1);
-        let (mut c, mut u) = (0u32, 0u32);
-        for &r in faces {
-            chain.push(c);
-            upper.push(u);
-            let len = layout::interior_chain_len(r);
-            c = c.saturating_add(len);
-            u = u.saturating_add(len - layout::interior_sample_count(r).min(len));
-        }
-        chain.push(c);
-        upper.push(u);
+        let lengths =
+            store.face_resolutions().iter().map(|&r| (layout::interior_chain_len(r), layout::interior_sample_count(r)));
+        let (chain, upper) = prefix_sums(lengths);
         InteriorPrefix { chain, upper }
     }
 
@@ -45,6 +35,23 @@ impl InteriorPrefix {
     pub(crate) fn upper_len(&self) -> usize {
         self.upper.last().copied().unwrap_or(0) as usize
     }
+}
+
+/// Prefix sums of chain lengths and of their levels ≥ 1, from `(chain length, level-0
+/// length)` per element: `(chain, upper)`, each one longer than the elements.
+pub(crate) fn prefix_sums(lengths: impl ExactSizeIterator<Item = (u32, u32)>) -> (Vec<u32>, Vec<u32>) {
+    let mut chain = Vec::with_capacity(lengths.len() + 1);
+    let mut upper = Vec::with_capacity(lengths.len() + 1);
+    let (mut c, mut u) = (0u32, 0u32);
+    for (len, level0) in lengths {
+        chain.push(c);
+        upper.push(u);
+        c = c.saturating_add(len);
+        u = u.saturating_add(len - level0.min(len));
+    }
+    chain.push(c);
+    upper.push(u);
+    (chain, upper)
 }
 
 /// The interior section as built so far: its bytes (level 0 decoded from them) and the

@@ -150,32 +150,14 @@ impl Context<'_> {
     /// `upper` every edge's levels ≥ 1 (blocks of edges in parallel). Each edge prefetches
     /// the interiors of the faces [`PREFETCH_AHEAD`] edges on, so their loads overlap work.
     fn all_edge_chains(&self, bytes: &mut [u8], upper: &mut [Rgba], coarse: &[bool], interiors: &InteriorReader) {
-        let size = self.format.bytes_per_sample();
         let topology = self.store.topology();
-        let edges = topology.edge_count() as usize;
-        let (chain, up) = (&self.edges.chain, &self.edges.upper);
-        let block_first: Vec<usize> = (0..=edges.div_ceil(BLOCK)).map(|b| (b * BLOCK).min(edges)).collect();
-        let byte_bounds: Vec<usize> = block_first.iter().map(|&e| chain[e] as usize * size).collect();
-        let upper_bounds: Vec<usize> = block_first.iter().map(|&e| up[e] as usize).collect();
-        split_at_bounds(bytes, &byte_bounds)
-            .into_par_iter()
-            .zip(split_at_bounds(upper, &upper_bounds))
-            .enumerate()
-            .for_each(|(b, (bytes, upper))| {
-                let mut scratch = Vec::new();
-                let (first, end) = (block_first[b], block_first[b + 1]);
-                for e in first..end {
-                    for &(face, _) in topology.faces_of_edge((e as u32).saturating_add(PREFETCH_AHEAD)) {
-                        interiors.prefetch(face);
-                    }
-                    let (c, c_end) = ((chain[e] - chain[first]) as usize, (chain[e + 1] - chain[first]) as usize);
-                    let (u, u_end) = ((up[e] - up[first]) as usize, (up[e + 1] - up[first]) as usize);
-                    if c_end > c {
-                        let out = (&mut bytes[c * size..c_end * size], &mut upper[u..u_end]);
-                        self.edge_chain(e as u32, coarse[e], &mut scratch, out, interiors);
-                    }
-                }
-            });
+        let size = self.format.bytes_per_sample();
+        for_each_chain((bytes, upper), size, (&self.edges.chain, &self.edges.upper), |e, scratch, bytes, upper| {
+            for &(face, _) in topology.faces_of_edge((e as u32).saturating_add(PREFETCH_AHEAD)) {
+                interiors.prefetch(face);
+            }
+            self.edge_chain(e as u32, coarse[e], scratch, (bytes, upper), interiors);
+        });
     }
 
     /// Builds `face`'s whole interior chain in `scratch` and writes its encoding to `bytes`
@@ -199,29 +181,41 @@ impl Context<'_> {
     /// face's levels ≥ 1 (blocks of faces in parallel, one scratch chain per block).
     fn all_interior_chains(&self, bytes: &mut [u8], upper: &mut [Rgba]) {
         let size = self.format.bytes_per_sample();
-        let faces = self.store.topology().face_count() as usize;
-        let chain = &self.prefix.chain;
-        let up = &self.prefix.upper;
-        let block_first: Vec<usize> = (0..=faces.div_ceil(BLOCK)).map(|b| (b * BLOCK).min(faces)).collect();
-        let byte_bounds: Vec<usize> = block_first.iter().map(|&f| chain[f] as usize * size).collect();
-        let upper_bounds: Vec<usize> = block_first.iter().map(|&f| up[f] as usize).collect();
-        split_at_bounds(bytes, &byte_bounds)
-            .into_par_iter()
-            .zip(split_at_bounds(upper, &upper_bounds))
-            .enumerate()
-            .for_each(|(b, (bytes, upper))| {
-                let mut scratch = Vec::new();
-                let (first, end) = (block_first[b], block_first[b + 1]);
-                for f in first..end {
-                    let (c, c_end) = ((chain[f] - chain[first]) as usize, (chain[f + 1] - chain[first]) as usize);
-                    let (u, u_end) = ((up[f] - up[first]) as usize, (up[f + 1] - up[first]) as usize);
-                    if c_end > c {
-                        let out = &mut bytes[c * size..c_end * size];
-                        self.interior_chain(f as u32, &mut scratch, &mut upper[u..u_end], out);
-                    }
-                }
-            });
+        for_each_chain((bytes, upper), size, (&self.prefix.chain, &self.prefix.upper), |f, scratch, bytes, upper| {
+            self.interior_chain(f as u32, scratch, upper, bytes);
+        });
     }
+}
+
+/// Runs `work(id, scratch, bytes, upper)` for every element that has samples, in parallel
+/// blocks of [`BLOCK`] ids: `bytes` and `upper` are one section of the colour bytes and its
+/// `f32` levels ≥ 1, laid out by the prefix sums `prefix` (chain, upper; `count + 1` long),
+/// and each element gets its own pieces of both (and one scratch chain per block).
+fn for_each_chain(
+    (bytes, upper): (&mut [u8], &mut [Rgba]),
+    size: usize,
+    (chain, up): (&[u32], &[u32]),
+    work: impl Fn(usize, &mut Vec<Rgba>, &mut [u8], &mut [Rgba]) + Sync,
+) {
+    let count = chain.len().saturating_sub(1);
+    let block_first: Vec<usize> = (0..=count.div_ceil(BLOCK)).map(|b| (b * BLOCK).min(count)).collect();
+    let byte_bounds: Vec<usize> = block_first.iter().map(|&e| chain[e] as usize * size).collect();
+    let upper_bounds: Vec<usize> = block_first.iter().map(|&e| up[e] as usize).collect();
+    split_at_bounds(bytes, &byte_bounds)
+        .into_par_iter()
+        .zip(split_at_bounds(upper, &upper_bounds))
+        .enumerate()
+        .for_each(|(b, (bytes, upper))| {
+            let mut scratch = Vec::new();
+            let (first, end) = (block_first[b], block_first[b + 1]);
+            for e in first..end {
+                let (c, c_end) = ((chain[e] - chain[first]) as usize, (chain[e + 1] - chain[first]) as usize);
+                let (u, u_end) = ((up[e] - up[first]) as usize, (up[e + 1] - up[first]) as usize);
+                if c_end > c {
+                    work(e, &mut scratch, &mut bytes[c * size..c_end * size], &mut upper[u..u_end]);
+                }
+            }
+        });
 }
 
 /// What the coarser faces of `edge` show next to its level-`(level − 1)` samples (the seam
