@@ -69,13 +69,11 @@ struct Sections {
 }
 
 impl Sections {
-    fn of(store: &ColorStore, layout: &PackLayout) -> Self {
-        let topology = store.topology();
+    /// The sections of `layout`; the edge section is as long as `edges` says.
+    fn of(store: &ColorStore, layout: &PackLayout, edges: &EdgePrefix) -> Self {
         let levels = layout.vertex_levels as usize;
-        let vertex_end = topology.vertex_count as usize * levels;
-        let edge_samples: usize = (0..topology.edge_count())
-            .map(|e| store.edge_resolution(e).map_or(0, layout::edge_chain_len) as usize)
-            .sum();
+        let vertex_end = store.topology().vertex_count as usize * levels;
+        let edge_samples = edges.chain.last().copied().unwrap_or(0) as usize;
         Sections { levels, vertex_end, edge_end: vertex_end + edge_samples, total: layout.sample_count as usize }
     }
 }
@@ -547,7 +545,8 @@ impl PackCache {
             return Err(PackError::PositionCount { positions: positions.len(), vertices: topology.vertex_count });
         }
         let layout = PackLayout::of(store)?;
-        let sections = Sections::of(store, &layout);
+        let edges = EdgePrefix::of(store);
+        let sections = Sections::of(store, &layout, &edges);
         let Buffers { chains, upper, colors, mut records, positions: mut position_copy, mut indices } = buffers;
         records.clear();
         records.par_extend(
@@ -555,7 +554,6 @@ impl PackCache {
         );
         let size = format.bytes_per_sample();
         let prefix = InteriorPrefix::of(store);
-        let edges = EdgePrefix::of(store);
         // Every sample of these three is written by `build_all`: stale contents never show.
         let mut chains = reuse(chains, sections.vertex_end + edges.upper_len(), [0.0f32; 4]);
         let mut upper = reuse(upper, prefix.upper_len(), [0.0f32; 4]);
