@@ -1094,6 +1094,12 @@ fn bench_paint_reports_every_measurement() {
             }
             assert!(row[name]["samples_covered"].as_u64().unwrap() > 0, "{name}");
         }
+        // Frame-paced: each dab after a frame of idle.
+        for name in ["occlusion_frame_paced", "blur_frame_paced"] {
+            assert!(row[name]["samples_per_second_median"].as_f64().unwrap() > 0.0, "{name}");
+            assert!((row[name]["dab_gap_seconds"].as_f64().unwrap() - 1.0 / 60.0).abs() < 1e-4, "{name}");
+        }
+        assert_eq!(row["occlusion"]["dab_gap_seconds"].as_f64(), Some(0.0));
     }
     let first = &report["session_first_dab"];
     assert!(first["samples_per_second_best"].as_f64().unwrap() > 0.0, "{first}");
@@ -1101,6 +1107,7 @@ fn bench_paint_reports_every_measurement() {
     assert_eq!(report["headline"]["row"], "occlusion");
     assert_eq!(report["headline"]["target_samples"], 100_000);
     assert!(report["headline"]["samples_per_second_median"].as_f64().unwrap() > 0.0);
+    assert!(report["headline"]["samples_per_second_median_frame_paced"].as_f64().unwrap() > 0.0);
     assert!(report["occlusion_depth_map"]["build_seconds"].as_f64().unwrap() > 0.0);
     assert_eq!(report["occlusion_depth_map"]["maps_built"], 1);
     assert!(report["threads"].as_u64().unwrap() >= 1);
