@@ -132,17 +132,7 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
         brushes.push(row);
     }
     // The headline: the editor's defaults on the largest brush.
-    let headline = brushes.last().map_or(serde_json::Value::Null, |row| {
-        let dab = &row[HEADLINE_ROW];
-        serde_json::json!({
-            "row": HEADLINE_ROW,
-            "what": "paint with the editor's defaults (occlusion and backface culling on), in a stroke",
-            "target_samples": row["target_samples"],
-            "samples_per_second_best": dab["samples_per_second_best"],
-            "samples_per_second_median": dab["samples_per_second_median"],
-            "samples_per_second_median_frame_paced": row[format!("{HEADLINE_ROW}_frame_paced")]["samples_per_second_median"],
-        })
-    });
+    let headline = brushes.last().map_or(serde_json::Value::Null, headline);
     // The editor's whole dab on the largest brush: the dab, then the upload it triggers.
     let gpu_upload = match (Gpu::new_headless(), options.target_samples.last()) {
         (Ok(gpu), Some(&target)) => {
@@ -180,6 +170,19 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
             "threads": crate::packing::packer::pack_threads(),
         },
     }))
+}
+
+/// The headline of a brush size's `row`: the editor's defaults ([`HEADLINE_ROW`]).
+fn headline(row: &serde_json::Value) -> serde_json::Value {
+    let dab = &row[HEADLINE_ROW];
+    serde_json::json!({
+        "row": HEADLINE_ROW,
+        "what": "paint with the editor's defaults (occlusion and backface culling on), in a stroke",
+        "target_samples": row["target_samples"],
+        "samples_per_second_best": dab["samples_per_second_best"],
+        "samples_per_second_median": dab["samples_per_second_median"],
+        "samples_per_second_median_frame_paced": row[format!("{HEADLINE_ROW}_frame_paced")]["samples_per_second_median"],
+    })
 }
 
 /// The brush radius (world units, by bisection on the measured footprint) whose dab covers
