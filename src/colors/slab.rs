@@ -86,16 +86,19 @@ impl Slab {
     /// The samples of each element of `ids`, all writable at once (for writers that work on
     /// many elements in parallel). `None` when an id is past the end or listed twice.
     pub(crate) fn many_mut(&mut self, ids: &[u32]) -> Option<Vec<&mut [Rgba]>> {
-        let mut order = Vec::with_capacity(ids.len());
-        for (position, &id) in ids.iter().enumerate() {
+        // Each run as (chunk · 2³² + start, len, position in `ids`): sorting by the one key
+        // puts the runs in storage order (16-byte entries, one comparison each).
+        let mut order: Vec<(u64, u32, u32)> = Vec::with_capacity(ids.len());
+        for (position, &id) in (0u32..).zip(ids) {
             let slot = *self.slots.get(id as usize)?;
-            order.push((slot.chunk, slot.start, slot.len, position));
+            // Empty runs share `Slot::default()`; they need no storage.
+            if slot.len > 0 {
+                order.push(((u64::from(slot.chunk) << 32) | u64::from(slot.start), slot.len, position));
+            }
         }
-        // Empty runs share `Slot::default()`; they need no storage.
-        order.retain(|&(_, _, len, _)| len > 0);
         // Often already in order (faces by id, a stroke's elements in their first dab's order).
-        if !order.is_sorted() {
-            order.sort_unstable();
+        if !order.is_sorted_by_key(|run| run.0) {
+            order.sort_unstable_by_key(|run| run.0);
         }
         let mut out: Vec<&mut [Rgba]> = Vec::with_capacity(ids.len());
         out.resize_with(ids.len(), || &mut []);
@@ -103,8 +106,8 @@ impl Slab {
         // The chunk being split: its index, the part after the last run taken, and where that
         // part starts.
         let mut current: Option<(usize, &mut [Rgba], usize)> = None;
-        for (chunk, start, len, position) in order {
-            let (chunk, start, len) = (chunk as usize, start as usize, len as usize);
+        for (key, len, position) in order {
+            let (chunk, start, len) = ((key >> 32) as usize, (key & u64::from(u32::MAX)) as usize, len as usize);
             if current.as_ref().is_none_or(|(index, _, _)| *index != chunk) {
                 // Only the chunks written into are made unique (copied if shared).
                 let (index, data) = chunks.find(|(index, _)| *index >= chunk)?;
@@ -123,7 +126,7 @@ impl Slab {
             let (piece, tail) = tail[skip..].split_at_mut(len);
             *rest = tail;
             *offset = start + len;
-            *out.get_mut(position)? = piece;
+            *out.get_mut(position as usize)? = piece;
         }
         Some(out)
     }

@@ -154,6 +154,30 @@ impl ElementSlice<'_> {
         true
     }
 
+    /// Writes `blend(old, w)` to each sample `start + i` whose weight `w = weights[i]` is
+    /// positive, as [`ElementSlice::write`] does; returns how many had a positive weight.
+    #[inline(always)]
+    pub fn blend_run(
+        &mut self,
+        start: u32,
+        weights: &[f32],
+        log: &mut UndoLog,
+        blend: impl Fn(Rgba, f32) -> Rgba,
+    ) -> u64 {
+        let mut covered = 0;
+        for (index, &w) in (start..).zip(weights) {
+            if w <= 0.0 {
+                continue;
+            }
+            let Some(&old) = self.samples.get(index as usize) else {
+                break;
+            };
+            covered += 1;
+            self.write(index, blend(old, w), log);
+        }
+        covered
+    }
+
     /// Samples whose colour [`ElementSlice::write`] changed.
     pub fn changed(&self) -> u32 {
         self.changed

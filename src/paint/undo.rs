@@ -624,10 +624,12 @@ impl UndoHistory {
     }
 }
 
-/// Whether two colours differ in any bit (one 128-bit comparison).
+/// Whether two colours differ in any bit (compiles to one vector comparison).
 #[inline(always)]
 pub(super) fn differs(a: Rgba, b: Rgba) -> bool {
-    bytemuck::cast::<Rgba, u128>(a) != bytemuck::cast::<Rgba, u128>(b)
+    let (x, y) = (a.map(f32::to_bits), b.map(f32::to_bits));
+    // Lane by lane (`x != y` on the arrays becomes a byte comparison through integer registers).
+    (x[0] ^ y[0]) | (x[1] ^ y[1]) | (x[2] ^ y[2]) | (x[3] ^ y[3]) != 0
 }
 
 /// The one way tools change a store: every write records the old value in the history's

@@ -165,6 +165,68 @@ impl<C: Coverage> Kernel<'_, C> {
         }
     }
 
+    /// Whether the element's samples can take [`Kernel::blend_stream`]: one sphere reaching
+    /// it, no occlusion to test, and a blend that needs no base colour.
+    #[inline(always)]
+    fn streams(&self, mask: u8, unoccluded: bool) -> bool {
+        mask != 0 && unoccluded && self.op.blend != BlendMode::EraseToBase
+    }
+
+    /// Blends the element's samples `0, 1, …`, which `rows` lists in storage order as rows of
+    /// `count` points `k = 1..=count` at squared distance `c[0] + k·(c[1] + k·c[2])` from the
+    /// one sphere's centre: their weights [`BATCH`] at a time
+    /// ([`Coverage::weights_of_distance_sq`], one vectorised loop), then the blend of those
+    /// with a positive weight, the blend mode chosen once per element.
+    #[inline(always)]
+    fn blend_stream(&self, out: &mut Out, rows: impl Iterator<Item = ([f64; 3], u32)>) {
+        let color = self.op.color;
+        match self.op.blend {
+            BlendMode::Mix => self.stream_with(out, rows, |old, w| BlendMode::Mix.blend(old, color, old, w)),
+            BlendMode::Add => self.stream_with(out, rows, |old, w| BlendMode::Add.blend(old, color, old, w)),
+            BlendMode::Multiply => {
+                self.stream_with(out, rows, |old, w| BlendMode::Multiply.blend(old, color, old, w));
+            }
+            BlendMode::EraseToBase => {}
+        }
+    }
+
+    /// [`Kernel::blend_stream`] with the blend `blend(old, weight)`.
+    #[inline(always)]
+    fn stream_with(
+        &self,
+        out: &mut Out,
+        rows: impl Iterator<Item = ([f64; 3], u32)>,
+        blend: impl Fn(Rgba, f32) -> Rgba,
+    ) {
+        let (mut d2, mut weights) = ([0.0f64; BATCH], [0.0f32; BATCH]);
+        // The storage index of `d2[0]`, and the distances buffered.
+        let (mut start, mut n) = (0u32, 0usize);
+        let mut flush = |d2: &[f64], start: u32| {
+            if let Some(weights) = weights.get_mut(..d2.len()) {
+                self.coverage.weights_of_distance_sq(d2, weights);
+                *out.covered += out.slice.blend_run(start, weights, out.log, &blend);
+            }
+        };
+        for ([c0, c1, c2], count) in rows {
+            let mut k = 1u32;
+            while k <= count {
+                let take = ((count - k + 1) as usize).min(BATCH - n);
+                if let Some(slots) = d2.get_mut(n..n + take) {
+                    for (slot, k) in slots.iter_mut().zip(k..) {
+                        let k = f64::from(k);
+                        *slot = c0 + k * (c1 + k * c2);
+                    }
+                }
+                (n, k) = (n + take, k + take as u32);
+                if n == BATCH {
+                    flush(&d2, start);
+                    (start, n) = (start + BATCH as u32, 0);
+                }
+            }
+        }
+        flush(d2.get(..n).unwrap_or(&[]), start);
+    }
+
     /// [`Kernel::row`] with `weight(k)`, the weight of point `k`.
     #[inline(always)]
     fn row_with(
@@ -212,9 +274,18 @@ impl<C: Coverage> Kernel<'_, C> {
         let [p0, p1, p2] = corners.map(|v| position(self.positions, v));
         let inv = 1.0 / f64::from(res);
         let (e1, e2) = ((p1 - p0) * inv, (p2 - p0) * inv);
+        let unoccluded = self.coverage.unoccluded(&[p0, p1, p2], mask);
+        if self.streams(mask, unoccluded) && self.coverage.row_distance(p0, e2).is_some() {
+            // Every interior point in storage order: row `i`, then `k` along it.
+            let rows = (1..res - 1).map(|i| {
+                let c = self.coverage.row_distance(p0 + e1 * f64::from(i), e2).unwrap_or([f64::NAN; 3]);
+                (c, res - 1 - i)
+            });
+            self.blend_stream(out, rows);
+            return;
+        }
         let base_same = op.base.and_then(|b| (b.face_resolution(face) == Some(r)).then(|| b.interior_samples(face)));
         let whole = self.coverage.covers(&[p0, p1, p2], mask);
-        let unoccluded = self.coverage.unoccluded(&[p0, p1, p2], mask);
         for i in 1..res - 1 {
             let a = p0 + e1 * f64::from(i);
             let range =
@@ -247,12 +318,18 @@ impl<C: Coverage> Kernel<'_, C> {
         let Some(ks) = range else {
             return;
         };
+        let unoccluded = self.coverage.unoccluded(&[a, end], mask);
+        if self.streams(mask, unoccluded)
+            && let Some(c) = self.coverage.row_distance(a, b)
+        {
+            self.blend_stream(out, std::iter::once((c, res - 1)));
+            return;
+        }
         let op = self.op;
         let base_same =
             op.base.and_then(|base| (base.edge_resolution(edge) == Some(r)).then(|| base.edge_samples(edge)));
         let base_other = |k: u32, old: Rgba| base_on_edge(op, topology, edge, r, k, old);
         let row = Row { a, b, ks, first: 0 };
-        let unoccluded = self.coverage.unoccluded(&[a, end], mask);
         self.row(out, (row, mask, unoccluded), base_same, base_other);
     }
 
@@ -298,6 +375,9 @@ enum Item {
     Edge(u32),
     Vertex(u32),
 }
+
+/// Samples whose weights [`Kernel::blend_stream`] computes at a time.
+const BATCH: usize = 64;
 
 /// Samples below which a dab computes on the calling thread (handing work to rayon costs
 /// more than it saves).

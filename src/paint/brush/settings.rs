@@ -31,7 +31,12 @@ impl Falloff {
         if distance_fraction.is_nan() || distance_fraction > 1.0 {
             return 0.0;
         }
-        let s = 1.0 - distance_fraction.max(0.0);
+        self.shape(1.0 - distance_fraction.max(0.0))
+    }
+
+    /// The weight as a function of `s = 1 − x` in `[0, 1]` (the formulas above).
+    #[inline(always)]
+    pub fn shape(self, s: f32) -> f32 {
         match self {
             Falloff::Smooth => s * s * (3.0 - 2.0 * s),
             Falloff::Linear => s,
