@@ -13,6 +13,7 @@
 //! edges are written in parallel, each in place through its [`ElementSlice`] from
 //! [`StoreWriter::split`], and the vertices last.
 
+use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::colors::format::Rgba;
@@ -25,6 +26,7 @@ use super::footprint::Coverage;
 use super::kernels::{DabStats, PARALLEL_MIN_SAMPLES, Runs};
 use super::scratch::{BlurAcc, Scratch, accumulate_masks, face_elements, position, visit_mask};
 use super::settings::BlendMode;
+use super::stencil::{Holder, NEIGHBOURS, Stencil, grid_index};
 
 /// Faces per parallel task.
 const CHUNK: usize = 32;
@@ -35,16 +37,6 @@ const CHUNK: usize = 32;
 struct FaceSums {
     interiors: Runs,
     shared: Vec<(u32, Rgba, u32, f32)>,
-}
-
-/// The six lattice neighbours `(di, dj)`.
-const NEIGHBOURS: [(i64, i64); 6] = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, -1), (-1, 1)];
-
-/// Index of lattice point `(i, j)` in a face grid of resolution `res` (row `i` holds
-/// `res + 1 − i` points).
-#[inline(always)]
-fn grid_index(res: u32, i: u32, j: u32) -> usize {
-    (i * (res + 1) - i * i.saturating_sub(1) / 2 + j) as usize
 }
 
 /// Where the boundary points of one face's lattice are stored: per face edge its edge, the
@@ -84,34 +76,51 @@ impl<'a> Boundary<'a> {
     #[inline(always)]
     fn locate(&self, i: u32, j: u32) -> Option<BoundaryPoint> {
         let res = self.res;
-        let (k, position) = match (i, j) {
-            (0, 0) => return Some(BoundaryPoint::Vertex(self.corners[0])),
-            (i, 0) if i == res => return Some(BoundaryPoint::Vertex(self.corners[1])),
-            (0, j) if j == res => return Some(BoundaryPoint::Vertex(self.corners[2])),
-            (i, 0) => (0, i),
-            (i, j) if i + j == res => (1, j),
-            (0, j) => (2, res - j),
+        let holder = match (i, j) {
+            (0, 0) => Holder { element: 0, position: 0 },
+            (i, 0) if i == res => Holder { element: 1, position: 0 },
+            (0, j) if j == res => Holder { element: 2, position: 0 },
+            (i, 0) => Holder { element: 3, position: i },
+            (i, j) if i + j == res => Holder { element: 4, position: j },
+            (0, j) => Holder { element: 5, position: res - j },
             _ => return None,
         };
-        let (_, r_edge, shift, _, reversed) = self.edges[k];
-        Some(BoundaryPoint::Edge { k, offset: layout::edge_storage_offset(r_edge, position << shift, reversed) })
+        self.point(holder)
     }
 
-    /// The colour at boundary point `(i, j)`.
+    /// Where the boundary point `holder` names is stored ([`Holder`]'s conventions).
     #[inline(always)]
-    fn color(&self, store: &ColorStore, i: u32, j: u32) -> Option<Rgba> {
-        match self.locate(i, j)? {
-            BoundaryPoint::Vertex(v) => store.vertex_color(v),
-            BoundaryPoint::Edge { k, offset } => self.edges[k].3.get(offset as usize).copied(),
+    fn point(&self, Holder { element, position }: Holder) -> Option<BoundaryPoint> {
+        match element {
+            0..=2 => self.corners.get(usize::from(element)).map(|&v| BoundaryPoint::Vertex(v)),
+            _ => {
+                let k = usize::from(element) - 3;
+                let &(_, r_edge, shift, _, reversed) = self.edges.get(k)?;
+                Some(BoundaryPoint::Edge {
+                    k,
+                    offset: layout::edge_storage_offset(r_edge, position << shift, reversed),
+                })
+            }
         }
     }
 
-    /// The blur accumulator slot of boundary point `(i, j)` (`scratch`'s per-dab tables).
+    /// The colour at boundary point `point`.
     #[inline(always)]
-    fn slot(&self, scratch: &Scratch, i: u32, j: u32) -> Option<u32> {
-        match self.locate(i, j)? {
+    fn color(&self, store: &ColorStore, point: BoundaryPoint) -> Option<Rgba> {
+        match point {
+            BoundaryPoint::Vertex(v) => store.vertex_color(v),
+            BoundaryPoint::Edge { k, offset } => self.edges.get(k)?.3.get(offset as usize).copied(),
+        }
+    }
+
+    /// The blur accumulator slot of boundary point `point` (`scratch`'s per-dab tables).
+    #[inline(always)]
+    fn slot(&self, scratch: &Scratch, point: BoundaryPoint) -> Option<u32> {
+        match point {
             BoundaryPoint::Vertex(v) => scratch.vertex_slot.get(v as usize).copied(),
-            BoundaryPoint::Edge { k, offset } => scratch.edge_slot.get(self.edges[k].0 as usize).map(|&s| s + offset),
+            BoundaryPoint::Edge { k, offset } => {
+                scratch.edge_slot.get(self.edges.get(k)?.0 as usize).map(|&s| s + offset)
+            }
         }
     }
 }
@@ -127,12 +136,13 @@ pub(super) fn blur_faces<C: Coverage + Sync>(
     let stamp = accumulate_masks(writer.store(), scratch);
     assign_slots(writer.store(), scratch, stamp);
     let store = writer.store();
+    scratch.stencils.prepare(scratch.faces.iter().filter_map(|&face| store.face_resolution(face)));
     let tables = &*scratch;
     let compute = |faces: &[(u32, u8)]| {
         let mut sums = FaceSums::default();
-        let mut grid = Vec::new();
+        let mut buffers = FaceBuffers::default();
         for &face in faces {
-            blur_face(coverage, positions, store, tables, face, &mut grid, &mut sums);
+            blur_face(coverage, positions, store, tables, face, &mut buffers, &mut sums);
         }
         sums
     };
@@ -291,7 +301,7 @@ fn blur_face<C: Coverage>(
     store: &ColorStore,
     scratch: &Scratch,
     (face, face_mask): (u32, u8),
-    grid: &mut Vec<Rgba>,
+    buffers: &mut FaceBuffers,
     out: &mut FaceSums,
 ) {
     let Some((r, corners, edges)) = face_elements(store, face) else {
@@ -308,13 +318,22 @@ fn blur_face<C: Coverage>(
     let Some(boundary) = Boundary::of(store, face, r, corners, edges) else {
         return;
     };
+    let [p0, p1, p2] = corners.map(|v| position(positions, v));
+    let unoccluded = coverage.unoccluded(&[p0, p1, p2], all);
+    if let Some(stencil) = scratch.stencils.get(r).filter(|_| unoccluded) {
+        let masks =
+            [face_mask, vertex_mask(0), vertex_mask(1), vertex_mask(2), edge_mask(0), edge_mask(1), edge_mask(2)];
+        let face = StencilFace { face, corners: [p0, p1, p2], masks, boundary: &boundary };
+        if blur_face_stencil(coverage, stencil, store, scratch, &face, buffers, out) {
+            return;
+        }
+    }
+    let grid = &mut buffers.grid;
     if !gather_lattice(store, face, &boundary, grid) {
         return;
     }
-    let [p0, p1, p2] = corners.map(|v| position(positions, v));
     let inv = 1.0 / f64::from(res);
     let (e1, e2) = ((p1 - p0) * inv, (p2 - p0) * inv);
-    let unoccluded = coverage.unoccluded(&[p0, p1, p2], all);
     let whole = coverage.covers(&[p0, p1, p2], all);
     for i in 0..=res {
         let a = p0 + e1 * f64::from(i);
@@ -354,12 +373,123 @@ fn blur_face<C: Coverage>(
                 out.interiors.push(Element::Interior(face), index, new);
                 continue;
             }
-            let Some(slot) = boundary.slot(scratch, i, j) else {
+            let Some(slot) = boundary.locate(i, j).and_then(|point| boundary.slot(scratch, point)) else {
                 continue;
             };
             out.shared.push((slot, sum, count, weight));
         }
     }
+}
+
+/// A face's working buffers, reused across the faces of a chunk: its lattice
+/// ([`grid_index`] order), and its points' squared distances and weights.
+#[derive(Default)]
+struct FaceBuffers {
+    grid: Vec<Rgba>,
+    d2: Vec<f64>,
+    weights: Vec<f32>,
+}
+
+/// What [`blur_face_stencil`] reads of one face: its corners' positions, its masks (the
+/// face's, then corners 0–2', then face edges 0–2', [`Holder::element`] + 1) and where its
+/// boundary is stored.
+struct StencilFace<'a, 'b> {
+    face: u32,
+    corners: [DVec3; 3],
+    masks: [u8; 7],
+    boundary: &'a Boundary<'b>,
+}
+
+/// [`blur_face`] through the stencil of its resolution, when one sphere reaches the face and
+/// none of it is occluded: the squared distance of every lattice point row by row, all their
+/// weights in one branch-free, vectorised loop, then the interior points and the boundary
+/// points from the stencil's neighbour tables (the same sums, in the same order, as the
+/// per-row path). `false`, with nothing done, when the coverage is not one sphere.
+fn blur_face_stencil<C: Coverage>(
+    coverage: &C,
+    stencil: &Stencil,
+    store: &ColorStore,
+    scratch: &Scratch,
+    face: &StencilFace,
+    buffers: &mut FaceBuffers,
+    out: &mut FaceSums,
+) -> bool {
+    let res = stencil.res;
+    let [p0, p1, p2] = face.corners;
+    let inv = 1.0 / f64::from(res);
+    let (e1, e2) = ((p1 - p0) * inv, (p2 - p0) * inv);
+    let FaceBuffers { grid, d2, weights } = buffers;
+    d2.clear();
+    d2.resize(stencil.points, 0.0);
+    for i in 0..=res {
+        let Some([c0, c1, c2]) = coverage.row_distance(p0 + e1 * f64::from(i), e2) else {
+            return false;
+        };
+        let start = grid_index(res, i, 0);
+        for (slot, k) in d2.get_mut(start..start + (res - i + 1) as usize).unwrap_or(&mut []).iter_mut().zip(0u32..) {
+            let k = f64::from(k);
+            *slot = c0 + k * (c1 + k * c2);
+        }
+    }
+    weights.clear();
+    weights.resize(stencil.points, 0.0);
+    coverage.weights_of_distance_sq(d2, weights);
+    if !gather_stencil(store, face.face, face.boundary, stencil, grid) {
+        return true;
+    }
+    let color = |g: u32| glam::Vec4::from_array(grid.get(g as usize).copied().unwrap_or_default());
+    let weight = |g: u32| weights.get(g as usize).copied().unwrap_or(0.0);
+    if face.masks[0] != 0 {
+        for (index, &(g, [n0, n1, n2, n3, n4, n5])) in (0u32..).zip(&stencil.interior) {
+            let w = weight(g);
+            if w <= 0.0 {
+                continue;
+            }
+            let sum = glam::Vec4::ZERO + color(n0) + color(n1) + color(n2) + color(n3) + color(n4) + color(n5);
+            let new = towards_mean(color(g).to_array(), sum.to_array(), 6, w);
+            out.interiors.push(Element::Interior(face.face), index, new);
+        }
+    }
+    for point in &stencil.boundary {
+        let mask = face.masks.get(1 + usize::from(point.holder.element)).copied().unwrap_or(0);
+        let w = weight(point.grid);
+        if mask == 0 || w <= 0.0 {
+            continue;
+        }
+        let mut sum = glam::Vec4::ZERO;
+        for &n in point.neighbours.get(..point.count as usize).unwrap_or(&[]) {
+            sum += color(n);
+        }
+        if let Some(slot) = face.boundary.point(point.holder).and_then(|p| face.boundary.slot(scratch, p)) {
+            out.shared.push((slot, sum.to_array(), point.count, w));
+        }
+    }
+    true
+}
+
+/// [`gather_lattice`] through `stencil`: the interior rows copied, the boundary points read
+/// from their holders. `false` when the store does not hold what the face's resolution says.
+fn gather_stencil(store: &ColorStore, face: u32, boundary: &Boundary, stencil: &Stencil, grid: &mut Vec<Rgba>) -> bool {
+    let res = stencil.res;
+    let interior = store.interior_samples(face);
+    if interior.len() != stencil.interior.len() {
+        return false;
+    }
+    grid.clear();
+    grid.resize(stencil.points, [0.0; 4]);
+    for i in 1..res.saturating_sub(1) {
+        let (first, len) = (((i - 1) * (2 * res - 2 - i) / 2) as usize, (res - 1 - i) as usize);
+        let start = grid_index(res, i, 1);
+        if let (Some(to), Some(from)) = (grid.get_mut(start..start + len), interior.get(first..first + len)) {
+            to.copy_from_slice(from);
+        }
+    }
+    for point in &stencil.boundary {
+        if let Some(slot) = grid.get_mut(point.grid as usize) {
+            *slot = boundary.point(point.holder).and_then(|p| boundary.color(store, p)).unwrap_or([0.0; 4]);
+        }
+    }
+    true
 }
 
 /// `old` moved towards the mean `sum / count` of its neighbours by `weight` (`count > 0`).
@@ -419,7 +549,7 @@ fn gather_lattice(store: &ColorStore, face: u32, boundary: &Boundary, grid: &mut
                 grid.extend_from_slice(row);
             }
             if !interior_point {
-                grid.push(boundary.color(store, i, j).unwrap_or([0.0; 4]));
+                grid.push(boundary.locate(i, j).and_then(|point| boundary.color(store, point)).unwrap_or([0.0; 4]));
             }
         }
     }

@@ -27,6 +27,7 @@
 //! | `error.rs` | [`BrushError`] |
 //! | `settings.rs` | [`BrushSettings`], [`Tool`], [`Falloff`], [`BlendMode`], [`BrushRadius`], [`ResolutionOp`], validation |
 //! | `footprint.rs` | where a dab reaches: the `Coverage` trait, the dab's spheres, fill's "everywhere", [`visible`] |
+//! | `stencil.rs` | the blur's lattice stencils, one per face resolution (neighbours and holders of every lattice point) |
 //! | `scratch.rs` | per-mesh scratch reused across dabs, mask accumulation (pass 1 of a dab) |
 //! | `kernels.rs` | the colour kernels (interior rows, edges, vertices, one shared per-sample step), [`DabStats`] |
 //! | `blur.rs` | the blur kernel |
@@ -118,6 +119,7 @@ mod painter;
 mod replay;
 mod scratch;
 mod settings;
+mod stencil;
 mod tools;
 
 #[cfg(doc)]

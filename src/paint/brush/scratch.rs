@@ -32,6 +32,8 @@ pub(super) struct Scratch {
     /// Backface culling: per face, whether its winding is read reversed to agree with its
     /// component ([`crate::mesh::orientation::face_flips`]); built on first use.
     pub(super) face_flipped: Vec<bool>,
+    /// Blur: the lattice stencils by resolution (built on first use, kept across dabs).
+    pub(super) stencils: super::stencil::Stencils,
 }
 
 impl Scratch {
