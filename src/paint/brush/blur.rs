@@ -5,7 +5,9 @@
 //! Per face of the dab, the face's whole lattice is gathered once into a local grid
 //! (interior rows copied from the face's storage, the boundary read from its edges and
 //! vertices), and each covered point sums its neighbours from the grid: no per-neighbour
-//! store look-up. The faces are computed in parallel (rayon over chunks of faces, reading
+//! store look-up. Faces up to R = 64 that one sphere reaches unoccluded read those neighbours
+//! from their resolution's stencil (`stencil.rs`), with every lattice point's weight computed
+//! in one vectorised loop; the others go row by row. The faces are computed in parallel (rayon over chunks of faces, reading
 //! the store only). A face's interior is only ever read by the face itself, so its new
 //! colours are final; samples on edges and vertices belong to several faces, so each face
 //! returns its sums for them, which are accumulated per element (one slot per edge sample
