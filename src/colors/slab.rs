@@ -58,7 +58,8 @@ impl Slab {
             slots.push(Slot { chunk: chunk as u32, start: start as u32, len });
             live += u64::from(len);
         }
-        let chunks: Vec<Arc<Vec<Rgba>>> = chunk_lens.par_iter().map(|&n| Arc::new(vec![color; n])).collect();
+        let chunks: Vec<Arc<Vec<Rgba>>> =
+            chunk_lens.par_iter().map(|&n| Arc::new(crate::memory::filled(n, color))).collect();
         Slab { dead: vec![0; chunks.len()], chunks, slots, live }
     }
 

@@ -498,13 +498,14 @@ struct Buffers {
 /// `buffer` cut or grown to `len` elements. Kept elements keep their old values (the
 /// caller overwrites every element); when the capacity does not suffice the old memory is
 /// released first, so the peak holds one buffer, not two.
-fn reuse<T: Copy>(mut buffer: Vec<T>, len: usize, fill: T) -> Vec<T> {
+/// Fresh memory is zeroed with huge pages advised ([`crate::memory`]).
+fn reuse<T: Copy + bytemuck::Zeroable>(mut buffer: Vec<T>, len: usize) -> Vec<T> {
     if buffer.capacity() < len {
         drop(buffer);
-        return vec![fill; len];
+        return crate::memory::zeroed(len);
     }
     buffer.truncate(len);
-    buffer.resize(len, fill);
+    buffer.resize(len, T::zeroed());
     buffer
 }
 
@@ -555,9 +556,9 @@ impl PackCache {
         let size = format.bytes_per_sample();
         let prefix = InteriorPrefix::of(store);
         // Every sample of these three is written by `build_all`: stale contents never show.
-        let mut chains = reuse(chains, sections.vertex_end + edges.upper_len(), [0.0f32; 4]);
-        let mut upper = reuse(upper, prefix.upper_len(), [0.0f32; 4]);
-        let mut colors = reuse(colors, sections.total * size, 0u8);
+        let mut chains = reuse(chains, sections.vertex_end + edges.upper_len());
+        let mut upper = reuse(upper, prefix.upper_len());
+        let mut colors = reuse(colors, sections.total * size);
         let vertex_edge = vertex_edges(topology);
         {
             let ctx =

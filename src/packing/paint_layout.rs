@@ -303,7 +303,7 @@ impl PaintLayout {
         // slack stays zero bytes, which is the encoding of a zero colour in every format.
         let size = format.bytes_per_sample();
         let capacity = self.capacity.min(u64::from(u32::MAX)) as usize;
-        let mut bytes = vec![0u8; capacity * size];
+        let mut bytes = crate::memory::zeroed::<u8>(capacity * size);
         let topology = store.topology();
         let vertices: Vec<Rgba> =
             (0..topology.vertex_count).map(|v| store.vertex_color(v).unwrap_or([0.0; 4])).collect();
