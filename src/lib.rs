@@ -18,7 +18,7 @@
 //! | [`paint`] | [`paint::picking`] (obvhs BVH, watertight rays), [`paint::occlusion`] (a CPU depth map of the view: brush occlusion without a ray per sample), [`paint::brush`] (colour / blur / resolution brushes, tools, replay), [`paint::undo`] (per stroke, memory cap; the one write path, `StoreWriter`), [`paint::split`] (that write path split per element for parallel dabs) |
 //! | [`io`] | [`io::document`] (open glTF or packed files into a store; pack for export), [`io::export_gltf`], [`io::bake`] (texture → mesh colors), [`io::autosave`], [`io::subdivide`] (1→4 midpoint split of a scene, budget first) |
 //! | [`atomic_write`] | the one way files are written: temporary file, `sync_all`, rename, directory sync |
-//! | [`memory`] | the one way big buffers are allocated (the store's chunks on open, packed colours, the paint layout's bytes): transparent huge pages advised before the first write |
+//! | [`memory`] | fresh buffers a document's bulk is written into once (the store's chunks on open, packed colours, the paint layout's bytes): transparent huge pages advised before the first write |
 //! | [`camera`] | the orbit camera: matrices, framing, pixel rays (shared by render, picking, replay) |
 //! | [`render`] | **GPU**: wgpu context, packed buffers on the GPU, sampling pipelines, readback |
 //! | [`bench`](mod@bench) | **GPU**: the measurements behind `meshpaint bench` (time, size and error, as JSON; [`bench::trade`] every choice's cost and error side by side, [`bench::plot`] its PNG plots; [`bench::extremes`]: the numerical extremes, each against an independent truth with the tolerance its test enforces) |

@@ -1,5 +1,5 @@
-//! The one way big buffers are allocated: backed by transparent huge pages where the
-//! kernel offers them.
+//! Fresh buffers that a document's bulk is written into once, backed by transparent huge
+//! pages where the kernel offers them.
 //!
 //! A fresh buffer is mapped page by page as it is first written. On this kind of machine
 //! (a VM, Linux with transparent huge pages in `madvise` mode, the default of Debian and
@@ -38,7 +38,7 @@ pub fn filled<T: Clone>(len: usize, value: T) -> Vec<T> {
 }
 
 /// An empty buffer with room for `capacity` values, huge pages advised for that room.
-pub fn with_capacity<T>(capacity: usize) -> Vec<T> {
+fn with_capacity<T>(capacity: usize) -> Vec<T> {
     let buffer = Vec::with_capacity(capacity);
     advise_huge_pages(&buffer);
     buffer
@@ -46,7 +46,7 @@ pub fn with_capacity<T>(capacity: usize) -> Vec<T> {
 
 /// Advises huge pages for the whole 2 MiB-aligned pages inside `buffer`'s allocation
 /// (its capacity). No effect on smaller buffers.
-pub fn advise_huge_pages<T>(buffer: &Vec<T>) {
+fn advise_huge_pages<T>(buffer: &Vec<T>) {
     advise_huge_pages_bytes(buffer.as_ptr() as usize, buffer.capacity().saturating_mul(std::mem::size_of::<T>()));
 }
 
