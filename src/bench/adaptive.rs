@@ -27,7 +27,8 @@ use crate::camera::default_camera;
 use crate::colors::format::ColorFormat;
 use crate::colors::layout::Resolution;
 use crate::io::adaptive::ResolutionRule;
-use crate::io::document::Document;
+use crate::io::document::{Document, OpenPhases};
+use crate::io::least_squares::BakeFit;
 use crate::mesh::scene::Scene;
 use crate::render::{DrawItem, FilterMode, Gpu, RenderSettings, Shading};
 
@@ -39,11 +40,37 @@ pub const SUPERSAMPLE: u32 = 4;
 /// Supersampling factor per axis of both renders in `bench adaptive` (module docs).
 pub const ADAPTIVE_SUPERSAMPLE: u32 = 16;
 
+/// What `bench adaptive` renders and which bakes it compares.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdaptiveOptions {
+    /// With `Some(max)`, each uniform `R ≥ 4` is followed by the budget allocation (capped at
+    /// `max`) given a third of its samples.
+    pub budget_max: Option<Resolution>,
+    /// Image size (square).
+    pub size: u32,
+    /// Camera views around the model.
+    pub views: u32,
+    /// Supersampling per axis of both renders.
+    pub supersample: u32,
+    /// Each rule is converted with each of these bakes.
+    pub fits: Vec<BakeFit>,
+}
+
+/// `bake` in the JSON rows: `least-squares` or `point`.
+pub fn fit_name(fit: BakeFit) -> &'static str {
+    match fit {
+        BakeFit::Point => "point",
+        BakeFit::LeastSquares => "least-squares",
+    }
+}
+
 /// One measured conversion.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AdaptiveRow {
     /// The rule, as [`ResolutionRule::describe`] writes it.
     pub rule: ResolutionRule,
+    /// How the texture was baked.
+    pub fit: BakeFit,
     /// Level-0 samples.
     pub samples: u64,
     /// Samples with MIP chains (the packed colour buffer).
@@ -78,6 +105,7 @@ impl AdaptiveRow {
         let worst = self.psnr_db.iter().copied().fold(f64::INFINITY, f64::min);
         serde_json::json!({
             "rule": rule,
+            "bake": fit_name(self.fit),
             "describe": self.rule.describe(),
             "resolution": resolution,
             "error_bound": bound,
@@ -96,19 +124,18 @@ impl AdaptiveRow {
     }
 }
 
-/// Measures every rule in `rules` on `scene` (read from `path`), `size`² images supersampled
-/// `supersample`² (module docs), `views` cameras; with `budget_max`, each uniform `R ≥ 4` is followed by the budget allocation
-/// (capped at `budget_max`) given a third of its samples. Fails when the scene has no
-/// base-colour texture (no reference).
+/// Measures every rule in `rules` with every bake of `options` on `scene` (read from
+/// `path`), `size`² images supersampled `supersample`² (module docs), `views` cameras, the
+/// budget rows of [`AdaptiveOptions::budget_max`]. Fails when the scene has no base-colour
+/// texture (no reference).
+/// Long: references, then one conversion, pack, upload and render per row.
 pub fn bench_adaptive(
     path: &Path,
     scene: &Scene,
     rules: &[ResolutionRule],
-    budget_max: Option<Resolution>,
-    size: u32,
-    views: u32,
-    supersample: u32,
+    options: &AdaptiveOptions,
 ) -> Result<Vec<AdaptiveRow>, BenchRenderError> {
+    let AdaptiveOptions { budget_max, size, views, supersample, ref fits } = *options;
     let gpu = Gpu::new_headless()?;
     let baseline = gpu
         .upload_baseline(scene)?
@@ -131,11 +158,18 @@ pub fn bench_adaptive(
         })
         .collect::<Result<_, _>>()?;
     let mut rows: Vec<AdaptiveRow> = Vec::new();
-    let mut queue: std::collections::VecDeque<ResolutionRule> = rules.iter().copied().collect();
-    while let Some(rule) = queue.pop_front() {
+    let mut queue: std::collections::VecDeque<(ResolutionRule, BakeFit)> =
+        rules.iter().flat_map(|&rule| fits.iter().map(move |&fit| (rule, fit))).collect();
+    while let Some((rule, fit)) = queue.pop_front() {
         let started = Instant::now();
-        let document =
-            Document::from_scene_within(scene.clone(), rule, path, &crate::colors::budget::Budget::from_environment())?;
+        let document = Document::from_scene_phased(
+            scene.clone(),
+            rule,
+            fit,
+            path,
+            &crate::colors::budget::Budget::from_environment(),
+            &mut OpenPhases::default(),
+        )?;
         let convert_seconds = started.elapsed().as_secs_f64();
         let packed = document.pack(ColorFormat::Rgba8Srgb)?;
         let mesh = gpu.upload(&packed)?;
@@ -154,10 +188,11 @@ pub fn bench_adaptive(
         if let (ResolutionRule::Uniform(r), Some(max)) = (rule, budget_max)
             && r.get() >= 4
         {
-            queue.push_front(ResolutionRule::Budget { samples: document.store.sample_count() / 3, max });
+            queue.push_front((ResolutionRule::Budget { samples: document.store.sample_count() / 3, max }, fit));
         }
         rows.push(AdaptiveRow {
             rule,
+            fit,
             samples: document.store.sample_count(),
             samples_with_mips: packed.sample_count(),
             packed_bytes: packed.face_record_bytes() + packed.color_bytes(),
@@ -299,11 +334,13 @@ fn uv_texels(scene: &Scene, count: impl Fn(Vec<&[[f32; 2]; 3]>, [u32; 2]) -> u64
         .sum()
 }
 
-/// The goals of the adaptive-resolution issue, checked on `rows`: the fewest samples of any
+/// The goals of the adaptive-resolution issue, checked on the rows of `rows` baked with
+/// `fit`: the fewest samples of any
 /// rule at ≥ 38 dB (mean over the views) against `uv_island_texels`, and for each uniform
 /// R the fewest samples of a content-driven rule reaching its PSNR (`ratio` = uniform
 /// samples / those; the goal is ≥ 3).
-pub fn summary(rows: &[AdaptiveRow], uv_island_texels: u64) -> serde_json::Value {
+pub fn summary(rows: &[AdaptiveRow], fit: BakeFit, uv_island_texels: u64) -> serde_json::Value {
+    let rows: Vec<&AdaptiveRow> = rows.iter().filter(|row| row.fit == fit).collect();
     let mean = |row: &AdaptiveRow| row.psnr_db.iter().sum::<f64>() / row.psnr_db.len().max(1) as f64;
     let fewest_at = |db: f64, adaptive_only: bool| {
         rows.iter()
@@ -327,6 +364,7 @@ pub fn summary(rows: &[AdaptiveRow], uv_island_texels: u64) -> serde_json::Value
         })
         .collect();
     serde_json::json!({
+        "bake": fit_name(fit),
         "uv_island_texels": uv_island_texels,
         "fewest_samples_at_38_db": at_38.map(|row| row.samples),
         "rule_at_38_db": at_38.map(|row| row.rule.describe()),

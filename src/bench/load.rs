@@ -22,6 +22,7 @@ use crate::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, default_camera};
 use crate::colors::budget::{Budget, BudgetError};
 use crate::colors::layout::Resolution;
 use crate::io::document::{Document, DocumentError, OpenPhases, import_scene_within};
+use crate::io::least_squares::BakeFit;
 use crate::packing::packer::{PackCache, PackError};
 use crate::packing::paint_layout::PaintLayout;
 use crate::paint::picking::{BvhPreset, MeshBvh};
@@ -74,7 +75,7 @@ pub fn bench_load(
     let scene = if subdivide > 0 { crate::io::subdivide::subdivide_scene(&scene, subdivide, &budget)? } else { scene };
     let subdivide_time = subdivide_started.elapsed();
     let mut phases = OpenPhases::default();
-    let mut document = Document::from_scene_phased(scene, resolution, path, &budget, &mut phases)?;
+    let mut document = Document::from_scene_phased(scene, resolution, BakeFit::default(), path, &budget, &mut phases)?;
     document.source = kind;
     let format = document.display_format();
     let parallel_started = Instant::now();

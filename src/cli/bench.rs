@@ -6,8 +6,27 @@ use anyhow::{Context, Result};
 use clap::Subcommand;
 
 use meshpaint::colors::format::ColorFormat;
+use meshpaint::io::least_squares::BakeFit;
 
 use super::args::{ResolutionArg, ResolutionArg16, budget, open, open_subdivided, parse_format};
+
+/// `--bake`: how a conversion turns the texture into samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(super) enum BakeArg {
+    /// The least-squares fit of the reconstruction to the texture (the default).
+    LeastSquares,
+    /// Each sample reads the texture prefiltered to its spacing.
+    Point,
+}
+
+impl From<BakeArg> for BakeFit {
+    fn from(arg: BakeArg) -> Self {
+        match arg {
+            BakeArg::LeastSquares => BakeFit::LeastSquares,
+            BakeArg::Point => BakeFit::Point,
+        }
+    }
+}
 
 #[derive(Debug, Subcommand)]
 pub(super) enum BenchCommand {
@@ -85,6 +104,10 @@ pub(super) enum BenchCommand {
         /// docs/ADAPTIVE.md).
         #[arg(long, default_value_t = meshpaint::bench::adaptive::ADAPTIVE_SUPERSAMPLE)]
         supersample: u32,
+        /// The bakes to compare (each rule is converted with each): the least-squares fit
+        /// (the conversion's default) and the point bake it starts from.
+        #[arg(long, value_enum, value_delimiter = ',', default_values_t = [BakeArg::LeastSquares, BakeArg::Point])]
+        bake: Vec<BakeArg>,
     },
     /// What every choice costs and buys: filter × resolution (uniform R 1…32 and --error
     /// bounds) × colour format, per view at several distances — PSNR, max error, FLIP against a
@@ -190,12 +213,19 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             }
             Ok(())
         }
-        BenchCommand::Adaptive { file, max_resolution, size, views, supersample } => {
+        BenchCommand::Adaptive { file, max_resolution, size, views, supersample, bake } => {
             let max = meshpaint::colors::layout::Resolution::new(max_resolution).context("--max-resolution")?;
             let scene = meshpaint::mesh::import::import_gltf(&file)?;
             let rules = meshpaint::bench::adaptive::default_rules(max);
-            let rows =
-                meshpaint::bench::adaptive::bench_adaptive(&file, &scene, &rules, Some(max), size, views, supersample)?;
+            let fits: Vec<BakeFit> = bake.iter().map(|&b| b.into()).collect();
+            let options = meshpaint::bench::adaptive::AdaptiveOptions {
+                budget_max: Some(max),
+                size,
+                views,
+                supersample,
+                fits: fits.clone(),
+            };
+            let rows = meshpaint::bench::adaptive::bench_adaptive(&file, &scene, &rules, &options)?;
             for row in &rows {
                 let mut value = row.to_json();
                 value["bench"] = "adaptive".into();
@@ -203,11 +233,13 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
                 println!("{value}");
             }
             let texels = meshpaint::bench::adaptive::uv_island_texels(&scene);
-            let mut summary = meshpaint::bench::adaptive::summary(&rows, texels);
-            summary["uv_face_texels"] = meshpaint::bench::adaptive::uv_face_texels(&scene).into();
-            summary["bench"] = "adaptive-summary".into();
-            summary["file"] = file.display().to_string().into();
-            println!("{summary}");
+            for fit in fits {
+                let mut summary = meshpaint::bench::adaptive::summary(&rows, fit, texels);
+                summary["uv_face_texels"] = meshpaint::bench::adaptive::uv_face_texels(&scene).into();
+                summary["bench"] = "adaptive-summary".into();
+                summary["file"] = file.display().to_string().into();
+                println!("{summary}");
+            }
             Ok(())
         }
         BenchCommand::Pack { file, resolution, format, runs, subdivide, stroke_samples } => {

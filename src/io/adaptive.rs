@@ -41,7 +41,8 @@ use rayon::prelude::*;
 use crate::colors::format::{Rgba, linear_to_srgb};
 use crate::colors::layout::{self, Resolution};
 use crate::colors::store::ColorStore;
-use crate::io::bake::{FaceMaterial, bake_texture, face_materials, interpolate_uv, material_color};
+use crate::io::bake::{FaceMaterial, bake_texture, face_materials, interpolate_uv, material_color, world_area};
+use crate::io::least_squares::{self, BakeFit};
 use crate::mesh::scene::Scene;
 use crate::mesh::weld::WeldedMesh;
 use crate::packing::sampler::{Filter, sample};
@@ -295,23 +296,26 @@ impl Ord for OrderedRatio {
     }
 }
 
-/// World-space area of `face` of `mesh` (0 for a missing face).
-fn world_area(mesh: &WeldedMesh, face: usize) -> f64 {
-    let Some(t) = mesh.triangles.get(face) else { return 0.0 };
-    let p = |k: usize| mesh.positions_world.get(t[k] as usize).map_or([0.0; 3], |p| p.map(f64::from));
-    let (a, b, c) = (p(0), p(1), p(2));
-    let (u, v) = ([b[0] - a[0], b[1] - a[1], b[2] - a[2]], [c[0] - a[0], c[1] - a[1], c[2] - a[2]]);
-    let cross = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
-    0.5 * (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]).sqrt()
-}
-
 /// Bakes `store` (the store of `mesh`, at the resolutions [`face_resolutions`] chose for
-/// `rule`) and, for an error bound, checks every face as the mesh shows it — shared
-/// vertices and edges baked from their owner face, which across a UV seam maps them to
-/// other texels, and coarse faces fanned towards finer edges — raising `R` (up to `max`) of
-/// every face still over the bound and baking again, until none is. Returns the rounds.
-pub fn bake_and_verify(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene, rule: ResolutionRule) -> u32 {
-    bake_texture(store, mesh, scene);
+/// `rule`) with `fit` and, for an error bound, checks every face as the mesh shows it —
+/// shared vertices and edges baked from their owner face (or, fitted, balanced between the
+/// faces that show them), and coarse faces fanned towards finer edges — raising `R` (up to
+/// `max`) of every face still over the bound and baking again, until none is. Returns the
+/// rounds.
+pub fn bake_and_verify(
+    store: &mut ColorStore,
+    mesh: &WeldedMesh,
+    scene: &Scene,
+    rule: ResolutionRule,
+    fit: BakeFit,
+) -> u32 {
+    let bake = |store: &mut ColorStore| {
+        bake_texture(store, mesh, scene);
+        if fit == BakeFit::LeastSquares {
+            least_squares::refine(store, mesh, scene);
+        }
+    };
+    bake(store);
     let ResolutionRule::ErrorBound { bound, max } = rule else {
         return 0;
     };
@@ -349,7 +353,7 @@ pub fn bake_and_verify(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene,
             // The face exists and `raised` is a valid resolution, so this cannot fail.
             let _ = store.set_face_resolution(face, raised);
         }
-        bake_texture(store, mesh, scene);
+        bake(store);
     }
 }
 

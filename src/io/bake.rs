@@ -350,3 +350,13 @@ fn uv_edges_texels(uvs: [[f32; 2]; 3], width: u32, height: u32) -> [f32; 3] {
     edges.sort_by(f32::total_cmp);
     edges
 }
+
+/// World-space area of `face` of `mesh` (0 for a missing face).
+pub(crate) fn world_area(mesh: &WeldedMesh, face: usize) -> f64 {
+    let Some(t) = mesh.triangles.get(face) else { return 0.0 };
+    let p = |k: usize| mesh.positions_world.get(t[k] as usize).map_or([0.0; 3], |p| p.map(f64::from));
+    let (a, b, c) = (p(0), p(1), p(2));
+    let (u, v) = ([b[0] - a[0], b[1] - a[1], b[2] - a[2]], [c[0] - a[0], c[1] - a[1], c[2] - a[2]]);
+    let cross = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+    0.5 * (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]).sqrt()
+}

@@ -19,6 +19,7 @@ use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::Resolution;
 use crate::colors::store::{ColorStore, StoreError};
 use crate::io::adaptive::ResolutionRule;
+use crate::io::least_squares::BakeFit;
 use crate::mesh::formats::{FormatError, MeshFormat, import_mesh_file};
 use crate::mesh::import::{ImportError, ImportLimits, import_gltf_slice_within, import_gltf_within};
 use crate::mesh::scene::Scene;
@@ -477,14 +478,16 @@ impl Document {
         name: &Path,
         budget: &Budget,
     ) -> Result<Self, DocumentError> {
-        Self::from_scene_phased(scene, rule, name, budget, &mut OpenPhases::default())
+        Self::from_scene_phased(scene, rule, BakeFit::default(), name, budget, &mut OpenPhases::default())
     }
 
-    /// [`Document::from_scene_within`], recording how long each phase took in `phases`
-    /// (`meshpaint bench load`).
+    /// [`Document::from_scene_within`] with the texture baked by `fit` (the default is the
+    /// least-squares fit, [`crate::io::least_squares`]), recording how long each phase took in
+    /// `phases` (`meshpaint bench load`, `bench adaptive`).
     pub fn from_scene_phased(
         scene: Scene,
         rule: impl Into<ResolutionRule>,
+        fit: BakeFit,
         name: &Path,
         budget: &Budget,
         phases: &mut OpenPhases,
@@ -531,7 +534,7 @@ impl Document {
         let mut store = ColorStore::with_resolutions(topology, resolutions, uniform.unwrap_or([1.0; 4]))
             .map_err(|source| DocumentError::Store { path: name.to_owned(), source })?;
         if has_base_color {
-            crate::io::adaptive::bake_and_verify(&mut store, &welded, &scene, rule);
+            crate::io::adaptive::bake_and_verify(&mut store, &welded, &scene, rule, fit);
         } else if neutral && uniform.is_none() {
             fill_neutral(&mut store, &welded.triangle_materials, &scene);
         }

@@ -11,6 +11,7 @@ pub mod document;
 pub mod export_fit;
 pub mod export_gltf;
 pub mod export_textured;
+pub mod least_squares;
 pub mod subdivide;
 
 pub use document::{Document, SourceKind};
