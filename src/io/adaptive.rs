@@ -35,6 +35,11 @@
 //! The fit treats each face alone (its edges at its own `R`). In the mesh an edge takes
 //! the larger `R` of its two faces, which only adds texture samples along it. Faces are
 //! fitted in parallel (rayon).
+//!
+//! The errors these rules predict are the point bake's. The conversion then refines the bake
+//! to the least-squares fit ([`crate::io::least_squares`], [`BakeFit::LeastSquares`], the
+//! default), which shows most faces closer to the texture; an error bound is verified on the
+//! store as fitted ([`bake_and_verify`]).
 
 use rayon::prelude::*;
 
