@@ -401,3 +401,19 @@ pub fn uniform_counts(r: Resolution, vertices: u64, edges: u64, faces: u64) -> U
             + faces * u64::from(interior_chain_len(r)),
     }
 }
+
+/// The barycentrics of the centroids of the `dense²` sub-triangles of a lattice `dense`:
+/// rows `j` ascending, `i` within, each lower sub-triangle's centroid followed by the upper
+/// one's beside it (an even quadrature of the face: each stands for `1/dense²` of its area).
+pub fn sub_triangle_centroids(dense: u32) -> impl Iterator<Item = [f32; 3]> {
+    let n = dense as f32;
+    (0..dense).flat_map(move |j| {
+        (0..dense - j).flat_map(move |i| {
+            let (u, v) = (i as f32, j as f32);
+            let upper = (i + j + 2 <= dense).then_some((u + 2.0 / 3.0, v + 2.0 / 3.0));
+            std::iter::once((u + 1.0 / 3.0, v + 1.0 / 3.0))
+                .chain(upper)
+                .map(move |(cu, cv)| [(n - cu - cv) / n, cu / n, cv / n])
+        })
+    })
+}

@@ -465,30 +465,19 @@ impl<'a> FaceFit<'a> {
     /// The centroids of the `dense²` sub-triangles of a lattice `dense` and the truth there
     /// (the texture's level 0 read bilinearly, times the factor).
     fn test_points(&self, dense: u32) -> Vec<([f32; 3], Rgba)> {
-        let n = dense as f32;
         let material = self.material;
         let level0 = material
             .texture
             .and_then(|t| self.pyramids.get(t))
             .and_then(Option::as_ref)
             .and_then(|p| p.levels().first());
-        let mut points = Vec::with_capacity((dense * dense) as usize);
-        for j in 0..dense {
-            for i in 0..dense - j {
-                let (u, v) = (i as f32, j as f32);
-                let mut centroids = vec![(u + 1.0 / 3.0, v + 1.0 / 3.0)];
-                if i + j + 2 <= dense {
-                    centroids.push((u + 2.0 / 3.0, v + 2.0 / 3.0));
-                }
-                for (cu, cv) in centroids {
-                    let bary = [(n - cu - cv) / n, cu / n, cv / n];
-                    let uv = interpolate_uv(self.uvs, bary);
-                    let texel = level0.map_or([1.0; 4], |level| level.sample_bilinear(uv));
-                    points.push((bary, std::array::from_fn(|c| material.factor[c] * texel[c])));
-                }
-            }
-        }
-        points
+        layout::sub_triangle_centroids(dense)
+            .map(|bary| {
+                let uv = interpolate_uv(self.uvs, bary);
+                let texel = level0.map_or([1.0; 4], |level| level.sample_bilinear(uv));
+                (bary, std::array::from_fn(|c| material.factor[c] * texel[c]))
+            })
+            .collect()
     }
 
     /// The error (module docs) of the colours `shown` returns at the test points of a face

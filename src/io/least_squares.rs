@@ -204,32 +204,21 @@ impl Template {
     /// Long: one configuration's quadrature, weights (by probing the sampler) and mass matrix.
     fn new(r: Resolution, edges: [Resolution; 3], dense: u32) -> Self {
         let probe = Probe { r, edges, reads: RefCell::new(Vec::new()), base: RefCell::new(None) };
-        let n = dense as f32;
         let mut index: HashMap<Local, u32> = HashMap::new();
         let mut locals = Vec::new();
         let mut points = Vec::with_capacity((dense * dense) as usize);
         let mut weights = Vec::new();
-        for j in 0..dense {
-            for i in 0..dense - j {
-                let (u, v) = (i as f32, j as f32);
-                let mut centroids = vec![(u + 1.0 / 3.0, v + 1.0 / 3.0)];
-                if i + j + 2 <= dense {
-                    centroids.push((u + 2.0 / 3.0, v + 2.0 / 3.0));
-                }
-                for (cu, cv) in centroids {
-                    let bary = [(n - cu - cv) / n, cu / n, cv / n];
-                    let start = weights.len() as u32;
-                    for (local, w) in probe.weights(bary) {
-                        let next = locals.len() as u32;
-                        let id = *index.entry(local).or_insert_with(|| {
-                            locals.push(local);
-                            next
-                        });
-                        weights.push((id, w));
-                    }
-                    points.push((bary, start, weights.len() as u32));
-                }
+        for bary in layout::sub_triangle_centroids(dense) {
+            let start = weights.len() as u32;
+            for (local, w) in probe.weights(bary) {
+                let next = locals.len() as u32;
+                let id = *index.entry(local).or_insert_with(|| {
+                    locals.push(local);
+                    next
+                });
+                weights.push((id, w));
             }
+            points.push((bary, start, weights.len() as u32));
         }
         let mut mass: HashMap<(u32, u32), f64> = HashMap::new();
         let area = 1.0 / f64::from(dense * dense);
