@@ -144,6 +144,42 @@ fn a_sample_budget_is_never_crossed_and_spends_where_the_texture_varies() {
     assert!(rms <= uniform_rms * 1.25, "{rms} vs {uniform_rms}");
 }
 
+/// Area-weighted RMS over faces of the per-face random-point errors.
+fn area_weighted_rms(scene: &Scene, errors: &[f32]) -> f64 {
+    let welded = weld_scene(scene);
+    let area = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| glam::Vec3::from(welded.positions_world[i as usize]));
+        f64::from((b - a).cross(c - a).length())
+    };
+    let (sum, total) = welded
+        .triangles
+        .iter()
+        .zip(errors)
+        .fold((0.0, 0.0), |(s, w), (t, e)| (s + area(t) * f64::from(*e).powi(2), w + area(t)));
+    (sum / total).sqrt()
+}
+
+/// The least-squares fit shares samples between neighbours, so a budget allocation that
+/// predicted each face's error from its own point bake spent a third of Fox's uniform R = 8
+/// samples 12 % worse than uniform R = 8 (area-weighted RMS at random points against the
+/// texture: 0.0352 vs 0.0314); calibrated on fitted stores it comes within 0.5 % (0.0315).
+/// Within 5 % fails the old prediction. (The points are seeded, so the run is repeatable.)
+#[test]
+fn a_third_of_uniform_r8_samples_by_budget_comes_within_5_percent_of_uniform_r8_on_the_fox() {
+    let scene = import_gltf(&model("Fox/Fox.glb")).unwrap();
+    let uniform = convert(&scene, ResolutionRule::Uniform(r(8)));
+    let samples = uniform.store.sample_count() / 3;
+    let budget = convert(&scene, ResolutionRule::Budget { samples, max: r(64) });
+    assert!(budget.store.sample_count() <= samples);
+    let uniform_rms = area_weighted_rms(&scene, &face_errors(&scene, &uniform, 64));
+    let budget_rms = area_weighted_rms(&scene, &face_errors(&scene, &budget, 64));
+    eprintln!(
+        "Fox: uniform R = 8 area RMS {uniform_rms:.5}; budget {} samples, area RMS {budget_rms:.5}",
+        budget.store.sample_count()
+    );
+    assert!(budget_rms <= uniform_rms * 1.05, "{budget_rms} vs {uniform_rms}");
+}
+
 #[test]
 fn texel_density_follows_the_closed_form_and_untextured_faces_stay_at_one() {
     let scene = import_gltf(&model("BoxTextured/BoxTextured.glb")).unwrap();

@@ -108,9 +108,12 @@ fn gltf_info(path: &Path, resolution_arg: ResolutionArg, json: bool) -> Result<(
             (SampleCounts::uniform_on(&topology, resolution), format!("R = {resolution} on every face"))
         }
         rule => {
-            // Content-driven resolutions: the fit runs (no samples are allocated).
+            // Content-driven resolutions, as `pack` would choose them with its default bake: the
+            // fit runs, the document's store is not allocated (a budget's calibration stores are
+            // bounded by `least_squares::MAX_SAMPLES`).
             let face_count = topology.face_count() as usize;
-            let resolutions = meshpaint::io::adaptive::face_resolutions(&mesh, &scene, face_count, rule);
+            let fit = meshpaint::io::least_squares::BakeFit::default();
+            let resolutions = meshpaint::io::adaptive::face_resolutions(&mesh, &scene, face_count, rule, fit);
             let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);
             stats.samples = counts.samples;
             stats.samples_with_mips = counts.samples_with_mips;

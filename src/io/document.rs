@@ -520,7 +520,7 @@ impl Document {
                 // The budget rule stays within the packed limit by construction; every rule's
                 // result is checked before the store is allocated.
                 let resolutions =
-                    crate::io::adaptive::face_resolutions(&welded, &scene, topology.face_count() as usize, rule);
+                    crate::io::adaptive::face_resolutions(&welded, &scene, topology.face_count() as usize, rule, fit);
                 let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);
                 budget.check(&rule.describe(), &counts, ColorFormat::default()).map_err(budget_error)?;
                 resolutions
