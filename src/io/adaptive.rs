@@ -269,32 +269,33 @@ fn allocate_budget(
         added
     };
     let mut used: u64 = mesh.positions_world.len() as u64;
-    // The best raise of a face: the level with the most distortion removed per sample.
-    let best = |level: &[usize], face: usize| -> Option<(f64, usize, u64)> {
+    // The best raise of a face that adds at most `limit` samples: the level with the most
+    // distortion removed per sample. (A face whose best raise no longer fits the budget
+    // still takes a smaller one that does.)
+    let best = |level: &[usize], face: usize, limit: u64| -> Option<(f64, usize)> {
         ((level[face] + 1)..levels)
             .filter_map(|to| {
                 let gain = distortion[face][level[face]] - distortion[face][to];
-                let cost = added(level, face, to).max(1);
-                (gain > 0.0).then_some((gain / cost as f64, to, cost))
+                let cost = added(level, face, to);
+                (gain > 0.0 && cost <= limit).then_some((gain / cost.max(1) as f64, to))
             })
             .max_by(|a, b| a.0.total_cmp(&b.0))
     };
     let mut heap: std::collections::BinaryHeap<(OrderedRatio, usize, usize)> = (0..face_count)
-        .filter_map(|face| best(&level, face).map(|(ratio, to, _)| (OrderedRatio(ratio), face, to)))
+        .filter_map(|face| {
+            best(&level, face, budget.saturating_sub(used)).map(|(ratio, to)| (OrderedRatio(ratio), face, to))
+        })
         .collect();
     while let Some((_, face, to)) = heap.pop() {
-        // Stale entries (the face or a neighbour moved since): recompute.
-        let Some((ratio, now_to, cost)) = best(&level, face) else { continue };
+        // Stale entries (the face or a neighbour moved, or the budget left shrank): recompute.
+        let Some((ratio, now_to)) = best(&level, face, budget.saturating_sub(used)) else { continue };
         if now_to != to {
             heap.push((OrderedRatio(ratio), face, now_to));
             continue;
         }
-        if used + cost > budget {
-            continue;
-        }
-        used += cost;
+        used += added(&level, face, to);
         level[face] = to;
-        if let Some((ratio, to, _)) = best(&level, face) {
+        if let Some((ratio, to)) = best(&level, face, budget.saturating_sub(used)) {
             heap.push((OrderedRatio(ratio), face, to));
         }
     }
