@@ -200,7 +200,8 @@ fn faces_on_material_boundaries(mesh: &WeldedMesh, face_count: usize) -> Vec<boo
 }
 
 /// Rate–distortion allocation (module docs): every face starts at `R = 1`; raises are taken
-/// in order of distortion removed per sample added until the next does not fit `budget`.
+/// in order of distortion removed per sample added, each face's best raise among those that
+/// still fit `budget`, until none fits.
 /// Sample counts are exact as the store counts them (an edge holds the larger `R` of its
 /// faces), so the result never exceeds the budget (nor goes below the `R = 1` count, the
 /// least any mesh needs).
