@@ -1,16 +1,19 @@
 //! Per-face resolution from the content (src/io/adaptive.rs), checked independently: the
 //! error at random points of each face against the texture read by this test's own bilinear
 //! lookup, the budget against the store's own sample count, texel density against its
-//! closed form.
+//! closed form; the budget's goal against the UV-textured render of the source (the GPU's
+//! own texture sampling), as `meshpaint bench adaptive` measures it.
 
 mod common;
 
 use common::{Rng, model};
+use meshpaint::bench::adaptive::{ADAPTIVE_SUPERSAMPLE, AdaptiveOptions, bench_adaptive};
 use meshpaint::colors::budget::Budget;
 use meshpaint::colors::format::{linear_to_srgb, srgb_to_linear};
 use meshpaint::colors::layout::Resolution;
 use meshpaint::io::adaptive::ResolutionRule;
 use meshpaint::io::document::Document;
+use meshpaint::io::least_squares::BakeFit;
 use meshpaint::mesh::import::import_gltf;
 use meshpaint::mesh::scene::{Scene, Texture};
 use meshpaint::mesh::weld::weld_scene;
@@ -178,6 +181,43 @@ fn a_third_of_uniform_r8_samples_by_budget_comes_within_5_percent_of_uniform_r8_
         budget.store.sample_count()
     );
     assert!(budget_rms <= uniform_rms * 1.05, "{budget_rms} vs {uniform_rms}");
+}
+
+/// The goal's own measure (`bench adaptive`: PSNR of the RGBA8 linear-filter render against
+/// the UV-textured render of the source, 3 views, 16×16 supersampled) at a third of uniform
+/// R = 4's samples on the Fox (1,536, between R = 2's 1,154 and R = 4's 4,610). Allocated once
+/// from predictions measured on uniform stores, the budget showed 27.8 dB against R = 4's
+/// 28.1: in the mixed store a coarse face fans towards finer edges and the fit balances
+/// shared samples between faces of different R. With the rounds that measure each allocation
+/// on its fitted store and correct the predictions (`REFINEMENT_ROUNDS`) it shows 28.6 dB.
+/// (Area-weighted over every face at random points against level 0, a measure the views do
+/// not weight alike, the budget stays 6 % above R = 4's RMS error: 0.0502 vs 0.0473, 0.0509
+/// allocated once.)
+#[test]
+fn a_third_of_uniform_r4_samples_by_budget_beats_uniform_r4_on_the_fox_in_the_render() {
+    let path = model("Fox/Fox.glb");
+    let scene = import_gltf(&path).unwrap();
+    let options = AdaptiveOptions {
+        budget_max: Some(r(64)),
+        size: 256,
+        views: 3,
+        supersample: ADAPTIVE_SUPERSAMPLE,
+        fits: vec![BakeFit::LeastSquares],
+    };
+    let rows = bench_adaptive(&path, &scene, &[ResolutionRule::Uniform(r(4))], &options).unwrap();
+    let [budget, uniform] = [ResolutionRule::Budget { samples: 4610 / 3, max: r(64) }, ResolutionRule::Uniform(r(4))]
+        .map(|rule| rows.iter().find(|row| row.rule == rule).unwrap());
+    let mean = |psnr: &[f64]| psnr.iter().sum::<f64>() / psnr.len() as f64;
+    eprintln!(
+        "Fox: uniform R = 4, {} samples: {:.2} dB; budget, {} samples: {:.2} dB",
+        uniform.samples,
+        mean(&uniform.psnr_db),
+        budget.samples,
+        mean(&budget.psnr_db)
+    );
+    assert_eq!(uniform.samples, 4610);
+    assert!(budget.samples <= 4610 / 3);
+    assert!(mean(&budget.psnr_db) > mean(&uniform.psnr_db), "{:?} vs {:?}", budget.psnr_db, uniform.psnr_db);
 }
 
 /// A budget that uniform R = 4 leaves unfilled on BoxTextured (98 of 128 samples) is spent

@@ -49,6 +49,14 @@
 //! error is scaled by the gain its fit made there. (A face fitted alone, every sample free,
 //! predicts far too little error at low `R`, where the global fit cannot give each face its
 //! own vertices: Fox's budget rows fell from 26.6–51.0 dB to 22.2–31.8 dB with it.)
+//!
+//! Those predictions come from uniform stores, where a face's neighbours share its `R`. In
+//! the allocated store a coarse face fans towards finer edges and the fit balances shared
+//! samples between faces of different `R`, so a face can show more or less error than
+//! predicted. [`REFINEMENT_ROUNDS`] times, the allocation is baked, fitted and measured as
+//! shown, each face's predicted distortions are scaled by measured / predicted at its `R`,
+//! and the budget is allocated again; the allocation whose store showed the least
+//! area-weighted squared error is kept (the first one included).
 
 use rayon::prelude::*;
 
@@ -137,8 +145,11 @@ pub fn face_resolutions(
         return vec![Resolution::ONE; face_count];
     }
     if let ResolutionRule::Budget { samples, max } = rule {
+        let faces = Faces { mesh, materials: &materials, shared: &shared, pyramids: &pyramids, max };
         let calibration = calibration_stores(mesh, scene, samples, max, fit);
-        return allocate_budget(mesh, &materials, &shared, &pyramids, samples, max, &calibration);
+        let mut distortion = faces.predicted_distortions(&calibration);
+        let first = allocate_budget(mesh, &distortion, samples, max);
+        return refine_allocation(&faces, scene, &mut distortion, first, samples, fit);
     }
     let material_boundary = if matches!(rule, ResolutionRule::WhereTextured(_)) {
         faces_on_material_boundaries(mesh, face_count)
@@ -199,40 +210,131 @@ fn faces_on_material_boundaries(mesh: &WeldedMesh, face_count: usize) -> Vec<boo
         .collect()
 }
 
+/// A mesh's faces as a budget allocation sees them: materials, where each face's shared
+/// samples are baked, the texture pyramids, and the largest `R` given.
+struct Faces<'a> {
+    mesh: &'a WeldedMesh,
+    materials: &'a [FaceMaterial],
+    shared: &'a [SharedUvs],
+    pyramids: &'a [Option<crate::io::bake::TexturePyramid>],
+    max: Resolution,
+}
+
+impl<'a> Faces<'a> {
+    /// Face `face`'s test points and texture; `None` for a face without a texture.
+    fn fit(&self, face: usize) -> Option<FaceFit<'a>> {
+        self.materials.get(face)?.texture?;
+        let uvs = self.mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
+        Some(FaceFit::new(self.materials, face, *self.shared.get(face)?, self.pyramids, uvs, self.max))
+    }
+
+    /// The distortion the allocation weighs: error² × the face's world area (zero at or
+    /// below [`ROUNDING`]).
+    fn distortion(&self, face: usize, error: f32) -> f64 {
+        if error <= ROUNDING { 0.0 } else { f64::from(error).powi(2) * world_area(self.mesh, face) }
+    }
+
+    /// Each face's predicted distortion at each level `R = 2^l` up to `max` (module docs).
+    fn predicted_distortions(&self, calibration: &[Option<ColorStore>]) -> Vec<Vec<f64>> {
+        let levels = self.max.log2() as usize + 1;
+        (0..self.materials.len())
+            .into_par_iter()
+            .map(|face| match self.fit(face) {
+                None => vec![0.0; levels],
+                Some(fit) => fit
+                    .predicted_errors(face as u32, self.max, calibration)
+                    .into_iter()
+                    .map(|error| self.distortion(face, error))
+                    .collect(),
+            })
+            .collect()
+    }
+
+    /// Each face's distortion as `store` shows it (at the face's own `R` in the store).
+    fn shown_distortions(&self, store: &ColorStore) -> Vec<f64> {
+        (0..self.materials.len())
+            .into_par_iter()
+            .map(|face| {
+                let (Some(fit), Some(r)) = (self.fit(face), store.face_resolution(face as u32)) else {
+                    return 0.0;
+                };
+                let error =
+                    fit.error_of(r, |bary| sample(store, face as u32, bary, Filter::Linear, 0).unwrap_or([0.0; 4]));
+                self.distortion(face, error)
+            })
+            .collect()
+    }
+}
+
+/// Rounds of [`refine_allocation`] after the first allocation.
+pub const REFINEMENT_ROUNDS: usize = 2;
+
+/// Measures an allocation on the store the conversion makes of it and corrects the
+/// predictions (module docs): the predictions come from uniform stores, where every face's
+/// neighbours share its `R`; in the allocated store a coarse face fans towards finer edges
+/// and the least-squares fit balances shared samples between faces of different `R`, so a
+/// face can show more or less error than predicted. Each round bakes and fits the allocated
+/// store (counted first: it holds at most `budget` samples), measures each face's error as
+/// shown, scales that face's predicted distortions at every level by measured / predicted at
+/// its level, and allocates again. Returns the allocation whose store showed the least
+/// area-weighted squared error, the first one included, so a round never makes it worse by
+/// that measure. The point bake's predictions are its own errors: nothing to correct.
+fn refine_allocation(
+    faces: &Faces,
+    scene: &Scene,
+    distortion: &mut [Vec<f64>],
+    first: Vec<Resolution>,
+    budget: u64,
+    fit: BakeFit,
+) -> Vec<Resolution> {
+    let mesh = faces.mesh;
+    let topology = Topology::build(mesh.positions_world.len() as u32, &mesh.triangles).ok();
+    let (Some(topology), BakeFit::LeastSquares) = (topology, fit) else {
+        return first;
+    };
+    let measure = |resolutions: &[Resolution]| -> Option<Vec<f64>> {
+        let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);
+        if counts.samples > budget.min(least_squares::MAX_SAMPLES) {
+            return None;
+        }
+        let mut store = ColorStore::with_resolutions(topology.clone(), resolutions.to_vec(), [1.0; 4]).ok()?;
+        bake_texture(&mut store, mesh, scene);
+        least_squares::refine(&mut store, mesh, scene)?;
+        Some(faces.shown_distortions(&store))
+    };
+    let mut current = first;
+    let Some(mut shown) = measure(&current) else { return current };
+    let mut best = (shown.iter().sum::<f64>(), current.clone());
+    for _ in 0..REFINEMENT_ROUNDS {
+        for (face, row) in distortion.iter_mut().enumerate() {
+            let level = current[face].log2() as usize;
+            let predicted = row.get(level).copied().unwrap_or(0.0);
+            if predicted > 0.0 && shown[face] > 0.0 {
+                let scale = shown[face] / predicted;
+                row.iter_mut().for_each(|d| *d *= scale);
+            }
+        }
+        current = allocate_budget(mesh, distortion, budget, faces.max);
+        let Some(measured) = measure(&current) else { break };
+        shown = measured;
+        let total = shown.iter().sum::<f64>();
+        if total < best.0 {
+            best = (total, current.clone());
+        }
+    }
+    best.1
+}
+
 /// Rate–distortion allocation (module docs): every face starts at `R = 1`; raises are taken
 /// in order of distortion removed per sample added, each face's best raise among those that
-/// still fit `budget`, until none fits.
+/// still fit `budget`, until none fits. `distortion[face][l]` is the face's predicted
+/// distortion at `R = 2^l`.
 /// Sample counts are exact as the store counts them (an edge holds the larger `R` of its
 /// faces), so the result never exceeds the budget (nor goes below the `R = 1` count, the
 /// least any mesh needs).
-fn allocate_budget(
-    mesh: &WeldedMesh,
-    materials: &[FaceMaterial],
-    shared: &[SharedUvs],
-    pyramids: &[Option<crate::io::bake::TexturePyramid>],
-    budget: u64,
-    max: Resolution,
-    calibration: &[Option<ColorStore>],
-) -> Vec<Resolution> {
-    let face_count = materials.len();
+fn allocate_budget(mesh: &WeldedMesh, distortion: &[Vec<f64>], budget: u64, max: Resolution) -> Vec<Resolution> {
+    let face_count = distortion.len();
     let levels = max.log2() as usize + 1;
-    // Distortion per face and level: error² × world area.
-    let distortion: Vec<Vec<f64>> = (0..face_count)
-        .into_par_iter()
-        .map(|face| {
-            let material = &materials[face];
-            if material.texture.is_none() {
-                return vec![0.0; levels];
-            }
-            let uvs = mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
-            let area = world_area(mesh, face);
-            let fit = FaceFit::new(materials, face, shared[face], pyramids, uvs, max);
-            fit.predicted_errors(face as u32, max, calibration)
-                .into_iter()
-                .map(|error| if error <= ROUNDING { 0.0 } else { f64::from(error).powi(2) * area })
-                .collect()
-        })
-        .collect();
     // Topology: the three edges of each face, as vertex pairs.
     let mut edge_ids = std::collections::HashMap::new();
     let face_edges: Vec<[usize; 3]> = mesh
