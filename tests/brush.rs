@@ -1132,3 +1132,35 @@ fn bench_paint_reports_every_measurement() {
     assert!(report["repack_rgba8"]["timing"]["best_seconds"].as_f64().unwrap() > 0.0);
     assert!(report["pick_latency"]["best_seconds"].as_f64().unwrap() > 0.0);
 }
+
+/// `bench paint --rows`: only the named dab rows run (what a profiler should see), an unknown
+/// name is refused.
+#[test]
+fn bench_paint_rows_measures_only_the_named_rows() {
+    let input = model("Duck/Duck.glb");
+    let run = |rows: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_meshpaint"))
+            .args(["bench", "paint", input.to_str().unwrap(), "-r", "4", "--dabs", "2", "--dab-samples", "1000"])
+            .args(["--json", "--rows", rows])
+            .output()
+            .unwrap()
+    };
+    let out = run("blur,occlusion_frame_paced");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let row = &report["brushes"][0];
+    assert!(row["blur"]["samples_per_second_median"].as_f64().unwrap() > 0.0, "{row}");
+    assert!(row["occlusion_frame_paced"]["samples_per_second_median"].as_f64().unwrap() > 0.0, "{row}");
+    for name in
+        ["occlusion", "occlusion_first_dab", "paint", "first_dab", "culling", "blur_occlusion", "blur_frame_paced"]
+    {
+        assert!(row.get(name).is_none(), "{name} ran: {row}");
+    }
+    assert_eq!(report["bvh_presets"].as_array().unwrap().len(), 0);
+    assert!(
+        report["repack_rgba8"].is_null() && report["gpu_upload"].is_null() && report["session_first_dab"].is_null()
+    );
+    let out = run("bluur");
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("bluur"));
+}

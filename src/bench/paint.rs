@@ -35,6 +35,10 @@ pub struct PaintBenchOptions {
     pub picks: usize,
     /// Repack repetitions.
     pub pack_runs: usize,
+    /// Only these rows of [`ROWS`] (a frame-paced one as `<row>_frame_paced`), and nothing
+    /// else (no BVH presets, session-first dab, GPU upload or repack): what a profiler should
+    /// see of one kind of dab. Empty: everything.
+    pub rows: Vec<String>,
 }
 
 impl Default for PaintBenchOptions {
@@ -45,6 +49,7 @@ impl Default for PaintBenchOptions {
             dabs: 30,
             picks: 2000,
             pack_runs: 3,
+            rows: Vec::new(),
         }
     }
 }
@@ -84,7 +89,9 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
     let [width, height] = options.viewport_px;
     let camera = default_camera(BoundingSphere::of_points(positions), DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
     let reference = MeshBvh::build(positions, triangles, BvhPreset::FastBuild);
-    let presets = bvh_presets(positions, triangles, &camera, &reference, options);
+    let everything = options.rows.is_empty();
+    let selected = |name: &str| everything || options.rows.iter().any(|row| row == name);
+    let presets = if everything { bvh_presets(positions, triangles, &camera, &reference, options) } else { Vec::new() };
 
     // Pick latency through the whole cursor path (pixel → ray → BVH), default preset.
     let bvh = reference;
@@ -101,8 +108,11 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
     let (depth_timing, built) = Timing::measure(1, || painter.prepare_occlusion(&view, &store, false));
     let mut brushes = Vec::new();
     let scene_radius = camera.scene_radius.max(1e-12);
-    let session_first_dab =
-        measure_session_first_dab(&view, &mut store, &mut painter, center, scene_radius, &options.target_samples)?;
+    let session_first_dab = if everything {
+        measure_session_first_dab(&view, &mut store, &mut painter, center, scene_radius, &options.target_samples)?
+    } else {
+        serde_json::Value::Null
+    };
     for &target in &options.target_samples {
         let radius = radius_covering(&view, &store, center, scene_radius, target);
         let mut row = serde_json::json!({ "target_samples": target, "radius_world": radius,
@@ -120,9 +130,12 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
                 mirror_x: false,
                 ..BrushSettings::default()
             };
-            let pace = (options.dabs, None);
-            row[name] = measure_dabs(&view, &mut store, &mut painter, settings, (center, radius), pace, step_per_dab)?;
-            if FRAME_PACED_ROWS.contains(&name) {
+            if selected(name) {
+                let pace = (options.dabs, None);
+                row[name] =
+                    measure_dabs(&view, &mut store, &mut painter, settings, (center, radius), pace, step_per_dab)?;
+            }
+            if FRAME_PACED_ROWS.contains(&name) && selected(&format!("{name}_frame_paced")) {
                 // As in a stroke: one dab per frame, the machine idle between.
                 let pace = (options.dabs.min(FRAME_PACED_DABS), Some(FRAME));
                 row[format!("{name}_frame_paced")] =
@@ -134,17 +147,21 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
     // The headline: the editor's defaults on the largest brush.
     let headline = brushes.last().map_or(serde_json::Value::Null, headline);
     // The editor's whole dab on the largest brush: the dab, then the upload it triggers.
-    let gpu_upload = match (Gpu::new_headless(), options.target_samples.last()) {
-        (Ok(gpu), Some(&target)) => {
+    let gpu_upload = match (everything.then(Gpu::new_headless), options.target_samples.last()) {
+        (None, _) => serde_json::Value::Null,
+        (Some(Ok(gpu)), Some(&target)) => {
             let radius = radius_covering(&view, &store, center, scene_radius, target);
             let settings = BrushSettings { tool: Tool::Paint, blend: BlendMode::Mix, ..BrushSettings::default() };
             measure_gpu_upload(&view, &mut store, &mut painter, settings, (center, radius), options.dabs, &gpu)?
         }
-        (Err(error), _) => serde_json::json!({ "skipped": error.to_string() }),
-        (Ok(_), None) => serde_json::Value::Null,
+        (Some(Err(error)), _) => serde_json::json!({ "skipped": error.to_string() }),
+        (Some(Ok(_)), None) => serde_json::Value::Null,
     };
-    let (pack_timing, packed) = Timing::measure(options.pack_runs, || document.pack(ColorFormat::Rgba8Srgb));
-    let packed_bytes = packed.map(|p| p.face_record_bytes() + p.color_bytes()).unwrap_or(0);
+    let repack = everything.then(|| {
+        let (timing, packed) = Timing::measure(options.pack_runs, || document.pack(ColorFormat::Rgba8Srgb));
+        let bytes = packed.map(|p| p.face_record_bytes() + p.color_bytes()).unwrap_or(0);
+        serde_json::json!({ "timing": timing.to_json(), "bytes": bytes, "threads": crate::packing::packer::pack_threads() })
+    });
     Ok(serde_json::json!({
         "bench": "paint",
         "triangles": document.store.topology().face_count(),
@@ -164,11 +181,7 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
         "session_first_dab": session_first_dab,
         "session_first_dab_note": "the first dab after entering paint mode (editor defaults, largest brush): it also copies the store chunks it writes, shared with the base snapshot until then",
         "gpu_upload": gpu_upload,
-        "repack_rgba8": {
-            "timing": pack_timing.to_json(),
-            "bytes": packed_bytes,
-            "threads": crate::packing::packer::pack_threads(),
-        },
+        "repack_rgba8": repack,
     }))
 }
 

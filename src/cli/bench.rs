@@ -164,6 +164,10 @@ pub(super) enum BenchCommand {
         /// Print compact JSON (default: indented JSON).
         #[arg(long)]
         json: bool,
+        /// Measure only these dab rows (e.g. `blur`, `paint`, `occlusion_frame_paced`) and
+        /// nothing else: for a profiler (`perf record -g -- meshpaint bench paint … --rows blur`).
+        #[arg(long, value_delimiter = ',')]
+        rows: Vec<String>,
     },
     /// The numerical extremes (R = 4096 in perspective, offsets 1e5 / 1e6, scale 1e-4,
     /// slivers, valence 200, RGBA16F's largest value, HDR Add, NaN / ∞ colours, grazing
@@ -272,7 +276,7 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             println!("{report}");
             Ok(())
         }
-        BenchCommand::Paint { file, resolution, dabs, subdivide, dab_samples, json } => {
+        BenchCommand::Paint { file, resolution, dabs, subdivide, dab_samples, json, rows } => {
             let document = if subdivide == 0 {
                 open(&file, resolution, &budget(None))?
             } else {
@@ -281,7 +285,17 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
                 let scene = meshpaint::io::subdivide::subdivide_scene(&scene, subdivide, &budget)?;
                 meshpaint::io::document::Document::from_scene_within(scene, resolution.rule()?, &file, &budget)?
             };
-            let mut options = meshpaint::bench::PaintBenchOptions { dabs, ..Default::default() };
+            let known = |row: &String| {
+                meshpaint::bench::paint::ROWS.iter().any(|&(name, ..)| {
+                    *row == name
+                        || (meshpaint::bench::paint::FRAME_PACED_ROWS.contains(&name)
+                            && *row == format!("{name}_frame_paced"))
+                })
+            };
+            if let Some(row) = rows.iter().find(|row| !known(row)) {
+                anyhow::bail!("--rows: no row named {row:?}");
+            }
+            let mut options = meshpaint::bench::PaintBenchOptions { dabs, rows, ..Default::default() };
             if !dab_samples.is_empty() {
                 options.target_samples = dab_samples;
             }
