@@ -150,11 +150,9 @@ pub(super) fn blur_faces<C: Coverage + Sync>(
     };
     let faces: Vec<(u32, u8)> = scratch.faces.iter().copied().zip(scratch.face_masks.iter().copied()).collect();
     let samples: u64 = faces.iter().map(|&(face, _)| store.interior_samples(face).len() as u64).sum();
-    let parts: Vec<FaceSums> = if samples < PARALLEL_MIN_SAMPLES {
-        vec![compute(&faces)]
-    } else {
-        faces.par_chunks(CHUNK).map(compute).collect()
-    };
+    stats.parallel = samples >= PARALLEL_MIN_SAMPLES;
+    let parts: Vec<FaceSums> =
+        if !stats.parallel { vec![compute(&faces)] } else { faces.par_chunks(CHUNK).map(compute).collect() };
     for part in &parts {
         stats.samples_covered += part.interiors.len();
         for &(slot, sum, count, weight) in &part.shared {
@@ -167,7 +165,7 @@ pub(super) fn blur_faces<C: Coverage + Sync>(
             }
         }
     }
-    write_blurred(writer, scratch, &faces, &parts, samples >= PARALLEL_MIN_SAMPLES, &mut stats);
+    write_blurred(writer, scratch, &faces, &parts, stats.parallel, &mut stats);
     stats
 }
 

@@ -35,6 +35,8 @@ pub struct DabStats {
     pub samples_changed: u64,
     /// Faces whose resolution changed.
     pub faces_resized: u32,
+    /// Whether the dab's kernels ran on the thread pool (8192 samples or more to compute).
+    pub parallel: bool,
 }
 
 impl DabStats {
@@ -43,6 +45,7 @@ impl DabStats {
         self.samples_covered += other.samples_covered;
         self.samples_changed += other.samples_changed;
         self.faces_resized += other.faces_resized;
+        self.parallel |= other.parallel;
     }
 }
 
@@ -466,7 +469,8 @@ pub(super) fn paint_faces<C: Coverage + Sync>(
             }
             (log, covered)
         };
-        let parts: Vec<(UndoLog, u64)> = if samples < PARALLEL_MIN_SAMPLES {
+        stats.parallel = samples >= PARALLEL_MIN_SAMPLES;
+        let parts: Vec<(UndoLog, u64)> = if !stats.parallel {
             vec![compute((&mut slices, &jobs))]
         } else {
             slices.par_chunks_mut(CHUNK).zip(jobs.par_chunks(CHUNK)).map(compute).collect()

@@ -104,6 +104,9 @@ pub struct Painter {
     /// Occlusion depth maps of the view and of its mirror (built on the first dab that needs
     /// them after the view changed, see [`crate::paint::occlusion`]).
     depth_maps: [Option<DepthMap>; 2],
+    /// Whether the last colour or blur dab ran on the thread pool (`None` before the
+    /// first): a stroke keeps its radius, so the next one likely does too.
+    last_dab_parallel: Option<bool>,
 }
 
 impl Painter {
@@ -123,6 +126,7 @@ impl Painter {
             scratch: Scratch::default(),
             budget: None,
             tracker: None,
+            last_dab_parallel: None,
             depth_maps: [None, None],
         }
     }
@@ -329,13 +333,17 @@ impl Painter {
         if !(radius_world.is_finite() && radius_world > 0.0 && center.is_finite()) {
             return Ok(DabStats::default());
         }
-        if matches!(settings.tool, Tool::Paint | Tool::Blur) {
+        let brush = matches!(settings.tool, Tool::Paint | Tool::Blur);
+        if brush && self.last_dab_parallel.is_none_or(|parallel| parallel) {
             // Wake the pool now, so that its threads are up by the time the kernels' parallel
             // section starts, after the sphere query and the masks: between a stroke's dabs
             // (one a frame) they sleep, and a sleeping thread takes a while to wake on a
             // virtual machine. `bench paint`'s `occlusion_frame_paced` row, 2.3M tris,
             // 100k-sample dabs, median of 30, two interleaved runs: 16.8 / 17.1 → 19.2 /
-            // 22.4 M samples/s (10k-sample dabs: 10.2 / 9.0 → 9.3 / 12.4, within the spread).
+            // 22.4 M samples/s. Only when the last dab ran in parallel (a stroke keeps its
+            // radius): a small dab runs on this thread, and the woken threads spin for work
+            // on the cores it needs (`perf` of 10k-sample blur dabs:
+            // 31 % of the time in the scheduler and `sched_yield`).
             rayon::spawn(|| {});
         }
         let occlusion = settings.occlusion && matches!(settings.tool, Tool::Paint | Tool::Blur);
@@ -430,6 +438,9 @@ impl Painter {
                 resize_faces(op, writer, &mut self.scratch, budget)?
             }
         };
+        if matches!(settings.tool, Tool::Paint | Tool::Blur) {
+            self.last_dab_parallel = Some(stats.parallel);
+        }
         Ok(stats)
     }
 }
