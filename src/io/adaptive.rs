@@ -146,8 +146,8 @@ pub fn face_resolutions(
     }
     if let ResolutionRule::Budget { samples, max } = rule {
         let faces = Faces { mesh, materials: &materials, shared: &shared, pyramids: &pyramids, max };
-        let calibration = calibration_stores(mesh, scene, samples, max, fit);
-        let mut distortion = faces.predicted_distortions(&calibration);
+        // The calibration stores are dropped before the refinement allocates its own.
+        let mut distortion = faces.predicted_distortions(&calibration_stores(mesh, scene, samples, max, fit));
         let first = allocate_budget(mesh, &distortion, samples, max);
         return refine_allocation(&faces, scene, &mut distortion, first, samples, fit);
     }
