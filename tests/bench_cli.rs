@@ -1,6 +1,7 @@
-//! Smoke tests of `meshpaint bench pack` and `meshpaint bench load` on a small input: each
-//! runs, prints JSON that parses, and its numbers are positive (speed itself is never
-//! asserted; the figures live in the README).
+//! Smoke tests of `meshpaint bench pack`, `bench load`, `bench render` and `bench adaptive`
+//! on a small input: each runs, prints JSON that parses, and its numbers are positive (speed
+//! itself is never asserted; the figures live in the README). `bench paint`, `bench trade`
+//! and `bench extremes` have theirs in tests/brush.rs, tests/trade.rs and tests/extremes.rs.
 
 mod common;
 use common::model;
@@ -96,4 +97,57 @@ fn bench_load_reports_every_phase_the_total_and_peak_memory() {
     let entering = phases["enter_paint_seconds"].as_f64().unwrap() + phases["paint_frame_seconds"].as_f64().unwrap();
     assert!(to_paint + 1e-9 >= total + entering, "{to_paint} < {total} + {entering}");
     assert!(report["peak_resident_bytes"].as_u64().unwrap() > 1 << 20);
+}
+
+#[test]
+fn bench_render_reports_every_mode_against_the_baseline() {
+    let input = model("Duck/Duck.glb");
+    let report = run(&[
+        "bench",
+        "render",
+        input.to_str().unwrap(),
+        "--resolution",
+        "4",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "2",
+    ]);
+    assert_eq!(report["bench"], "render");
+    assert_eq!((report["width"].as_u64(), report["height"].as_u64()), (Some(64), Some(48)));
+    let modes = report["modes"].as_array().unwrap();
+    assert!(modes.len() >= 2, "{report}");
+    for mode in modes {
+        assert!(mode["median_ms"].as_f64().unwrap() > 0.0, "{mode}");
+        assert!(mode["ratio_to_baseline"].as_f64().unwrap() > 0.0, "{mode}");
+    }
+}
+
+#[test]
+fn bench_adaptive_reports_every_rule_and_the_goals() {
+    let input = model("BoxTextured/BoxTextured.glb");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_meshpaint"))
+        .args(["bench", "adaptive", input.to_str().unwrap(), "--max-resolution", "8", "--size", "32"])
+        .args(["--supersample", "1", "--views", "1", "--bake", "point"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let lines: Vec<serde_json::Value> =
+        String::from_utf8_lossy(&out.stdout).lines().map(|line| serde_json::from_str(line).unwrap()).collect();
+    let rows: Vec<&serde_json::Value> = lines.iter().filter(|line| line["bench"] == "adaptive").collect();
+    // Uniform R = 1…32, texel density, five error bounds, and a budget row after each uniform R ≥ 4.
+    assert_eq!(rows.len(), 6 + 1 + 5 + 4, "{rows:?}");
+    for row in &rows {
+        assert!(row["samples"].as_u64().unwrap() > 0, "{row}");
+        assert!(row["psnr_db"].as_f64().unwrap() > 0.0, "{row}");
+        assert_eq!(row["bake"], "point");
+    }
+    for row in rows.iter().filter(|row| row["rule"] == "budget") {
+        assert!(row["samples"].as_u64() <= row["sample_budget"].as_u64(), "{row}");
+    }
+    let summary = lines.iter().find(|line| line["bench"] == "adaptive-summary").unwrap();
+    assert_eq!(summary["uv_face_texels"], 267_974);
+    assert!(summary["same_psnr_fewer_samples"].as_array().is_some_and(|rows| rows.len() == 6), "{summary}");
 }
