@@ -670,9 +670,10 @@ fn open_and_wait(editor: &mut Editor, path: &Path) {
 
 /// The open dialog's resolution choice reaches the document: "Automatic" keeps R on the
 /// textured Duck and starts an untextured STL at R = 1 with resolution following the brush;
-/// "Error ≤ E" gives the Duck exactly the per-face resolutions of the library's rule.
+/// "Error ≤ E" gives the Duck exactly the per-face resolutions of the library's rule, and so
+/// do "Match texture" and "Samples ≤ N" (the budget, on BoxTextured).
 #[test]
-fn the_open_dialog_offers_uniform_match_texture_and_error_bound_resolutions() {
+fn the_open_dialog_offers_uniform_match_texture_error_bound_and_budget_resolutions() {
     use meshpaint::app::import_settings::ImportMode;
     use meshpaint::colors::budget::Budget;
     use meshpaint::io::adaptive::ResolutionRule;
@@ -718,6 +719,17 @@ fn the_open_dialog_offers_uniform_match_texture_and_error_bound_resolutions() {
     let rule = ResolutionRule::TexelDensity { max: editor.import.max_resolution };
     let expected = Document::open_within(&duck, rule, &Budget::from_environment()).unwrap();
     assert_eq!(resolutions(editor), expected.store.face_resolutions());
+
+    // "Samples ≤ N": the budget rule's resolutions, within N (BoxTextured: 12 faces, fast).
+    let box_textured = crate_path("assets/models/BoxTextured/BoxTextured.glb");
+    editor.import.mode = ImportMode::Budget;
+    editor.import.sample_budget = 600;
+    open_and_wait(editor, &box_textured);
+    let rule = ResolutionRule::Budget { samples: 600, max: editor.import.max_resolution };
+    let expected = Document::open_within(&box_textured, rule, &Budget::from_environment()).unwrap();
+    assert_eq!(resolutions(editor), expected.store.face_resolutions());
+    let samples = editor.document.as_ref().unwrap().document.store.sample_count();
+    assert!(samples <= 600 && samples > 386, "{samples} samples: within N, more than uniform R = 8's 386");
 }
 
 /// An editor with a headless GPU (lavapipe) and the built-in Duck.

@@ -15,12 +15,19 @@ pub enum ImportMode {
     MatchTexture,
     /// The lowest `R` per face whose reconstruction stays within `E` of the texture.
     ErrorBound,
+    /// The per-face `R` that shows the texture best with at most `N` samples.
+    Budget,
 }
 
 impl ImportMode {
     /// Every mode, in the order the dialog lists them.
-    pub const ALL: [ImportMode; 4] =
-        [ImportMode::Automatic, ImportMode::Uniform, ImportMode::MatchTexture, ImportMode::ErrorBound];
+    pub const ALL: [ImportMode; 5] = [
+        ImportMode::Automatic,
+        ImportMode::Uniform,
+        ImportMode::MatchTexture,
+        ImportMode::ErrorBound,
+        ImportMode::Budget,
+    ];
 
     /// The name the dialog shows.
     pub fn name(self) -> &'static str {
@@ -29,6 +36,7 @@ impl ImportMode {
             ImportMode::Uniform => "Uniform R",
             ImportMode::MatchTexture => "Match texture",
             ImportMode::ErrorBound => "Error ≤ E",
+            ImportMode::Budget => "Samples ≤ N",
         }
     }
 
@@ -45,6 +53,10 @@ impl ImportMode {
                 "The lowest R per face whose linear reconstruction stays within E of the texture \
                  (RMS of sRGB-encoded differences, 0..1), up to the largest R"
             }
+            ImportMode::Budget => {
+                "The per-face R that shows the texture best with at most N samples (level 0, MIP chains \
+                 not counted): more where the texture varies, fewer where it is flat, up to the largest R"
+            }
         }
     }
 }
@@ -58,6 +70,8 @@ pub struct ImportSettings {
     pub resolution: Resolution,
     /// `E` of [`ImportMode::ErrorBound`] (colour units, full range = 1).
     pub error_bound: f32,
+    /// `N` of [`ImportMode::Budget`] (level-0 samples).
+    pub sample_budget: u64,
     /// The largest `R` of the content-driven modes.
     pub max_resolution: Resolution,
 }
@@ -68,6 +82,7 @@ impl Default for ImportSettings {
             mode: ImportMode::Automatic,
             resolution: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
             error_bound: 0.01,
+            sample_budget: 100_000,
             max_resolution: Resolution::from_log2(6).unwrap_or(Resolution::ONE),
         }
     }
@@ -83,6 +98,7 @@ impl ImportSettings {
             ImportMode::ErrorBound => {
                 ResolutionRule::ErrorBound { bound: self.error_bound.max(0.0), max: self.max_resolution }
             }
+            ImportMode::Budget => ResolutionRule::Budget { samples: self.sample_budget, max: self.max_resolution },
         }
     }
 
@@ -108,6 +124,12 @@ impl ImportSettings {
                 ImportMode::ErrorBound => {
                     let label = ui.label("E");
                     ui.add(egui::DragValue::new(&mut self.error_bound).range(0.0..=1.0).speed(0.001).max_decimals(4))
+                        .labelled_by(label.id);
+                    resolution_combo(ui, "R ≤", "import max R", &mut self.max_resolution);
+                }
+                ImportMode::Budget => {
+                    let label = ui.label("N");
+                    ui.add(egui::DragValue::new(&mut self.sample_budget).range(1..=1u64 << 28).speed(1000.0))
                         .labelled_by(label.id);
                     resolution_combo(ui, "R ≤", "import max R", &mut self.max_resolution);
                 }
