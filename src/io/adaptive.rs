@@ -250,18 +250,18 @@ impl<'a> Faces<'a> {
             .collect()
     }
 
-    /// Each face's distortion as `store` shows it (at the face's own `R` in the store).
+    /// The error (module docs) of face `face` as `store` shows it, at the face's own `R`
+    /// there; `None` for a face without a texture.
+    fn shown_error(&self, store: &ColorStore, face: usize) -> Option<f32> {
+        let (fit, r) = (self.fit(face)?, store.face_resolution(face as u32)?);
+        Some(fit.error_of(r, |bary| sample(store, face as u32, bary, Filter::Linear, 0).unwrap_or([0.0; 4])))
+    }
+
+    /// Each face's distortion as `store` shows it ([`Faces::shown_error`]).
     fn shown_distortions(&self, store: &ColorStore) -> Vec<f64> {
         (0..self.materials.len())
             .into_par_iter()
-            .map(|face| {
-                let (Some(fit), Some(r)) = (self.fit(face), store.face_resolution(face as u32)) else {
-                    return 0.0;
-                };
-                let error =
-                    fit.error_of(r, |bary| sample(store, face as u32, bary, Filter::Linear, 0).unwrap_or([0.0; 4]));
-                self.distortion(face, error)
-            })
+            .map(|face| self.shown_error(store, face).map_or(0.0, |error| self.distortion(face, error)))
             .collect()
     }
 }
@@ -487,6 +487,7 @@ pub fn bake_and_verify(
     if shared.len() != face_count {
         return 0;
     }
+    let faces = Faces { mesh, materials: &materials, shared: &shared, pyramids: &pyramids, max };
     let mut rounds = 0;
     loop {
         rounds += 1;
@@ -494,15 +495,8 @@ pub fn bake_and_verify(
         let over: Vec<u32> = (0..face_count)
             .into_par_iter()
             .filter(|&face| {
-                let material = &materials[face];
                 let r = shown.face_resolution(face as u32).unwrap_or(max);
-                if material.texture.is_none() || r >= max {
-                    return false;
-                }
-                let uvs = mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
-                let fit = FaceFit::new(&materials, face, shared[face], &pyramids, uvs, max);
-                fit.error_of(r, |bary| sample(shown, face as u32, bary, Filter::Linear, 0).unwrap_or([0.0; 4]))
-                    > bound.max(ROUNDING)
+                r < max && faces.shown_error(shown, face).is_some_and(|error| error > bound.max(ROUNDING))
             })
             .map(|face| face as u32)
             .collect();
