@@ -136,9 +136,7 @@ impl Context<'_> {
         if coarse {
             return;
         }
-        for level in 1..=self.edge_log2(edge).saturating_sub(1) {
-            reduce_edge_level(self, edge, &[], scratch, level, interiors);
-        }
+        reduce_edge_chain(self, edge, scratch, interiors);
         let n0 = scratch.len() - upper.len();
         self.format.encode_slice(&scratch[n0..], &mut bytes[n0 * self.format.bytes_per_sample()..]);
         upper.copy_from_slice(&scratch[n0..]);
@@ -320,6 +318,51 @@ fn reduce_edge_level(
     }
 }
 
+/// Levels ≥ 1 of `edge`'s chain when none of its faces is coarser than the edge: every
+/// level in one go, its faces looked up once instead of once a level. A manifold or
+/// boundary edge adds the same neighbours in the same order as [`reduce_edge_level`] (so
+/// the same bits); an edge with more faces goes level by level through it.
+fn reduce_edge_chain(ctx: &Context, edge: u32, chain: &mut [Rgba], interiors: &InteriorReader) {
+    let log2 = ctx.edge_log2(edge);
+    let topology = ctx.store.topology();
+    let faces = topology.faces_of_edge(edge);
+    if faces.len() > 2 {
+        for level in 1..log2 {
+            reduce_edge_level(ctx, edge, &[], chain, level, interiors);
+        }
+        return;
+    }
+    let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
+    let sides: [Option<(u32, u8, bool)>; 2] = std::array::from_fn(|n| {
+        faces.get(n).map(|&(face, face_edge)| (face, face_edge, topology.is_reversed(face, usize::from(face_edge))))
+    });
+    for level in 1..log2 {
+        let r_level = 1u32 << (log2 - level);
+        let r_previous = 2 * r_level;
+        let previous_start = layout::edge_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
+        let level_start = layout::edge_level_offset(r_edge, level).unwrap_or(0) as usize;
+        let face_level_offset = layout::interior_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
+        let rp = r_previous as usize;
+        let face_levels =
+            sides.map(|side| side.map(|(face, e, reversed)| (interiors.level(face, face_level_offset), e, reversed)));
+        for k in 1..r_level {
+            let position = 2 * k;
+            let at = |p: u32| chain[previous_start + p as usize - 1];
+            let center = at(position);
+            let mut sum = MipSum::default();
+            sum.add(at(position - 1));
+            sum.add(at(position + 1));
+            for &(face_level, face_edge, reversed) in face_levels.iter().flatten() {
+                let p = if reversed { r_previous - position } else { position } as usize;
+                for (i, j) in inside_neighbours(face_edge, p, rp) {
+                    sum.add_vec4(face_level.get_vec4(interior_row_start(rp, i) + j - 1));
+                }
+            }
+            chain[level_start + k as usize - 1] = sum.finish(center);
+        }
+    }
+}
+
 /// Level `level` of vertex `v` (eq. 2.5) from its incident edges' level `level − 1`.
 fn reduce_vertex_level(ctx: &Context, incident: &[u32], v: u32, slot: &mut [Rgba], level: usize, edges: &EdgeReader) {
     let previous = level - 1;
@@ -336,6 +379,33 @@ fn reduce_vertex_level(ctx: &Context, incident: &[u32], v: u32, slot: &mut [Rgba
         sum.add(edges.get(edge, level_start + position as usize - 1).unwrap_or([0.0; 4]));
     }
     slot[level] = sum.finish(slot[previous]);
+}
+
+/// Levels ≥ 1 of vertex `v` (eq. 2.5), every level in one pass over its incident edges:
+/// each edge's resolution, end and chain are looked up once, not once a level. Each level
+/// adds the same neighbours in the same order as [`reduce_vertex_level`], so the same bits.
+fn reduce_vertex_chain(ctx: &Context, incident: &[u32], v: u32, slot: &mut [Rgba], edges: &EdgeReader) {
+    const MAX_LEVELS: usize = layout::MAX_LOG2_RESOLUTION as usize + 1;
+    let levels = slot.len().min(MAX_LEVELS);
+    let mut sums = [MipSum::default(); MAX_LEVELS];
+    let topology = ctx.store.topology();
+    for &edge in incident {
+        let log2 = ctx.edge_log2(edge);
+        let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
+        let first = v == topology.edge_vertices[edge as usize][0];
+        // Level `level` reads level `level − 1` of the edge, which has samples while
+        // `level ≤ log2`.
+        for (level, sum) in sums.iter_mut().enumerate().take(levels.min(log2 as usize + 1)).skip(1) {
+            let previous = level as u32 - 1;
+            let r_previous = 1u32 << (log2 - previous);
+            let level_start = layout::edge_level_offset(r_edge, previous).unwrap_or(0) as usize;
+            let position = if first { 1 } else { r_previous - 1 };
+            sum.add(edges.get(edge, level_start + position as usize - 1).unwrap_or([0.0; 4]));
+        }
+    }
+    for level in 1..levels {
+        slot[level] = sums[level].finish(slot[level - 1]);
+    }
 }
 
 /// Sorted edge ids → what their coarse faces show at `level − 1`, for the ids of `edges`
@@ -402,9 +472,7 @@ fn build_all(
             .for_each(|(v, (slot, out))| {
                 ctx.vertex_level0(v as u32, slot, out);
                 if simple[v] && levels > 1 {
-                    for level in 1..levels {
-                        reduce_vertex_level(ctx, incident(v), v as u32, slot, level, &edges);
-                    }
+                    reduce_vertex_chain(ctx, incident(v), v as u32, slot, &edges);
                     ctx.format.encode_slice(&slot[1..], &mut out[size..]);
                 }
             });
