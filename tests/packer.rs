@@ -50,6 +50,26 @@ fn rgba8_srgb_round_trips_every_byte() {
     }
 }
 
+/// RGBA16F decoding (what the packer's filters and the sampler read) against `half`'s
+/// conversion for every one of the 65,536 binary16 bit patterns, in every channel, bit for
+/// bit: subnormals, both zeros, infinities and NaNs (quiet, payload kept) included.
+#[test]
+fn rgba16f_decoding_equals_half_on_every_bit_pattern() {
+    use half::f16;
+    for h in 0..=u16::MAX {
+        let want = f16::from_bits(h).to_f32().to_bits();
+        assert_eq!(meshpaint::colors::format::f16_bits_to_f32(h).to_bits(), want, "{h:#06x}");
+        for channel in 0..4 {
+            let mut bytes = [0u8; 8];
+            bytes[2 * channel..2 * channel + 2].copy_from_slice(&h.to_le_bytes());
+            let decoded = ColorFormat::Rgba16F.decode(&bytes);
+            let vector = ColorFormat::Rgba16F.decode_vec4(&bytes).to_array();
+            assert_eq!(decoded[channel].to_bits(), want, "{h:#06x} in channel {channel}");
+            assert_eq!(vector[channel].to_bits(), want, "{h:#06x} in channel {channel} (vector)");
+        }
+    }
+}
+
 /// Every format's slice encoders against one channel at a time, on the extremes: NaN,
 /// infinities, negatives, subnormals of f32 and of f16, the f16 rounding boundary at the top
 /// (65 519.996 rounds down, 65 520 would round to infinity), values past 1 in alpha, and runs
