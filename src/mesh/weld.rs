@@ -6,8 +6,6 @@
 //! Every node instance is its own copy. Triangles whose welded corners repeat are dropped
 //! and counted; vertices no kept triangle uses are dropped too.
 
-use std::collections::HashMap;
-
 use glam::{Mat3, Mat4, Vec3};
 
 use crate::mesh::scene::Scene;
@@ -46,7 +44,8 @@ struct LocalWeld {
 
 fn weld_local(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> LocalWeld {
     // Bitwise key: -0.0 and 0.0 stay distinct, exactly as "bitwise-equal" says.
-    let mut id_of_key: HashMap<[u32; 3], u32> = HashMap::with_capacity(positions.len());
+    let mut id_of_key: rustc_hash::FxHashMap<[u32; 3], u32> =
+        rustc_hash::FxHashMap::with_capacity_and_hasher(positions.len(), Default::default());
     let mut welded_of_source = Vec::with_capacity(positions.len());
     let mut welded_positions: Vec<Vec3> = Vec::new();
     let mut first_source: Vec<u32> = Vec::new();
@@ -63,14 +62,12 @@ fn weld_local(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> LocalWeld {
     let mut kept = Vec::with_capacity(triangles.len());
     let mut dropped = 0u64;
     for (source_triangle, corners) in triangles.iter().enumerate() {
-        let Some(welded) =
-            corners.iter().map(|&c| welded_of_source.get(c as usize).copied()).collect::<Option<Vec<u32>>>()
-        else {
+        let welded = corners.map(|c| welded_of_source.get(c as usize).copied());
+        let [Some(a), Some(b), Some(c)] = welded else {
             // The importer validated indices; a bad one here is dropped, not trusted.
             dropped += 1;
             continue;
         };
-        let [a, b, c] = [welded[0], welded[1], welded[2]];
         if a == b || b == c || c == a {
             dropped += 1;
             continue;
