@@ -244,7 +244,6 @@ fn coarse_neighbours(ctx: &Context, view: &ChainsView, edge: u32, level: u32) ->
 }
 
 /// Level `level` of `edge`'s chain from level `level − 1` (eq. 2.6 on the edge).
-#[allow(clippy::too_many_arguments)]
 fn reduce_edge_level(
     ctx: &Context,
     edge: u32,
@@ -260,68 +259,39 @@ fn reduce_edge_level(
     let store = ctx.store;
     let topology = store.topology();
     let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
-    let r_level = 1u32 << (log2 - level);
-    let r_previous = 2 * r_level;
-    let previous_start = layout::edge_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
-    let level_start = layout::edge_level_offset(r_edge, level).unwrap_or(0) as usize;
     let face_level_offset = layout::interior_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
-    let rp = r_previous as usize;
-    let faces = topology.faces_of_edge(edge);
-    let coarse_count = faces.iter().filter(|&&(face, _)| store.face_resolution(face) != Some(r_edge)).count();
-    // The equal-resolution faces' level − 1, looked up once (a manifold edge has ≤ 2).
-    let mut equal: [Option<(FaceLevel, u8, bool)>; 2] = [None; 2];
-    if faces.len() - coarse_count <= 2 {
-        let mut n = 0;
-        for &(face, face_edge) in faces {
-            if store.face_resolution(face) == Some(r_edge) {
-                let reversed = topology.is_reversed(face, usize::from(face_edge));
-                equal[n] = Some((interiors.level(face, face_level_offset), face_edge, reversed));
-                n += 1;
-            }
-        }
-    }
-    let few_faces = faces.len() - coarse_count <= 2;
-    for k in 1..r_level {
-        let position = 2 * k;
-        // Positions 2k − 1 … 2k + 1 lie in 1..r_previous: edge samples, never a vertex.
-        let at = |p: u32| chain[previous_start + p as usize - 1];
-        let center = at(position);
-        let mut sum = MipSum::default();
-        sum.add(at(position - 1));
-        sum.add(at(position + 1));
-        if few_faces {
-            for &(face_level, face_edge, reversed) in equal.iter().flatten() {
-                let p = if reversed { r_previous - position } else { position } as usize;
-                for (i, j) in inside_neighbours(face_edge, p, rp) {
-                    sum.add_vec4(face_level.get_vec4(interior_row_start(rp, i) + j - 1));
-                }
-            }
+    // The equal-resolution faces' level − 1, in `faces` order (a manifold edge has ≤ 2:
+    // no allocation).
+    let equal = topology.faces_of_edge(edge).iter().filter(|&&(face, _)| store.face_resolution(face) == Some(r_edge));
+    let side = |&(face, face_edge): &(u32, u8)| {
+        (interiors.level(face, face_level_offset), face_edge, topology.is_reversed(face, usize::from(face_edge)))
+    };
+    let mut two = [NO_SIDE; 2];
+    let mut more = Vec::new();
+    let mut n = 0;
+    for face in equal {
+        if n < 2 {
+            two[n] = side(face);
         } else {
-            for &(face, face_edge) in faces {
-                if store.face_resolution(face) != Some(r_edge) {
-                    continue;
-                }
-                let reversed = topology.is_reversed(face, usize::from(face_edge));
-                let p = if reversed { r_previous - position } else { position } as usize;
-                for (i, j) in inside_neighbours(face_edge, p, rp) {
-                    let at = face_level_offset + interior_row_start(rp, i) + j - 1;
-                    sum.add(interiors.get(face, at).unwrap_or([0.0; 4]));
-                }
+            if more.is_empty() {
+                more.extend_from_slice(&two);
             }
+            more.push(side(face));
         }
-        // Coarser faces: what they show at those two points (computed beforehand).
-        let per_k = 2 * coarse_count;
-        for &n in coarse.get((k as usize - 1) * per_k..k as usize * per_k).unwrap_or(&[]) {
-            sum.add(n);
-        }
-        chain[level_start + k as usize - 1] = sum.finish(center);
+        n += 1;
     }
+    filter_edge_level(chain, r_edge, level, if n <= 2 { &two[..n] } else { &more }, coarse);
 }
 
+/// A placeholder face side for the fixed arrays of [`reduce_edge_level`] and
+/// [`reduce_edge_chain`] (never read: only the sides counted are passed on).
+const NO_SIDE: (FaceLevel<'static>, u8, bool) = (FaceLevel::Upper(&[]), 0, false);
+
 /// Levels ≥ 1 of `edge`'s chain when none of its faces is coarser than the edge: every
-/// level in one go, its faces looked up once instead of once a level. A manifold or
-/// boundary edge adds the same neighbours in the same order as [`reduce_edge_level`] (so
-/// the same bits); an edge with more faces goes level by level through it.
+/// level in one go, the edge's resolution and its faces' orientations looked up once
+/// instead of once a level (each level adds the same neighbours in the same order as
+/// [`reduce_edge_level`], so the same bits); an edge with more than two faces goes level by
+/// level through it.
 fn reduce_edge_chain(ctx: &Context, edge: u32, chain: &mut [Rgba], interiors: &InteriorReader) {
     let log2 = ctx.edge_log2(edge);
     let topology = ctx.store.topology();
@@ -336,30 +306,53 @@ fn reduce_edge_chain(ctx: &Context, edge: u32, chain: &mut [Rgba], interiors: &I
     let sides: [Option<(u32, u8, bool)>; 2] = std::array::from_fn(|n| {
         faces.get(n).map(|&(face, face_edge)| (face, face_edge, topology.is_reversed(face, usize::from(face_edge))))
     });
+    let n = faces.len();
+    let mut levels = [NO_SIDE; 2];
     for level in 1..log2 {
-        let r_level = 1u32 << (log2 - level);
-        let r_previous = 2 * r_level;
-        let previous_start = layout::edge_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
-        let level_start = layout::edge_level_offset(r_edge, level).unwrap_or(0) as usize;
         let face_level_offset = layout::interior_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
-        let rp = r_previous as usize;
-        let face_levels =
-            sides.map(|side| side.map(|(face, e, reversed)| (interiors.level(face, face_level_offset), e, reversed)));
-        for k in 1..r_level {
-            let position = 2 * k;
-            let at = |p: u32| chain[previous_start + p as usize - 1];
-            let center = at(position);
-            let mut sum = MipSum::default();
-            sum.add(at(position - 1));
-            sum.add(at(position + 1));
-            for &(face_level, face_edge, reversed) in face_levels.iter().flatten() {
-                let p = if reversed { r_previous - position } else { position } as usize;
-                for (i, j) in inside_neighbours(face_edge, p, rp) {
-                    sum.add_vec4(face_level.get_vec4(interior_row_start(rp, i) + j - 1));
-                }
-            }
-            chain[level_start + k as usize - 1] = sum.finish(center);
+        for (slot, &(face, e, reversed)) in levels.iter_mut().zip(sides.iter().flatten()) {
+            *slot = (interiors.level(face, face_level_offset), e, reversed);
         }
+        filter_edge_level(chain, r_edge, level, &levels[..n], &[]);
+    }
+}
+
+/// Eq. 2.6 on an edge of resolution `r_edge` at `level` (which has samples), in `chain`:
+/// each sample from the centre, its two neighbours along the edge, for each face of
+/// `equal` (the incident faces of the edge's resolution: their level `level − 1`, face
+/// edge, reversed flag) its two lattice neighbours inside the face, then `coarse` (what the
+/// coarser faces show, two colours per coarse face for each sample in turn).
+fn filter_edge_level(
+    chain: &mut [Rgba],
+    r_edge: Resolution,
+    level: u32,
+    equal: &[(FaceLevel, u8, bool)],
+    coarse: &[Rgba],
+) {
+    let r_level = r_edge.get() >> level;
+    let r_previous = 2 * r_level;
+    let previous_start = layout::edge_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
+    let level_start = layout::edge_level_offset(r_edge, level).unwrap_or(0) as usize;
+    let rp = r_previous as usize;
+    let per_k = coarse.len() / (r_level as usize - 1).max(1);
+    for k in 1..r_level {
+        let position = 2 * k;
+        // Positions 2k − 1 … 2k + 1 lie in 1..r_previous: edge samples, never a vertex.
+        let at = |p: u32| chain[previous_start + p as usize - 1];
+        let center = at(position);
+        let mut sum = MipSum::default();
+        sum.add(at(position - 1));
+        sum.add(at(position + 1));
+        for &(face_level, face_edge, reversed) in equal {
+            let p = if reversed { r_previous - position } else { position } as usize;
+            for (i, j) in inside_neighbours(face_edge, p, rp) {
+                sum.add_vec4(face_level.get_vec4(interior_row_start(rp, i) + j - 1));
+            }
+        }
+        for &n in coarse.get((k as usize - 1) * per_k..k as usize * per_k).unwrap_or(&[]) {
+            sum.add(n);
+        }
+        chain[level_start + k as usize - 1] = sum.finish(center);
     }
 }
 
@@ -382,10 +375,12 @@ fn reduce_vertex_level(ctx: &Context, incident: &[u32], v: u32, slot: &mut [Rgba
 }
 
 /// Levels ≥ 1 of vertex `v` (eq. 2.5), every level in one pass over its incident edges:
-/// each edge's resolution, end and chain are looked up once, not once a level. Each level
-/// adds the same neighbours in the same order as [`reduce_vertex_level`], so the same bits.
+/// each edge's resolution and which end `v` is are looked up once, not once a level. Each
+/// level adds the same neighbours in the same order as [`reduce_vertex_level`], so the same
+/// bits.
 fn reduce_vertex_chain(ctx: &Context, incident: &[u32], v: u32, slot: &mut [Rgba], edges: &EdgeReader) {
     const MAX_LEVELS: usize = layout::MAX_LOG2_RESOLUTION as usize + 1;
+    debug_assert!(slot.len() <= MAX_LEVELS, "a vertex chain has at most {MAX_LEVELS} levels");
     let levels = slot.len().min(MAX_LEVELS);
     let mut sums = [MipSum::default(); MAX_LEVELS];
     let topology = ctx.store.topology();
