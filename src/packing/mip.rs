@@ -1,11 +1,15 @@
 //! The MIP filters of the packer (thesis eq. 2.5 / 2.6) that need no layout: the weighted
-//! filter, one face's interior chain, and the vertex → edge incidence.
+//! filter, one face's interior chain, one level of an edge's chain from its neighbours, a
+//! vertex's chain from its edges, and the vertex → edge incidence.
 
 use glam::Vec4;
 
 use crate::colors::format::Rgba;
 use crate::colors::layout::{self, Resolution};
+use crate::colors::store::ColorStore;
 use crate::mesh::topology::Topology;
+use crate::packing::edges::EdgeReader;
+use crate::packing::interiors::FaceLevel;
 
 /// `(C + ½ Σ N) / (1 + n/2)`: the thesis' MIP filter with the weights taken.
 #[inline]
@@ -121,4 +125,105 @@ pub(crate) fn inside_neighbours(face_edge: u8, p: usize, rp: usize) -> [(usize, 
         1 => [(rp - p - 1, p), (rp - p, p - 1)],
         _ => [(1, rp - p), (1, rp - p - 1)],
     }
+}
+
+/// A placeholder face side for the fixed arrays of the packer's edge filters (never read: only the sides counted are passed on).
+pub(crate) const NO_SIDE: (FaceLevel<'static>, u8, bool) = (FaceLevel::Upper(&[]), 0, false);
+
+/// Eq. 2.6 on an edge of resolution `r_edge` at `level` (which has samples), in `chain`:
+/// each sample from the centre, its two neighbours along the edge, for each face of
+/// `equal` (the incident faces of the edge's resolution: their level `level − 1`, face
+/// edge, reversed flag) its two lattice neighbours inside the face, then `coarse` (what the
+/// coarser faces show, two colours per coarse face for each sample in turn).
+pub(crate) fn filter_edge_level(
+    chain: &mut [Rgba],
+    r_edge: Resolution,
+    level: u32,
+    equal: &[(FaceLevel, u8, bool)],
+    coarse: &[Rgba],
+) {
+    let r_level = r_edge.get() >> level;
+    let r_previous = 2 * r_level;
+    let previous_start = layout::edge_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
+    let level_start = layout::edge_level_offset(r_edge, level).unwrap_or(0) as usize;
+    let rp = r_previous as usize;
+    let per_k = coarse.len() / (r_level as usize - 1).max(1);
+    for k in 1..r_level {
+        let position = 2 * k;
+        // Positions 2k − 1 … 2k + 1 lie in 1..r_previous: edge samples, never a vertex.
+        let at = |p: u32| chain[previous_start + p as usize - 1];
+        let center = at(position);
+        let mut sum = MipSum::default();
+        sum.add(at(position - 1));
+        sum.add(at(position + 1));
+        for &(face_level, face_edge, reversed) in equal {
+            let p = if reversed { r_previous - position } else { position } as usize;
+            for (i, j) in inside_neighbours(face_edge, p, rp) {
+                sum.add_vec4(face_level.get_vec4(interior_row_start(rp, i) + j - 1));
+            }
+        }
+        for &n in coarse.get((k as usize - 1) * per_k..k as usize * per_k).unwrap_or(&[]) {
+            sum.add(n);
+        }
+        chain[level_start + k as usize - 1] = sum.finish(center);
+    }
+}
+
+/// Level `level` of vertex `v` (eq. 2.5) from its incident edges' level `level − 1`.
+pub(crate) fn reduce_vertex_level(
+    store: &ColorStore,
+    incident: &[u32],
+    v: u32,
+    slot: &mut [Rgba],
+    level: usize,
+    edges: &EdgeReader,
+) {
+    let previous = level - 1;
+    let mut sum = MipSum::default();
+    for &edge in incident {
+        let log2 = edge_log2(store, edge);
+        if log2 < previous as u32 + 1 {
+            continue; // the edge has no samples at the previous level
+        }
+        let r_previous = 1u32 << (log2 - previous as u32);
+        let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
+        let level_start = layout::edge_level_offset(r_edge, previous as u32).unwrap_or(0) as usize;
+        let position = if v == store.topology().edge_vertices[edge as usize][0] { 1 } else { r_previous - 1 };
+        sum.add(edges.get(edge, level_start + position as usize - 1).unwrap_or([0.0; 4]));
+    }
+    slot[level] = sum.finish(slot[previous]);
+}
+
+/// Levels ≥ 1 of vertex `v` (eq. 2.5), every level in one pass over its incident edges:
+/// each edge's resolution and which end `v` is are looked up once, not once a level. Each
+/// level adds the same neighbours in the same order as [`reduce_vertex_level`], so the same
+/// bits.
+pub(crate) fn reduce_vertex_chain(store: &ColorStore, incident: &[u32], v: u32, slot: &mut [Rgba], edges: &EdgeReader) {
+    const MAX_LEVELS: usize = layout::MAX_LOG2_RESOLUTION as usize + 1;
+    debug_assert!(slot.len() <= MAX_LEVELS, "a vertex chain has at most {MAX_LEVELS} levels");
+    let levels = slot.len().min(MAX_LEVELS);
+    let mut sums = [MipSum::default(); MAX_LEVELS];
+    let topology = store.topology();
+    for &edge in incident {
+        let log2 = edge_log2(store, edge);
+        let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
+        let first = v == topology.edge_vertices[edge as usize][0];
+        // Level `level` reads level `level − 1` of the edge, which has samples while
+        // `level ≤ log2`.
+        for (level, sum) in sums.iter_mut().enumerate().take(levels.min(log2 as usize + 1)).skip(1) {
+            let previous = level as u32 - 1;
+            let r_previous = 1u32 << (log2 - previous);
+            let level_start = layout::edge_level_offset(r_edge, previous).unwrap_or(0) as usize;
+            let position = if first { 1 } else { r_previous - 1 };
+            sum.add(edges.get(edge, level_start + position as usize - 1).unwrap_or([0.0; 4]));
+        }
+    }
+    for level in 1..levels {
+        slot[level] = sums[level].finish(slot[level - 1]);
+    }
+}
+
+/// `log2` of `edge`'s resolution (0 for an edge without samples).
+fn edge_log2(store: &ColorStore, edge: u32) -> u32 {
+    store.edge_resolution(edge).map_or(0, Resolution::log2)
 }

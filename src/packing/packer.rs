@@ -37,9 +37,12 @@ use crate::colors::layout::{self, Resolution};
 use crate::colors::store::{ColorStore, DirtyElements};
 use crate::packing::chains_view::ChainsView;
 use crate::packing::edges::{EdgePrefix, EdgeReader};
-use crate::packing::interiors::{FaceLevel, InteriorPrefix, InteriorReader, dirty_pieces, split_at_bounds};
+use crate::packing::interiors::{InteriorPrefix, InteriorReader, dirty_pieces, split_at_bounds};
 use crate::packing::linear::{FaceRecord, PackedMesh};
-use crate::packing::mip::{MipSum, inside_neighbours, interior_row_start, reduce_interior_chain, vertex_edges};
+use crate::packing::mip::{
+    NO_SIDE, filter_edge_level, inside_neighbours, reduce_interior_chain, reduce_vertex_chain, reduce_vertex_level,
+    vertex_edges,
+};
 use crate::packing::sampler::{self, Filter};
 
 pub use crate::packing::canonical::{PackError, PackLayout};
@@ -283,10 +286,6 @@ fn reduce_edge_level(
     filter_edge_level(chain, r_edge, level, if n <= 2 { &two[..n] } else { &more }, coarse);
 }
 
-/// A placeholder face side for the fixed arrays of [`reduce_edge_level`] and
-/// [`reduce_edge_chain`] (never read: only the sides counted are passed on).
-const NO_SIDE: (FaceLevel<'static>, u8, bool) = (FaceLevel::Upper(&[]), 0, false);
-
 /// Levels ≥ 1 of `edge`'s chain when none of its faces is coarser than the edge: every
 /// level in one go, the edge's resolution and its faces' orientations looked up once
 /// instead of once a level (each level adds the same neighbours in the same order as
@@ -314,92 +313,6 @@ fn reduce_edge_chain(ctx: &Context, edge: u32, chain: &mut [Rgba], interiors: &I
             *slot = (interiors.level(face, face_level_offset), e, reversed);
         }
         filter_edge_level(chain, r_edge, level, &levels[..n], &[]);
-    }
-}
-
-/// Eq. 2.6 on an edge of resolution `r_edge` at `level` (which has samples), in `chain`:
-/// each sample from the centre, its two neighbours along the edge, for each face of
-/// `equal` (the incident faces of the edge's resolution: their level `level − 1`, face
-/// edge, reversed flag) its two lattice neighbours inside the face, then `coarse` (what the
-/// coarser faces show, two colours per coarse face for each sample in turn).
-fn filter_edge_level(
-    chain: &mut [Rgba],
-    r_edge: Resolution,
-    level: u32,
-    equal: &[(FaceLevel, u8, bool)],
-    coarse: &[Rgba],
-) {
-    let r_level = r_edge.get() >> level;
-    let r_previous = 2 * r_level;
-    let previous_start = layout::edge_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
-    let level_start = layout::edge_level_offset(r_edge, level).unwrap_or(0) as usize;
-    let rp = r_previous as usize;
-    let per_k = coarse.len() / (r_level as usize - 1).max(1);
-    for k in 1..r_level {
-        let position = 2 * k;
-        // Positions 2k − 1 … 2k + 1 lie in 1..r_previous: edge samples, never a vertex.
-        let at = |p: u32| chain[previous_start + p as usize - 1];
-        let center = at(position);
-        let mut sum = MipSum::default();
-        sum.add(at(position - 1));
-        sum.add(at(position + 1));
-        for &(face_level, face_edge, reversed) in equal {
-            let p = if reversed { r_previous - position } else { position } as usize;
-            for (i, j) in inside_neighbours(face_edge, p, rp) {
-                sum.add_vec4(face_level.get_vec4(interior_row_start(rp, i) + j - 1));
-            }
-        }
-        for &n in coarse.get((k as usize - 1) * per_k..k as usize * per_k).unwrap_or(&[]) {
-            sum.add(n);
-        }
-        chain[level_start + k as usize - 1] = sum.finish(center);
-    }
-}
-
-/// Level `level` of vertex `v` (eq. 2.5) from its incident edges' level `level − 1`.
-fn reduce_vertex_level(ctx: &Context, incident: &[u32], v: u32, slot: &mut [Rgba], level: usize, edges: &EdgeReader) {
-    let previous = level - 1;
-    let mut sum = MipSum::default();
-    for &edge in incident {
-        let log2 = ctx.edge_log2(edge);
-        if log2 < previous as u32 + 1 {
-            continue; // the edge has no samples at the previous level
-        }
-        let r_previous = 1u32 << (log2 - previous as u32);
-        let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
-        let level_start = layout::edge_level_offset(r_edge, previous as u32).unwrap_or(0) as usize;
-        let position = if v == ctx.store.topology().edge_vertices[edge as usize][0] { 1 } else { r_previous - 1 };
-        sum.add(edges.get(edge, level_start + position as usize - 1).unwrap_or([0.0; 4]));
-    }
-    slot[level] = sum.finish(slot[previous]);
-}
-
-/// Levels ≥ 1 of vertex `v` (eq. 2.5), every level in one pass over its incident edges:
-/// each edge's resolution and which end `v` is are looked up once, not once a level. Each
-/// level adds the same neighbours in the same order as [`reduce_vertex_level`], so the same
-/// bits.
-fn reduce_vertex_chain(ctx: &Context, incident: &[u32], v: u32, slot: &mut [Rgba], edges: &EdgeReader) {
-    const MAX_LEVELS: usize = layout::MAX_LOG2_RESOLUTION as usize + 1;
-    debug_assert!(slot.len() <= MAX_LEVELS, "a vertex chain has at most {MAX_LEVELS} levels");
-    let levels = slot.len().min(MAX_LEVELS);
-    let mut sums = [MipSum::default(); MAX_LEVELS];
-    let topology = ctx.store.topology();
-    for &edge in incident {
-        let log2 = ctx.edge_log2(edge);
-        let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
-        let first = v == topology.edge_vertices[edge as usize][0];
-        // Level `level` reads level `level − 1` of the edge, which has samples while
-        // `level ≤ log2`.
-        for (level, sum) in sums.iter_mut().enumerate().take(levels.min(log2 as usize + 1)).skip(1) {
-            let previous = level as u32 - 1;
-            let r_previous = 1u32 << (log2 - previous);
-            let level_start = layout::edge_level_offset(r_edge, previous).unwrap_or(0) as usize;
-            let position = if first { 1 } else { r_previous - 1 };
-            sum.add(edges.get(edge, level_start + position as usize - 1).unwrap_or([0.0; 4]));
-        }
-    }
-    for level in 1..levels {
-        slot[level] = sums[level].finish(slot[level - 1]);
     }
 }
 
@@ -467,7 +380,7 @@ fn build_all(
             .for_each(|(v, (slot, out))| {
                 ctx.vertex_level0(v as u32, slot, out);
                 if simple[v] && levels > 1 {
-                    reduce_vertex_chain(ctx, incident(v), v as u32, slot, &edges);
+                    reduce_vertex_chain(ctx.store, incident(v), v as u32, slot, &edges);
                     ctx.format.encode_slice(&slot[1..], &mut out[size..]);
                 }
             });
@@ -508,7 +421,7 @@ fn build_all(
         let edges = ctx.edge_reader(edge_bytes, edge_upper);
         vertex_colors.par_chunks_mut(levels).enumerate().with_min_len(BLOCK).for_each(|(v, slot)| {
             if !simple[v] {
-                reduce_vertex_level(ctx, incident(v), v as u32, slot, level, &edges);
+                reduce_vertex_level(ctx.store, incident(v), v as u32, slot, level, &edges);
             }
         });
     }
@@ -805,7 +718,7 @@ impl PackCache {
             for &v in &vertices {
                 let at = v as usize * levels;
                 let list = &incident[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
-                reduce_vertex_level(&ctx, list, v, &mut vertex_colors[at..at + levels], level, &reader);
+                reduce_vertex_level(store, list, v, &mut vertex_colors[at..at + levels], level, &reader);
             }
         }
         // Encode what changed; report it as ranges.
