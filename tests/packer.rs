@@ -70,6 +70,44 @@ fn rgba16f_decoding_equals_half_on_every_bit_pattern() {
     }
 }
 
+/// RGBA16F encoding (F16C where the CPU has it) against the rounding rule itself, not
+/// another converter: every channel's half is a nearest half to the clamped value (checked
+/// in `f64` against the halves on either side) and on a tie the even one. Inputs: every
+/// 997th f32 bit pattern up to 65,504, every midpoint between neighbouring halves and the
+/// f32 on either side of it, in every channel position of an odd-length slice (the vector
+/// path's scalar tail runs too); the decoded copy is the half's value.
+#[test]
+fn rgba16f_encoding_rounds_to_the_nearest_half_ties_to_even() {
+    use half::f16;
+    let top = 65504.0f32.to_bits();
+    let mut values: Vec<f32> = (0..=top).step_by(997).map(f32::from_bits).collect();
+    for h in 0..0x7bffu16 {
+        let mid = ((f16::from_bits(h).to_f64() + f16::from_bits(h + 1).to_f64()) / 2.0) as f32;
+        values.extend([mid.next_down(), mid, mid.next_up()]);
+    }
+    let colors: Vec<Rgba> =
+        (0..values.len() | 1).map(|i| std::array::from_fn(|c| values[(i + c) % values.len()])).collect();
+    let mut bytes = vec![0u8; colors.len() * 8];
+    let mut decoded = vec![[0.0f32; 4]; colors.len()];
+    ColorFormat::Rgba16F.encode_quantized_slice(&colors, &mut bytes, &mut decoded);
+    let value = |h: u16| f16::from_bits(h).to_f64();
+    for (i, color) in colors.iter().enumerate() {
+        for c in 0..4 {
+            let x = f64::from(color[c].min(if c == 3 { 1.0 } else { 65504.0 }));
+            let h = u16::from_le_bytes([bytes[8 * i + 2 * c], bytes[8 * i + 2 * c + 1]]);
+            let error = (x - value(h)).abs();
+            for neighbour in [h.checked_sub(1), h.checked_add(1)].into_iter().flatten() {
+                let other = (x - value(neighbour)).abs();
+                assert!(
+                    error < other || (error == other && h.is_multiple_of(2)),
+                    "{x} → {h:#06x}, {neighbour:#06x} is nearer or even"
+                );
+            }
+            assert_eq!(decoded[i][c].to_bits(), f16::from_bits(h).to_f32().to_bits(), "decoded {h:#06x}");
+        }
+    }
+}
+
 /// Every format's slice encoders against one channel at a time, on the extremes: NaN,
 /// infinities, negatives, subnormals of f32 and of f16, the f16 rounding boundary at the top
 /// (65 519.996 rounds down, 65 520 would round to infinity), values past 1 in alpha, and runs

@@ -305,10 +305,22 @@ pub fn f16_bits_to_f32(h: u16) -> f32 {
 }
 
 /// Encodes `colors` (clamped) as RGBA16F into `out` (8 bytes each) and, when given, writes
-/// what decoding gives to `quantized` (all three the same length): runs of samples through
-/// `half`'s slice conversions (F16C, eight channels an instruction, where the CPU has it;
-/// the same rounding as [`f16::from_f32`] either way).
-fn encode_f16_runs(colors: &[Rgba], out: &mut [u8], mut quantized: Option<&mut [Rgba]>) {
+/// what decoding gives to `quantized` (all three the same length). Where the CPU has F16C,
+/// two samples an instruction straight from the colours to the bytes
+/// ([`f16c::encode`]); elsewhere runs of samples through `half`'s slice conversions. The
+/// rounding is IEEE round-to-nearest-even either way, [`f16::from_f32`]'s.
+fn encode_f16_runs(colors: &[Rgba], out: &mut [u8], quantized: Option<&mut [Rgba]>) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("f16c") && std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: the CPU has F16C and AVX (checked above).
+        unsafe { f16c::encode(colors, out, quantized) };
+        return;
+    }
+    encode_f16_portable(colors, out, quantized);
+}
+
+/// [`encode_f16_runs`] through `half`'s slice conversions.
+fn encode_f16_portable(colors: &[Rgba], out: &mut [u8], mut quantized: Option<&mut [Rgba]>) {
     use half::slice::HalfFloatSliceExt;
     const RUN: usize = 32;
     let mut clamped = [0.0f32; RUN * 4];
@@ -329,6 +341,45 @@ fn encode_f16_runs(colors: &[Rgba], out: &mut [u8], mut quantized: Option<&mut [
             for (slot, value) in slots.zip(decoded.chunks_exact(4)) {
                 *slot = [value[0], value[1], value[2], value[3]];
             }
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod f16c {
+    use std::arch::x86_64::*;
+
+    use super::{MAX_CHANNEL, Rgba, encode_f16_portable};
+
+    /// Two samples (eight channels) a step: clamped as [`super::clamp_color`] does (NaN and
+    /// every zero or negative to +0: `max` returns its second operand for NaN and for two
+    /// zeros), converted with `vcvtps2ph` (round to nearest even), stored; the decoded copy
+    /// converted back with `vcvtph2ps`. An odd last sample goes through the portable path.
+    ///
+    /// # Safety
+    /// The CPU must have F16C and AVX.
+    #[target_feature(enable = "avx,f16c")]
+    pub(super) unsafe fn encode(colors: &[Rgba], out: &mut [u8], mut quantized: Option<&mut [Rgba]>) {
+        let n = colors.len().min(out.len() / 8).min(quantized.as_ref().map_or(usize::MAX, |q| q.len()));
+        let pairs = n / 2;
+        let zero = _mm256_setzero_ps();
+        let max =
+            _mm256_setr_ps(MAX_CHANNEL, MAX_CHANNEL, MAX_CHANNEL, 1.0, MAX_CHANNEL, MAX_CHANNEL, MAX_CHANNEL, 1.0);
+        let src = colors.as_ptr().cast::<f32>();
+        let dst = out.as_mut_ptr();
+        let decoded = quantized.as_deref_mut().map(|q| q.as_mut_ptr().cast::<f32>());
+        for p in 0..pairs {
+            // SAFETY: samples 2p and 2p + 1 are below `n`, within all three slices.
+            let x = unsafe { _mm256_loadu_ps(src.add(8 * p)) };
+            let halves = _mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(_mm256_min_ps(_mm256_max_ps(x, zero), max));
+            unsafe { _mm_storeu_si128(dst.add(16 * p).cast(), halves) };
+            if let Some(decoded) = decoded {
+                unsafe { _mm256_storeu_ps(decoded.add(8 * p), _mm256_cvtph_ps(halves)) };
+            }
+        }
+        let done = 2 * pairs;
+        if n > done {
+            encode_f16_portable(&colors[done..n], &mut out[8 * done..8 * n], quantized.map(|q| &mut q[done..n]));
         }
     }
 }
