@@ -127,7 +127,8 @@ pub(crate) fn inside_neighbours(face_edge: u8, p: usize, rp: usize) -> [(usize, 
     }
 }
 
-/// A placeholder face side for the fixed arrays of the packer's edge filters (never read: only the sides counted are passed on).
+/// A placeholder face side for the fixed arrays of the packer's edge filters (never read:
+/// only the sides counted are passed on).
 pub(crate) const NO_SIDE: (FaceLevel<'static>, u8, bool) = (FaceLevel::Upper(&[]), 0, false);
 
 /// Eq. 2.6 on an edge of resolution `r_edge` at `level` (which has samples), in `chain`:
@@ -224,6 +225,6 @@ pub(crate) fn reduce_vertex_chain(store: &ColorStore, incident: &[u32], v: u32, 
 }
 
 /// `log2` of `edge`'s resolution (0 for an edge without samples).
-fn edge_log2(store: &ColorStore, edge: u32) -> u32 {
+pub(crate) fn edge_log2(store: &ColorStore, edge: u32) -> u32 {
     store.edge_resolution(edge).map_or(0, Resolution::log2)
 }

@@ -40,8 +40,8 @@ use crate::packing::edges::{EdgePrefix, EdgeReader};
 use crate::packing::interiors::{InteriorPrefix, InteriorReader, dirty_pieces, split_at_bounds};
 use crate::packing::linear::{FaceRecord, PackedMesh};
 use crate::packing::mip::{
-    NO_SIDE, filter_edge_level, inside_neighbours, reduce_interior_chain, reduce_vertex_chain, reduce_vertex_level,
-    vertex_edges,
+    NO_SIDE, edge_log2, filter_edge_level, inside_neighbours, reduce_interior_chain, reduce_vertex_chain,
+    reduce_vertex_level, vertex_edges,
 };
 use crate::packing::sampler::{self, Filter};
 
@@ -99,7 +99,7 @@ impl Context<'_> {
     }
 
     fn edge_log2(&self, edge: u32) -> u32 {
-        self.store.edge_resolution(edge).map_or(0, Resolution::log2)
+        edge_log2(self.store, edge)
     }
 
     /// Whether `edge` has an incident face coarser than itself.
