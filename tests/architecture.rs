@@ -12,7 +12,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-const CORE: [&str; 8] = ["mesh", "colors", "packing", "paint", "io", "camera", "atomic_write", "memory"];
+const CORE: [&str; 9] = ["mesh", "colors", "packing", "paint", "io", "camera", "atomic_write", "memory", "threads"];
 const MAX_FILE_LINES: usize = 800;
 const MAX_FN_LINES: usize = 100;
 

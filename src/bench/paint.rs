@@ -166,7 +166,7 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
         "bench": "paint",
         "triangles": document.store.topology().face_count(),
         "samples": document.store.sample_count(),
-        "threads": rayon::current_num_threads(),
+        "threads": rayon::current_num_threads(), "caller_in_pool": crate::threads::caller_in_pool(),
         "viewport_px": options.viewport_px,
         "headline": headline,
         "occlusion_depth_map": {

@@ -265,6 +265,7 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
                 "triangles": document.store.topology().face_count(),
                 "resolution": resolution.resolution,
                 "threads": meshpaint::packing::packer::pack_threads(),
+                "caller_in_pool": meshpaint::threads::caller_in_pool(),
                 "results": results,
             });
             println!("{report}");
