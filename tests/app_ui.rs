@@ -549,6 +549,30 @@ fn resolution_brush_and_set_r_for_all_change_face_resolutions() {
     assert_eq!(resolutions(harness.state()).iter().filter(|r| r.get() == 16).count(), raised);
 }
 
+/// Leaving paint mode after a resolution stroke lays the packing out anew (moving the
+/// chains the stroke did not reach): the buffers the view draws are a full pack's.
+#[test]
+fn leaving_paint_mode_after_a_resolution_stroke_gives_the_full_pack() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    harness.get_by_label("Resolution").click();
+    harness.run_steps(2);
+    let center = harness.state().viewport.rect.center();
+    left_drag(&mut harness, center - egui::vec2(30.0, 0.0), center + egui::vec2(30.0, 0.0));
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.run_steps(2);
+    assert!(harness.state().status.text.contains("Repacked"), "{:?}", harness.state().status);
+    let open = harness.state().document.as_ref().unwrap();
+    let store = &open.document.store;
+    assert!(store.face_resolutions().iter().any(|r| r.get() == 16), "the stroke raised no face");
+    let full = meshpaint::packing::pack(store, &open.document.positions, open.format).unwrap();
+    assert!(*open.pack_cache.as_ref().unwrap().packed() == full, "the repacked buffers differ from a full pack");
+}
+
 /// The Optimize button (E = 0): fewer samples, every shown colour kept (CPU reference
 /// sampler at random points), the memory in the status line, one undo step back.
 #[test]

@@ -54,6 +54,14 @@ fn bench_pack_reports_threads_formats_and_the_incremental_repack() {
         assert!(incremental["samples_changed"].as_u64().unwrap() >= 2000);
         assert!(incremental["samples_rewritten"].as_u64().unwrap() > 0);
         assert!(incremental["repack"]["best_seconds"].as_f64().unwrap() > 0.0);
+        // Leaving paint mode after a resolution stroke: the relayout, equal to a full pack.
+        let relayout = &result["relayout_after_resolution_stroke"];
+        assert_eq!(relayout["equal_to_full_pack"], true, "{relayout}");
+        assert!(relayout["faces_resized"].as_u64().unwrap() > 0, "{relayout}");
+        assert!(relayout["samples_added"].as_u64().unwrap() >= 2000, "{relayout}");
+        for key in ["relayout", "rebuild", "memcpy"] {
+            assert!(relayout[key]["best_seconds"].as_f64().unwrap() > 0.0, "{key}");
+        }
     }
 }
 

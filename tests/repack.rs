@@ -173,6 +173,59 @@ fn a_resolution_change_asks_for_a_full_repack_and_that_matches_the_reference() {
 }
 
 #[test]
+fn a_relayout_after_resolution_changes_equals_the_reference_packer() {
+    // What leaving paint mode runs after a resolution stroke: several edits accumulated
+    // (resolutions up and down, past the largest and below it, strokes between), then the
+    // relayout that copies every chain no edit reached. The serial reference packer is the
+    // truth; an incremental update after it checks the state it keeps.
+    for (name, positions, store) in cases() {
+        for format in ColorFormat::ALL {
+            let mut store = store.clone();
+            let mut rng = Rng(31 + format.code() as u64);
+            let mut cache = PackCache::build(&store, &positions, format).unwrap();
+            let faces = u64::from(store.topology().face_count());
+            for round in 0..5 {
+                let mut accumulated = DirtyAccumulator::new(store.topology());
+                for _ in 0..2 {
+                    let center = (rng.next() % faces) as u32;
+                    for n in 0..1 + rng.next() % 3 {
+                        let face = ((u64::from(center) + n * 5) % faces) as u32;
+                        let old = store.face_resolution(face).unwrap();
+                        let new = match rng.next() % 3 {
+                            0 if old.log2() > 0 => old.halved().unwrap(),
+                            1 => r(64),
+                            _ => old.doubled().unwrap_or(old),
+                        };
+                        store.set_face_resolution(face, new).unwrap();
+                    }
+                    accumulated.add(&store.take_dirty());
+                    stroke(&mut store, &mut rng);
+                    accumulated.add(&store.take_dirty());
+                }
+                if round % 2 == 1 {
+                    // Every face at the largest resolution halved: fewer vertex levels.
+                    let largest = store.face_resolutions().iter().copied().max().unwrap();
+                    for face in 0..faces as u32 {
+                        if store.face_resolution(face) == Some(largest) && largest.log2() > 0 {
+                            store.set_face_resolution(face, largest.halved().unwrap()).unwrap();
+                        }
+                    }
+                    accumulated.add(&store.take_dirty());
+                }
+                cache = cache.relayout(&store, &positions, &accumulated.take()).unwrap();
+                let reference = pack_reference(&store, &positions, format).unwrap();
+                assert!(cache.packed().colors == reference.colors, "{name} {format:?} round {round}: bytes differ");
+                assert_eq!(*cache.packed(), reference, "{name} {format:?} round {round}");
+                stroke(&mut store, &mut rng);
+                cache.update(&store, &store.clone().take_dirty()).expect("no resolution changed");
+                store.take_dirty();
+                assert!(*cache.packed() == pack_reference(&store, &positions, format).unwrap(), "{name} {round}");
+            }
+        }
+    }
+}
+
+#[test]
 fn a_repack_into_reused_buffers_equals_the_reference_packer_whatever_they_held() {
     // Every case into the buffers of every case (smaller and larger, other formats, other
     // random colours): a sample the pack did not rewrite would keep the old colour.

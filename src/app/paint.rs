@@ -124,14 +124,15 @@ impl Editor {
             job.progress(0.1, "packing colours with MIP chains");
             let started = Instant::now();
             let dirty = dirty.take();
-            // Only the chains the session changed when no resolution changed; else all, into
-            // the old packing's buffers when there is one.
+            // Only the chains the session changed when no resolution changed; else a new
+            // layout in the old packing's buffers, with the chains no edit reached moved
+            // into it; all of them when the format changed.
             let failed = |error: crate::packing::PackError| format!("repacking failed: {error}");
             let (store, positions) = (&document.store, &document.positions);
             let (cache, ranges) = match cache {
                 Some(mut cache) if cache.packed().format == format => match cache.update(store, &dirty) {
                     Some(ranges) => (cache, Some(ranges)),
-                    None => (cache.rebuild(store, positions, format).map_err(failed)?, None),
+                    None => (cache.relayout(store, positions, &dirty).map_err(failed)?, None),
                 },
                 Some(cache) => (cache.rebuild(store, positions, format).map_err(failed)?, None),
                 None => (PackCache::build(store, positions, format).map_err(failed)?, None),

@@ -31,8 +31,10 @@ impl Timing {
         let mut last;
         loop {
             let start = Instant::now();
-            last = run();
+            let result = run();
             times.push(start.elapsed());
+            // The previous result is dropped here, untimed.
+            last = result;
             if times.len() >= runs.max(1) {
                 break;
             }
@@ -44,6 +46,33 @@ impl Timing {
             runs: times.len(),
         };
         (timing, last)
+    }
+
+    /// Times `run` on what `prepare` makes, `runs` times (at least once); `prepare` is not
+    /// timed.
+    pub fn measure_prepared<I, T>(
+        runs: usize,
+        mut prepare: impl FnMut() -> I,
+        mut run: impl FnMut(I) -> T,
+    ) -> (Timing, T) {
+        let mut best = Timing { best_seconds: f64::INFINITY, median_seconds: 0.0, runs: 0 };
+        let mut times = Vec::new();
+        let mut last;
+        loop {
+            let input = prepare();
+            let start = Instant::now();
+            let result = run(input);
+            times.push(start.elapsed().as_secs_f64());
+            last = result;
+            if times.len() >= runs.max(1) {
+                break;
+            }
+        }
+        times.sort_by(f64::total_cmp);
+        best.best_seconds = times[0];
+        best.median_seconds = times[times.len() / 2];
+        best.runs = times.len();
+        (best, last)
     }
 
     /// As a JSON object.
@@ -237,21 +266,9 @@ pub fn bench_incremental(
     let positions = &document.positions;
     let topology = store.topology().clone();
     let mut cache = crate::packing::packer::PackCache::build(&store, positions, format)?;
-    let centroid = |f: usize| {
-        let [a, b, c] = topology.face_vertices[f].map(|v| positions[v as usize]);
-        std::array::from_fn::<f32, 3, _>(|k| (a[k] + b[k] + c[k]) / 3.0)
-    };
-    let middle = centroid(topology.face_vertices.len() / 2);
-    let mut order: Vec<(f32, u32)> = (0..topology.face_vertices.len())
-        .map(|f| {
-            let p = centroid(f);
-            ((0..3).map(|k| (p[k] - middle[k]).powi(2)).sum(), f as u32)
-        })
-        .collect();
-    order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
     let (mut samples_changed, mut faces_painted) = (0u64, 0u64);
     let color = [0.8, 0.1, 0.3, 1.0];
-    for &(_, face) in &order {
+    for face in faces_around_the_middle(document) {
         if samples_changed >= target_samples {
             break;
         }
@@ -280,5 +297,101 @@ pub fn bench_incremental(
         repack,
         full,
         equal_to_full_pack: packed? == *cache.packed(),
+    })
+}
+
+/// Every face, nearest to the middle face's centroid first (where the bench's strokes go).
+fn faces_around_the_middle(document: &Document) -> Vec<u32> {
+    let (positions, topology) = (&document.positions, document.store.topology());
+    let centroid = |f: usize| {
+        let [a, b, c] = topology.face_vertices[f].map(|v| positions[v as usize]);
+        std::array::from_fn::<f32, 3, _>(|k| (a[k] + b[k] + c[k]) / 3.0)
+    };
+    let middle = centroid(topology.face_vertices.len() / 2);
+    let mut order: Vec<(f32, u32)> = (0..topology.face_vertices.len())
+        .map(|f| {
+            let p = centroid(f);
+            ((0..3).map(|k| (p[k] - middle[k]).powi(2)).sum(), f as u32)
+        })
+        .collect();
+    order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    order.into_iter().map(|(_, face)| face).collect()
+}
+
+/// Result of the relayout benchmark: a resolution stroke (faces raised to twice their
+/// resolution), then leaving paint mode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RelayoutBench {
+    /// Faces whose resolution the stroke doubled.
+    pub faces_resized: u64,
+    /// Level-0 samples the stroke added.
+    pub samples_added: u64,
+    /// The relayout (what leaving paint mode runs after a resolution change).
+    pub relayout: Timing,
+    /// The full repack into the previous pack's buffers (what it ran before), same run.
+    pub rebuild: Timing,
+    /// `memcpy` of the new colour buffer's bytes, same run.
+    pub memcpy: Timing,
+    /// Whether the relayout is byte-equal to a full pack of the same store.
+    pub equal_to_full_pack: bool,
+}
+
+impl RelayoutBench {
+    /// As a JSON object.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "faces_resized": self.faces_resized,
+            "samples_added": self.samples_added,
+            "relayout": self.relayout.to_json(),
+            "rebuild": self.rebuild.to_json(),
+            "memcpy": self.memcpy.to_json(),
+            "ratio_to_memcpy": self.relayout.best_seconds / self.memcpy.best_seconds.max(1e-12),
+            "speedup_over_rebuild": self.rebuild.best_seconds / self.relayout.best_seconds.max(1e-12),
+            "equal_to_full_pack": self.equal_to_full_pack,
+        })
+    }
+}
+
+/// Doubles the resolution of the faces nearest to the middle face's centroid until about
+/// `target_samples` level-0 samples were added (a stroke of the resolution brush), then
+/// times the relayout that leaving paint mode runs, against the full repack into the old
+/// buffers it replaces and a `memcpy` of the output.
+pub fn bench_relayout(
+    document: &Document,
+    format: ColorFormat,
+    runs: usize,
+    target_samples: u64,
+) -> Result<RelayoutBench, PackError> {
+    let mut store = document.store.clone();
+    let positions = &document.positions;
+    let cache = PackCache::build(&store, positions, format)?;
+    let before = store.sample_count();
+    let mut faces_resized = 0u64;
+    for face in faces_around_the_middle(document) {
+        if store.sample_count() - before >= target_samples {
+            break;
+        }
+        let raised = store.face_resolution(face).and_then(|r| r.doubled());
+        if raised.is_some_and(|r| store.set_face_resolution(face, r).is_ok()) {
+            faces_resized += 1;
+        }
+    }
+    let samples_added = store.sample_count() - before;
+    let dirty = store.take_dirty();
+    let (relayout, relaid) =
+        Timing::measure_prepared(runs, || cache.clone(), |old| old.relayout(&store, positions, &dirty));
+    let (rebuild, _) = Timing::measure_prepared(runs, || cache.clone(), |old| old.rebuild(&store, positions, format));
+    let relaid = relaid?;
+    let source = relaid.packed().colors.clone();
+    let mut target = vec![0u8; source.len()];
+    let (memcpy, ()) = Timing::measure(runs.max(5), || target.copy_from_slice(&source));
+    let full = crate::packing::packer::pack(&store, positions, format)?;
+    Ok(RelayoutBench {
+        faces_resized,
+        samples_added,
+        relayout,
+        rebuild,
+        memcpy,
+        equal_to_full_pack: full == *relaid.packed(),
     })
 }

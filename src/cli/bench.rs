@@ -256,6 +256,8 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
                 let incremental =
                     meshpaint::bench::pack::bench_incremental(&document, format, runs.max(3), stroke_samples)?;
                 value["incremental_after_stroke"] = incremental.to_json();
+                let relayout = meshpaint::bench::pack::bench_relayout(&document, format, runs.max(3), stroke_samples)?;
+                value["relayout_after_resolution_stroke"] = relayout.to_json();
                 results.push(value);
             }
             let report = serde_json::json!({

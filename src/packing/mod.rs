@@ -6,7 +6,7 @@
 //! |---|---|
 //! | [`linear`] | the linear GPU layout: 16-byte face records, colour buffer with MIP chains |
 //! | [`canonical`] | the canonical layout: where each element's chain starts, each face's record |
-//! | [`packer`] | store → linear (MIP chains, eq. 2.5/2.6) and linear → store |
+//! | [`packer`] | store → linear (MIP chains, eq. 2.5/2.6): the full pack; `packer/update.rs` the repacks from an earlier pack (only the chains an edit reaches; a new layout after resolution changes, chains no edit reached moved in place) |
 //! | [`paint_layout`] | paint mode: level 0 in blocks with slack; dirty ranges and patched records |
 //! | [`lod`] | the level of detail of trilinear filtering, continuous over the mesh (per-vertex density and normal) |
 //! | [`reference`] | the straightforward serial packer the fast and incremental ones are tested against byte for byte |

@@ -32,12 +32,14 @@
 
 use rayon::prelude::*;
 
+mod update;
+
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::{self, Resolution};
-use crate::colors::store::{ColorStore, DirtyElements};
+use crate::colors::store::ColorStore;
 use crate::packing::chains_view::ChainsView;
 use crate::packing::edges::{EdgePrefix, EdgeReader};
-use crate::packing::interiors::{InteriorPrefix, InteriorReader, dirty_pieces, split_at_bounds};
+use crate::packing::interiors::{InteriorPrefix, InteriorReader, split_at_bounds};
 use crate::packing::linear::{FaceRecord, PackedMesh};
 use crate::packing::mip::{
     NO_SIDE, edge_log2, filter_edge_level, inside_neighbours, reduce_interior_chain, reduce_vertex_chain,
@@ -90,6 +92,34 @@ struct Context<'a> {
     format: ColorFormat,
     prefix: &'a InteriorPrefix,
     edges: &'a EdgePrefix,
+    /// The chains a relayout has in place already (`None`: compute every chain).
+    kept: Option<&'a Kept>,
+}
+
+/// The chains a relayout ([`PackCache::relayout`]) has already moved to their places in the
+/// new layout: per face and per edge, whether its chain is the old one, because nothing it
+/// reads changed (its samples and resolution; for an edge also its faces' interiors, and no
+/// face coarser than the edge, whose contribution reads vertices).
+struct Kept {
+    faces: Vec<bool>,
+    edges: Vec<bool>,
+    /// Vertices whose whole chain is in place (its colour and every incident edge kept,
+    /// and as many vertex levels as before).
+    vertices: Vec<bool>,
+}
+
+impl Kept {
+    fn vertex(&self, v: u32) -> bool {
+        self.vertices.get(v as usize).copied().unwrap_or(false)
+    }
+
+    fn face(&self, face: u32) -> bool {
+        self.faces.get(face as usize).copied().unwrap_or(false)
+    }
+
+    fn edge(&self, edge: u32) -> bool {
+        self.edges.get(edge as usize).copied().unwrap_or(false)
+    }
 }
 
 impl Context<'_> {
@@ -152,6 +182,9 @@ impl Context<'_> {
         let topology = self.store.topology();
         let size = self.format.bytes_per_sample();
         for_each_chain((bytes, upper), size, (&self.edges.chain, &self.edges.upper), |e, scratch, bytes, upper| {
+            if !coarse[e] && self.kept.is_some_and(|kept| kept.edge(e as u32)) {
+                return;
+            }
             for &(face, _) in topology.faces_of_edge((e as u32).saturating_add(PREFETCH_AHEAD)) {
                 interiors.prefetch(face);
             }
@@ -162,6 +195,9 @@ impl Context<'_> {
     /// Builds `face`'s whole interior chain in `scratch` and writes its encoding to `bytes`
     /// (level 0 encoded once) and its levels ≥ 1 to `upper`.
     fn interior_chain(&self, face: u32, scratch: &mut Vec<Rgba>, upper: &mut [Rgba], bytes: &mut [u8]) {
+        if self.kept.is_some_and(|kept| kept.face(face)) {
+            return;
+        }
         let size = self.format.bytes_per_sample();
         let level0 = self.store.interior_samples(face);
         let r = self.store.face_resolution(face).unwrap_or(Resolution::ONE);
@@ -378,6 +414,9 @@ fn build_all(
             .enumerate()
             .with_min_len(BLOCK)
             .for_each(|(v, (slot, out))| {
+                if ctx.kept.is_some_and(|kept| kept.vertex(v as u32)) {
+                    return;
+                }
                 ctx.vertex_level0(v as u32, slot, out);
                 if simple[v] && levels > 1 {
                     reduce_vertex_chain(ctx.store, incident(v), v as u32, slot, &edges);
@@ -460,6 +499,29 @@ pub struct PackCache {
     packed: PackedMesh,
 }
 
+/// What a full pack lays out before it writes: the canonical layout, the edge and interior
+/// prefixes, the vertex → edge incidence and, for a relayout, the chains already in place.
+struct Plan {
+    layout: PackLayout,
+    edges: EdgePrefix,
+    prefix: InteriorPrefix,
+    vertex_edge: (Vec<u32>, Vec<u32>),
+    kept: Option<Kept>,
+}
+
+impl Plan {
+    /// The plan of a pack of `store` from scratch.
+    fn of(store: &ColorStore) -> Result<Self, PackError> {
+        Ok(Plan {
+            layout: PackLayout::of(store)?,
+            edges: EdgePrefix::of(store),
+            prefix: InteriorPrefix::of(store),
+            vertex_edge: vertex_edges(store.topology()),
+            kept: None,
+        })
+    }
+}
+
 /// The buffers of an earlier pack, reused by [`PackCache::rebuild`] (empty for a first pack).
 #[derive(Default)]
 struct Buffers {
@@ -491,7 +553,7 @@ pub type SampleRanges = Vec<(u64, u64)>;
 impl PackCache {
     /// Packs `store` (a full pack) and keeps what an incremental repack needs.
     pub fn build(store: &ColorStore, positions: &[[f32; 3]], format: ColorFormat) -> Result<Self, PackError> {
-        Self::build_into(store, positions, format, Buffers::default())
+        Self::build_into(store, positions, format, Buffers::default(), None)
     }
 
     /// A full pack of `store` into this cache's buffers (what leaving paint mode runs when
@@ -507,6 +569,7 @@ impl PackCache {
             positions,
             format,
             Buffers { chains, upper, colors, records: face_records, positions: old_positions, indices },
+            None,
         )
     }
 
@@ -516,13 +579,17 @@ impl PackCache {
         positions: &[[f32; 3]],
         format: ColorFormat,
         buffers: Buffers,
+        plan: Option<Plan>,
     ) -> Result<Self, PackError> {
         let topology = store.topology();
         if positions.len() != topology.vertex_count as usize {
             return Err(PackError::PositionCount { positions: positions.len(), vertices: topology.vertex_count });
         }
-        let layout = PackLayout::of(store)?;
-        let edges = EdgePrefix::of(store);
+        let Plan { layout, edges, prefix, vertex_edge, kept } = match plan {
+            Some(plan) => plan,
+            None => Plan::of(store)?,
+        };
+        let kept = kept.as_ref();
         let sections = Sections::of(store, &layout, &edges);
         let Buffers { chains, upper, colors, mut records, positions: mut position_copy, mut indices } = buffers;
         records.clear();
@@ -530,15 +597,21 @@ impl PackCache {
             (0..topology.face_count()).into_par_iter().with_min_len(BLOCK).map(|f| layout.face_record(store, f)),
         );
         let size = format.bytes_per_sample();
-        let prefix = InteriorPrefix::of(store);
         // Every sample of these three is written by `build_all`: stale contents never show.
         let mut chains = reuse(chains, sections.vertex_end + edges.upper_len());
         let mut upper = reuse(upper, prefix.upper_len());
         let mut colors = reuse(colors, sections.total * size);
-        let vertex_edge = vertex_edges(topology);
         {
-            let ctx =
-                Context { store, layout: &layout, records: &records, sections, format, prefix: &prefix, edges: &edges };
+            let ctx = Context {
+                store,
+                layout: &layout,
+                records: &records,
+                sections,
+                format,
+                prefix: &prefix,
+                edges: &edges,
+                kept,
+            };
             build_all(&ctx, &mut chains, &mut upper, &mut colors, &vertex_edge);
         }
         position_copy.clear();
@@ -564,196 +637,6 @@ impl PackCache {
     /// The packed mesh, dropping the rest.
     pub fn into_packed(self) -> PackedMesh {
         self.packed
-    }
-
-    /// Brings the packed mesh up to date with the edits in `dirty` (everything changed in
-    /// `store` since this cache was built or last updated): level 0 of the dirty elements,
-    /// the interior chains of dirty faces and, level by level, the edge and vertex chains
-    /// whose inputs changed. Gives exactly the bytes of a full pack of `store`. Returns the
-    /// rewritten sample ranges, or `None` when the layout no longer fits (a resolution
-    /// changed, or the store is not the one packed): then build a new cache.
-    /// Long: one level loop over the growing sets of edges and vertices it recomputes and
-    /// the buffer sections it borrows; split, the sets would travel through every helper.
-    pub fn update(&mut self, store: &ColorStore, dirty: &DirtyElements) -> Option<SampleRanges> {
-        let topology = store.topology();
-        if !dirty.resized_faces.is_empty()
-            || !dirty.resized_edges.is_empty()
-            || topology.face_count() as usize != self.packed.face_records.len()
-            || topology.vertex_count as usize != self.packed.positions.len()
-            || topology.edge_count() as usize != self.layout.edge_base.len()
-        {
-            return None;
-        }
-        let format = self.packed.format;
-        let size = format.bytes_per_sample();
-        let s = self.sections;
-        let levels = s.levels;
-        let layout = &self.layout;
-        let prefix = &self.prefix;
-        let ctx = Context {
-            store,
-            layout,
-            records: &self.packed.face_records,
-            sections: s,
-            format,
-            prefix,
-            edges: &self.edges,
-        };
-        let chains = &mut self.chains;
-        let upper = &mut self.upper;
-        let bytes = &mut self.packed.colors;
-        let interior_len =
-            |f: u32| layout::interior_chain_len(store.face_resolution(f).unwrap_or(Resolution::ONE)) as usize;
-        // Level 0 and whole interior chains.
-        for &v in &dirty.vertices {
-            let at = v as usize * levels;
-            ctx.vertex_level0(v, &mut chains[at..at + levels], &mut bytes[at * size..(at + levels) * size]);
-        }
-        let mut scratch = Vec::new();
-        for &e in &dirty.edges {
-            let (c, u) = self.edges.ranges(e);
-            scratch.resize(c.len() - u.len(), [0.0; 4]);
-            let out = &mut bytes[(s.vertex_end + c.start) * size..(s.vertex_end + c.end) * size];
-            format.encode_quantized_slice(store.edge_samples(e), out, &mut scratch);
-        }
-        {
-            let (_, interior_bytes) = bytes.split_at_mut(s.edge_end * size);
-            let mut work = dirty_pieces(prefix, &dirty.faces, size, interior_bytes, upper);
-            work.par_iter_mut()
-                .for_each_init(Vec::new, |scratch, (f, out, up)| ctx.interior_chain(*f, scratch, up, out));
-        }
-        // Which edges and vertices each level recomputes: an edge at level l reads its own
-        // level l − 1, its endpoints', its faces' (interiors, and what coarse faces show,
-        // which may read any element of such a face); a vertex reads its edges'. So a face
-        // is touched when any of its elements changed at a finer level, and every edge of a
-        // touched face is recomputed from there on (cumulative sets, a safe superset).
-        let mut edge_flag = vec![false; topology.edge_count() as usize];
-        let mut vertex_flag = vec![false; topology.vertex_count as usize];
-        let mut face_flag = vec![false; topology.face_count() as usize];
-        let mut edges: Vec<u32> = Vec::new();
-        let mut vertices: Vec<u32> = Vec::new();
-        for &e in &dirty.edges {
-            if !std::mem::replace(&mut edge_flag[e as usize], true) {
-                edges.push(e);
-            }
-        }
-        for &v in &dirty.vertices {
-            if !std::mem::replace(&mut vertex_flag[v as usize], true) {
-                vertices.push(v);
-            }
-        }
-        let (offsets, incident) = &self.vertex_edge;
-        let mut touched: Vec<u32> = Vec::new();
-        for level in 1..levels {
-            // Faces whose elements changed at a finer level (E and V as of level − 1).
-            touched.clear();
-            let mut touch = |face: u32, touched: &mut Vec<u32>| {
-                if !std::mem::replace(&mut face_flag[face as usize], true) {
-                    touched.push(face);
-                }
-            };
-            for &f in &dirty.faces {
-                touch(f, &mut touched);
-            }
-            for &v in &vertices {
-                for &e in &incident[offsets[v as usize] as usize..offsets[v as usize + 1] as usize] {
-                    for &(f, _) in topology.faces_of_edge(e) {
-                        touch(f, &mut touched);
-                    }
-                }
-            }
-            for &e in &edges {
-                for &(f, _) in topology.faces_of_edge(e) {
-                    touch(f, &mut touched);
-                }
-            }
-            for &f in &touched {
-                face_flag[f as usize] = false;
-            }
-            // Vertices read their edges; edges read everything of their faces.
-            let previous_edges = edges.len();
-            for &e in &edges[..previous_edges] {
-                for v in topology.edge_vertices[e as usize] {
-                    if !std::mem::replace(&mut vertex_flag[v as usize], true) {
-                        vertices.push(v);
-                    }
-                }
-            }
-            for &f in &touched {
-                for e in topology.face_edges[f as usize] {
-                    if !std::mem::replace(&mut edge_flag[e as usize], true) {
-                        edges.push(e);
-                    }
-                }
-            }
-            edges.sort_unstable();
-            vertices.sort_unstable();
-            let (vertex_colors, edge_upper) = chains.split_at_mut(s.vertex_end);
-            let interiors = ctx.interiors(&bytes[s.edge_end * size..], upper);
-            let edge_bytes = &bytes[s.vertex_end * size..s.edge_end * size];
-            let coarse = {
-                let view = ChainsView {
-                    store,
-                    records: ctx.records,
-                    vertex_levels: layout.vertex_levels,
-                    vertex_colors: &*vertex_colors,
-                    edges: ctx.edge_reader(edge_bytes, edge_upper),
-                    interiors,
-                    vertex_section: s.vertex_end,
-                    interior_start: s.edge_end,
-                };
-                coarse_table(&ctx, &view, &edges, level as u32)
-            };
-            for &e in &edges {
-                let (c, u) = self.edges.ranges(e);
-                if c.is_empty() {
-                    continue;
-                }
-                ctx.edge_reader(edge_bytes, edge_upper).chain_into(e, &mut scratch);
-                reduce_edge_level(&ctx, e, coarse_of(&coarse, e), &mut scratch, level as u32, &interiors);
-                let n0 = c.len() - u.len();
-                edge_upper[u].copy_from_slice(&scratch[n0..]);
-            }
-            let reader = ctx.edge_reader(edge_bytes, edge_upper);
-            for &v in &vertices {
-                let at = v as usize * levels;
-                let list = &incident[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
-                reduce_vertex_level(store, list, v, &mut vertex_colors[at..at + levels], level, &reader);
-            }
-        }
-        // Encode what changed; report it as ranges.
-        let mut ranges: Vec<(u64, u64)> = Vec::new();
-        for &v in &vertices {
-            let at = v as usize * levels;
-            format.encode_slice(&chains[at + 1..at + levels], &mut bytes[(at + 1) * size..(at + levels) * size]);
-            ranges.push((at as u64, levels as u64));
-        }
-        for &e in &edges {
-            let (c, u) = self.edges.ranges(e);
-            if !c.is_empty() {
-                let (first, n0) = (s.vertex_end + c.start, c.len() - u.len());
-                let upper_levels = &chains[s.vertex_end + u.start..s.vertex_end + u.end];
-                format.encode_slice(upper_levels, &mut bytes[(first + n0) * size..(s.vertex_end + c.end) * size]);
-                ranges.push((first as u64, c.len() as u64));
-            }
-        }
-        for &f in &dirty.faces {
-            let (at, len) = (layout.interior_base[f as usize] as usize, interior_len(f));
-            if len > 0 {
-                ranges.push((at as u64, len as u64));
-            }
-        }
-        ranges.sort_unstable();
-        let mut merged: SampleRanges = Vec::with_capacity(ranges.len());
-        for (first, count) in ranges {
-            match merged.last_mut() {
-                Some((last_first, last_count)) if *last_first + *last_count >= first => {
-                    *last_count = (*last_count).max(first + count - *last_first);
-                }
-                _ => merged.push((first, count)),
-            }
-        }
-        Some(merged)
     }
 }
 
