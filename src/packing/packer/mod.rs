@@ -512,13 +512,12 @@ struct Plan {
 impl Plan {
     /// The plan of a pack of `store` from scratch.
     fn of(store: &ColorStore) -> Result<Self, PackError> {
-        Ok(Plan {
-            layout: PackLayout::of(store)?,
-            edges: EdgePrefix::of(store),
-            prefix: InteriorPrefix::of(store),
-            vertex_edge: vertex_edges(store.topology()),
-            kept: None,
-        })
+        // Four passes over the mesh that read only the store, side by side.
+        let ((layout, edges), (prefix, vertex_edge)) = rayon::join(
+            || rayon::join(|| PackLayout::of(store), || EdgePrefix::of(store)),
+            || rayon::join(|| InteriorPrefix::of(store), || vertex_edges(store.topology())),
+        );
+        Ok(Plan { layout: layout?, edges, prefix, vertex_edge, kept: None })
     }
 }
 

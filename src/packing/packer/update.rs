@@ -5,7 +5,7 @@
 use rayon::prelude::*;
 
 use super::{
-    Buffers, Context, Kept, PackCache, Plan, SampleRanges, Sections, coarse_of, coarse_table, reduce_edge_level,
+    BLOCK, Buffers, Context, Kept, PackCache, Plan, SampleRanges, Sections, coarse_of, coarse_table, reduce_edge_level,
 };
 use crate::colors::layout::{self, Resolution};
 use crate::colors::store::{ColorStore, DirtyElements};
@@ -42,8 +42,11 @@ impl PackCache {
             return self.rebuild(store, positions, format);
         }
         // Refused layouts (too many samples) before anything moves.
-        let layout = super::PackLayout::of(store)?;
-        let (new_edges, new_prefix) = (EdgePrefix::of(store), InteriorPrefix::of(store));
+        let (layout, (new_edges, new_prefix)) = rayon::join(
+            || super::PackLayout::of(store),
+            || rayon::join(|| EdgePrefix::of(store), || InteriorPrefix::of(store)),
+        );
+        let layout = layout?;
         let new = Sections::of(store, &layout, &new_edges);
         let mut kept = Kept { faces: vec![true; faces], edges: Vec::new(), vertices: Vec::new() };
         for &f in dirty.faces.iter().chain(&dirty.resized_faces) {
@@ -60,30 +63,8 @@ impl PackCache {
                 *edge = false;
             }
         }
-        // Where each kept chain is and goes: its samples in the colour bytes, its levels ≥ 1
-        // in `chains` (edges) or `upper` (faces).
-        let (old, old_edges, old_prefix) = (self.sections, &self.edges, &self.prefix);
-        let (mut bytes, mut edge_upper, mut face_upper) = (Moves::default(), Moves::default(), Moves::default());
-        for e in 0..edges as u32 {
-            let ((c, u), (c_new, u_new)) = (old_edges.ranges(e), new_edges.ranges(e));
-            if kept.edge(e) && c.len() == c_new.len() && u.len() == u_new.len() {
-                bytes.push(old.vertex_end + c.start, new.vertex_end + c_new.start, c.len());
-                edge_upper.push(old.vertex_end + u.start, new.vertex_end + u_new.start, u.len());
-            } else {
-                kept.edges[e as usize] = false;
-            }
-        }
-        for f in 0..faces {
-            let span = |prefix: &[u32]| (prefix[f] as usize, (prefix[f + 1] - prefix[f]) as usize);
-            let ((c, n), (c_new, n_new)) = (span(&old_prefix.chain), span(&new_prefix.chain));
-            let ((u, m), (u_new, m_new)) = (span(&old_prefix.upper), span(&new_prefix.upper));
-            if kept.faces[f] && n == n_new && m == m_new {
-                bytes.push(old.edge_end + c, new.edge_end + c_new, n);
-                face_upper.push(u, u_new, m);
-            } else {
-                kept.faces[f] = false;
-            }
-        }
+        let (bytes, edge_upper, face_upper) =
+            kept_moves(&mut kept, (&self.sections, &self.edges, &self.prefix), (&new, &new_edges, &new_prefix));
         let bytes = bytes.scaled(format.bytes_per_sample());
         let size = format.bytes_per_sample();
         if !(bytes.fit(self.packed.colors.len(), new.total * size)
@@ -316,6 +297,67 @@ impl PackCache {
     }
 }
 
+/// Where each kept chain is and goes, from the `old` layout (sections, edge and interior
+/// prefixes) to the `new`: its samples in the colour bytes, its levels ≥ 1 in `chains`
+/// (edges) and in `upper` (faces). A chain whose lengths differ is not kept (never: kept
+/// means same resolution). Blocks of elements in parallel, joined in order.
+fn kept_moves(
+    kept: &mut Kept,
+    (old, old_edges, old_prefix): (&Sections, &EdgePrefix, &InteriorPrefix),
+    (new, new_edges, new_prefix): (&Sections, &EdgePrefix, &InteriorPrefix),
+) -> (Moves, Moves, Moves) {
+    let edge_blocks: Vec<(Moves, Moves)> = kept
+        .edges
+        .par_chunks_mut(BLOCK)
+        .enumerate()
+        .map(|(block, flags)| {
+            let (mut bytes, mut upper) = (Moves::default(), Moves::default());
+            for (k, flag) in flags.iter_mut().enumerate() {
+                let e = (block * BLOCK + k) as u32;
+                let ((c, u), (c_new, u_new)) = (old_edges.ranges(e), new_edges.ranges(e));
+                if *flag && c.len() == c_new.len() && u.len() == u_new.len() {
+                    bytes.push(old.vertex_end + c.start, new.vertex_end + c_new.start, c.len());
+                    upper.push(old.vertex_end + u.start, new.vertex_end + u_new.start, u.len());
+                } else {
+                    *flag = false;
+                }
+            }
+            (bytes, upper)
+        })
+        .collect();
+    let face_blocks: Vec<(Moves, Moves)> = kept
+        .faces
+        .par_chunks_mut(BLOCK)
+        .enumerate()
+        .map(|(block, flags)| {
+            let (mut bytes, mut upper) = (Moves::default(), Moves::default());
+            for (k, flag) in flags.iter_mut().enumerate() {
+                let f = block * BLOCK + k;
+                let span = |prefix: &[u32]| (prefix[f] as usize, (prefix[f + 1] - prefix[f]) as usize);
+                let ((c, n), (c_new, n_new)) = (span(&old_prefix.chain), span(&new_prefix.chain));
+                let ((u, m), (u_new, m_new)) = (span(&old_prefix.upper), span(&new_prefix.upper));
+                if *flag && n == n_new && m == m_new {
+                    bytes.push(old.edge_end + c, new.edge_end + c_new, n);
+                    upper.push(u, u_new, m);
+                } else {
+                    *flag = false;
+                }
+            }
+            (bytes, upper)
+        })
+        .collect();
+    let (mut bytes, mut edge_upper, mut face_upper) = (Moves::default(), Moves::default(), Moves::default());
+    for (block_bytes, block_upper) in edge_blocks {
+        bytes.append(block_bytes);
+        edge_upper.append(block_upper);
+    }
+    for (block_bytes, block_upper) in face_blocks {
+        bytes.append(block_bytes);
+        face_upper.append(block_upper);
+    }
+    (bytes, edge_upper, face_upper)
+}
+
 /// `buffer` (a vertex section first, `unit` elements a level) with `moves` applied and the
 /// vertex section re-laid from `from` to `to` levels a vertex (`shape`: vertices, (from,
 /// to)), cut or grown to `len`. The vertex section only shrinks into itself and only grows
@@ -383,6 +425,13 @@ impl Moves {
                 *last_count += count;
             }
             _ => self.0.push((from, to, count)),
+        }
+    }
+
+    /// `other`'s moves after these (merged where they meet).
+    fn append(&mut self, other: Moves) {
+        for (from, to, count) in other.0 {
+            self.push(from, to, count);
         }
     }
 
