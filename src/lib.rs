@@ -19,7 +19,7 @@
 //! | [`io`] | [`io::document`] (open glTF or packed files into a store; pack for export), [`io::export_gltf`], [`io::bake`] (texture → mesh colors, point bake), [`io::least_squares`] (the bake refined to the least-squares fit of the reconstruction), [`io::autosave`], [`io::subdivide`] (1→4 midpoint split of a scene, budget first) |
 //! | [`atomic_write`] | the one way files are written: temporary file, `sync_all`, rename, directory sync |
 //! | [`memory`] | fresh buffers a document's bulk is written into once (the store's chunks on open, packed colours, the paint layout's bytes): transparent huge pages advised before the first write |
-//! | [`threads`] | the thread pool: rayon's global pool with the program's main thread (the editor's UI thread) working in it, so a small parallel call does not wait for sleeping workers |
+//! | [`threads`] | the main thread's pool (the editor's UI thread works in it, so a small parallel call does not wait for sleeping workers); background jobs use rayon's global pool |
 //! | [`camera`] | the orbit camera: matrices, framing, pixel rays (shared by render, picking, replay) |
 //! | [`render`] | **GPU**: wgpu context, packed buffers on the GPU, sampling pipelines, readback |
 //! | [`bench`](mod@bench) | **GPU**: the measurements behind `meshpaint bench` (time, size and error, as JSON; [`bench::trade`] every choice's cost and error side by side, [`bench::plot`] its PNG plots; [`bench::extremes`]: the numerical extremes, each against an independent truth with the tolerance its test enforces) |

@@ -11,8 +11,8 @@ fn main() -> ExitCode {
     restore_default_sigpipe();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let args = cli::Cli::parse();
-    // This thread works in the parallel calls it makes instead of waiting for the pool
-    // (`meshpaint::threads`); if the pool cannot be set up so, the default pool still works.
+    // This thread works in the parallel calls it makes instead of waiting for a pool
+    // (`meshpaint::threads`); if that pool cannot be set up, the global pool still works.
     if let Err(error) = meshpaint::threads::init() {
         log::warn!("thread pool: {error}");
     }

@@ -1,6 +1,6 @@
-//! The thread pool the program runs its parallel work on: rayon's global pool, with the
-//! thread that starts the program (the editor's UI thread, a command's main thread) as one
-//! of its threads.
+//! The thread pool of the thread that starts the program (the editor's UI thread, a
+//! command's main thread): a rayon pool with that thread as one of its threads. The
+//! program's other threads (the editor's background jobs) use rayon's global pool.
 //!
 //! Why: a parallel call (`par_iter`, `join`) from a thread outside the pool hands the whole
 //! job to the pool and blocks until it is done, so every call waits for a sleeping worker
@@ -11,27 +11,46 @@
 //! for work first. `bench paint`, 2.3M tris, 10k-sample dabs, median M samples/s, two
 //! interleaved runs each against the default pool: `paint` 41.0 / 52.8 → 82.6 / 88.7,
 //! `occlusion` (the editor's defaults) 40.2 / 56.8 → 65.6 / 67.4, `first_dab` 21.1 / 34.8 →
-//! 55.5 / 55.0; `bench pack` and `bench load` unchanged within their spread
+//! 55.5 / 55.0; `bench pack` and `bench load` unchanged within their spread. Those runs put
+//! the thread in the global pool; the pool of its own below was measured after
 //! (docs/PERFORMANCE.md, Session 20).
 //!
-//! The pool keeps one worker per core besides the calling thread: the editor's background
-//! jobs (opening a file, baking) run on their own threads and hand their parallel work to
-//! the workers, so they keep every core while the UI thread waits for events.
+//! The thread's pool is its own, not rayon's global pool: a thread of a pool that waits in a
+//! parallel call may pick up any job queued in that pool, and the editor's background jobs
+//! (opening a file, autosave, Optimize) run on threads of their own that hand their parallel
+//! work to the global pool. Were the UI thread in the global pool, a dab waiting for its last
+//! piece could pick up a whole background pack and hold the UI until it ends. So the calling
+//! thread and `cores − 1` workers form one pool (its parallel calls use every core), and the
+//! background jobs keep the global pool's `cores` workers.
+
+use std::sync::OnceLock;
 
 /// Why the pool could not be set up as [`init`] asks.
 pub type PoolError = rayon::ThreadPoolBuildError;
 
-/// Makes the calling thread a thread of rayon's global pool, beside one worker per core.
-/// Call it first, from the thread that does the program's parallel work (`main`); fails if
-/// the global pool already exists (it is then used as it is, which is correct, only slower
-/// for small parallel calls).
+/// The calling thread's pool (kept for the program's life: rayon leaks a pool that holds the
+/// thread that built it).
+static POOL: OnceLock<rayon::ThreadPool> = OnceLock::new();
+
+/// Makes the calling thread a thread of a pool of its own, beside `cores − 1` workers: every
+/// parallel call it makes from then on runs in that pool. Call it first, from the thread that
+/// does the program's parallel work (`main`). On failure (it was called before, or the
+/// threads could not start) the thread's parallel calls go to rayon's global pool, as
+/// before: correct, only slower for small calls.
 pub fn init() -> Result<(), PoolError> {
     let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
-    rayon::ThreadPoolBuilder::new().num_threads(cores + 1).use_current_thread().build_global()
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(cores)
+        .thread_name(|k| format!("meshpaint worker {k}"))
+        .use_current_thread()
+        .build()?;
+    // A second call fails in `build` (this thread is in a pool already), so this is the first.
+    let _ = POOL.set(pool);
+    Ok(())
 }
 
-/// Whether the calling thread is one of the global pool's threads (what [`init`] makes of
-/// the thread it runs on).
+/// Whether the calling thread is a thread of a rayon pool (what [`init`] makes of the
+/// thread it runs on).
 pub fn caller_in_pool() -> bool {
     rayon::current_thread_index().is_some()
 }

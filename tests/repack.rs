@@ -216,11 +216,42 @@ fn a_relayout_after_resolution_changes_equals_the_reference_packer() {
                 let reference = pack_reference(&store, &positions, format).unwrap();
                 assert!(cache.packed().colors == reference.colors, "{name} {format:?} round {round}: bytes differ");
                 assert_eq!(*cache.packed(), reference, "{name} {format:?} round {round}");
+                // And the `f32` chains it keeps for the next repack are a fresh build's.
+                assert!(cache == PackCache::build(&store, &positions, format).unwrap(), "{name} {round}: chains");
                 stroke(&mut store, &mut rng);
                 cache.update(&store, &store.clone().take_dirty()).expect("no resolution changed");
                 store.take_dirty();
                 assert!(*cache.packed() == pack_reference(&store, &positions, format).unwrap(), "{name} {round}");
             }
+        }
+    }
+}
+
+#[test]
+fn a_relayout_from_one_vertex_level_and_back_to_the_same_layout_equals_a_fresh_build() {
+    // Every face at R = 1 (one vertex level, no edge or interior samples), some zero
+    // channels; faces raised to 4, then the same faces back to 1 (the layout of before).
+    let (positions, triangles) = icosphere(2);
+    let topology = Topology::build(positions.len() as u32, &triangles).unwrap();
+    let faces = topology.face_count();
+    let mut store = random_store(topology, vec![r(1); faces as usize], 41);
+    let mut k = 0;
+    store.fill_with(|_| {
+        k += 1;
+        if k % 3 == 0 { [0.0, 0.5, 0.0, 1.0] } else { [0.25, 0.0, 1.0, 0.0] }
+    });
+    store.take_dirty();
+    for format in ColorFormat::ALL {
+        let mut store = store.clone();
+        let mut cache = PackCache::build(&store, &positions, format).unwrap();
+        for target in [r(4), r(1)] {
+            for face in (0..faces).step_by(7) {
+                store.set_face_resolution(face, target).unwrap();
+            }
+            cache = cache.relayout(&store, &positions, &store.clone().take_dirty()).unwrap();
+            store.take_dirty();
+            assert_eq!(*cache.packed(), pack_reference(&store, &positions, format).unwrap(), "{format:?} {target:?}");
+            assert!(cache == PackCache::build(&store, &positions, format).unwrap(), "{format:?} {target:?}: chains");
         }
     }
 }

@@ -444,7 +444,7 @@ impl Editor {
             Severity::Info,
             format!(
                 "Repacked{}: {} samples with MIP chains in {:.1} ms ({:.2} s with the upload)",
-                if repacked.incremental { " (changed chains only)" } else { "" },
+                repacked.how.note(),
                 thousands(repacked.samples_with_mips),
                 repacked.pack_time.as_secs_f64() * 1000.0,
                 elapsed.as_secs_f64()

@@ -22,7 +22,7 @@ use crate::paint::undo::UndoHistory;
 
 use super::editor::{Editor, JobOutput};
 use super::jobs::JobKind;
-use super::paint_session::{Gesture, GestureKind, PaintSession, Repacked, STRENGTH_GESTURE_POINTS};
+use super::paint_session::{Gesture, GestureKind, PaintSession, Repack, Repacked, STRENGTH_GESTURE_POINTS};
 use super::state::{Mode, Severity};
 use super::text::{human_bytes, thousands};
 
@@ -129,13 +129,13 @@ impl Editor {
             // into it; all of them when the format changed.
             let failed = |error: crate::packing::PackError| format!("repacking failed: {error}");
             let (store, positions) = (&document.store, &document.positions);
-            let (cache, ranges) = match cache {
+            let (cache, ranges, how) = match cache {
                 Some(mut cache) if cache.packed().format == format => match cache.update(store, &dirty) {
-                    Some(ranges) => (cache, Some(ranges)),
-                    None => (cache.relayout(store, positions, &dirty).map_err(failed)?, None),
+                    Some(ranges) => (cache, Some(ranges), Repack::ChangedChains),
+                    None => (cache.relayout(store, positions, &dirty).map_err(failed)?, None, Repack::Relayout),
                 },
-                Some(cache) => (cache.rebuild(store, positions, format).map_err(failed)?, None),
-                None => (PackCache::build(store, positions, format).map_err(failed)?, None),
+                Some(cache) => (cache.rebuild(store, positions, format).map_err(failed)?, None, Repack::Full),
+                None => (PackCache::build(store, positions, format).map_err(failed)?, None, Repack::Full),
             };
             let pack_time = started.elapsed();
             job.progress(0.7, "uploading to the GPU");
@@ -160,7 +160,7 @@ impl Editor {
                 samples_with_mips: packed.sample_count(),
                 packed_bytes: packed.face_record_bytes() + packed.color_bytes(),
                 pack_time,
-                incremental: ranges.is_some(),
+                how,
                 cache,
             })))
         });

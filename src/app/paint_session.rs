@@ -69,6 +69,28 @@ pub struct PaintSession {
     pub repack_dirty: DirtyAccumulator,
 }
 
+/// Which repack leaving paint mode ran.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Repack {
+    /// Only the chains the session's edits reach, in place (no resolution changed).
+    ChangedChains,
+    /// A new layout, the chains no edit reached moved into it (a resolution changed).
+    Relayout,
+    /// Every chain (no earlier packing, or another format).
+    Full,
+}
+
+impl Repack {
+    /// How the status line says it (empty for a full repack).
+    pub fn note(self) -> &'static str {
+        match self {
+            Repack::ChangedChains => " (changed chains only)",
+            Repack::Relayout => " (new layout, unchanged chains moved)",
+            Repack::Full => "",
+        }
+    }
+}
+
 /// The result of a repack job (leaving paint mode).
 #[derive(Debug)]
 pub struct Repacked {
@@ -82,8 +104,8 @@ pub struct Repacked {
     pub packed_bytes: u64,
     /// How long packing took.
     pub pack_time: Duration,
-    /// Whether only the changed chains were repacked (else a full repack).
-    pub incremental: bool,
+    /// Which repack ran.
+    pub how: Repack,
     /// The packing, kept for the next incremental repack.
     pub cache: PackCache,
 }

@@ -101,7 +101,8 @@ pub struct PackBench {
     /// `memcpy` of the same number of bytes, same run.
     pub memcpy: Timing,
     /// The same full repack into the buffers of the previous one (`PackCache::rebuild`,
-    /// what leaving paint mode runs after a resolution change).
+    /// what leaving paint mode runs after a change of format; after a resolution change it
+    /// runs [`bench_relayout`]'s relayout).
     pub rebuild: Timing,
     /// Reading every level-0 sample of the store once, on the packer's threads, and
     /// nothing else: the least any repack does (its input is `f32`, 16 bytes a sample).
@@ -384,7 +385,10 @@ pub fn bench_relayout(
     let relaid = relaid?;
     let source = relaid.packed().colors.clone();
     let mut target = vec![0u8; source.len()];
-    let (memcpy, ()) = Timing::measure(runs.max(5), || target.copy_from_slice(&source));
+    let (memcpy, ()) = Timing::measure(runs.max(5), || {
+        target.copy_from_slice(std::hint::black_box(&source));
+        std::hint::black_box(&mut target);
+    });
     let full = crate::packing::packer::pack(&store, positions, format)?;
     Ok(RelayoutBench {
         faces_resized,

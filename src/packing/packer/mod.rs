@@ -61,7 +61,7 @@ const BLOCK: usize = 1024;
 const PREFETCH_AHEAD: u32 = 24;
 
 /// The colour buffer's three sections.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct Sections {
     /// Colours per vertex.
     levels: usize,
@@ -97,14 +97,16 @@ struct Context<'a> {
 }
 
 /// The chains a relayout ([`PackCache::relayout`]) has already moved to their places in the
-/// new layout: per face and per edge, whether its chain is the old one, because nothing it
-/// reads changed (its samples and resolution; for an edge also its faces' interiors, and no
-/// face coarser than the edge, whose contribution reads vertices).
+/// new layout, because nothing they read changed: a face's interior when its samples and
+/// resolution did not change; an edge's chain when neither did its own nor any of its
+/// faces' (an edge with a coarser face is flagged too, but its levels ≥ 1 are always
+/// recomputed: what that face shows reads its vertices); a vertex's chain when its colour
+/// did not change and all its edges are kept (next to a coarse edge only its level 0 stays:
+/// the coarse loop recomputes the rest).
 struct Kept {
     faces: Vec<bool>,
     edges: Vec<bool>,
-    /// Vertices whose whole chain is in place (its colour and every incident edge kept,
-    /// and as many vertex levels as before).
+    /// Vertices whose chain is in place (its colour and every incident edge kept).
     vertices: Vec<bool>,
 }
 
@@ -486,7 +488,7 @@ fn build_all(
 /// [`crate::packing::edges`], [`crate::packing::interiors`]) and the vertex → edge
 /// incidence. Built by a full pack; [`PackCache::update`] then recomputes only the chains
 /// an edit reaches.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PackCache {
     layout: PackLayout,
     sections: Sections,
@@ -596,7 +598,8 @@ impl PackCache {
             (0..topology.face_count()).into_par_iter().with_min_len(BLOCK).map(|f| layout.face_record(store, f)),
         );
         let size = format.bytes_per_sample();
-        // Every sample of these three is written by `build_all`: stale contents never show.
+        // Every sample of these three is written by `build_all`, or was moved into place by a
+        // relayout (`kept`): stale contents never show.
         let mut chains = reuse(chains, sections.vertex_end + edges.upper_len());
         let mut upper = reuse(upper, prefix.upper_len());
         let mut colors = reuse(colors, sections.total * size);

@@ -21,11 +21,13 @@ impl PackCache {
     /// A full pack of `store` after edits that may have changed resolutions (`dirty`:
     /// everything changed in `store` since this cache was built or last updated, as for
     /// [`PackCache::update`]), in this cache's format and buffers: a new layout, into which
-    /// each face interior and edge chain that reads nothing an edit changed is moved, in
-    /// place, instead of recomputed. Computed: every vertex chain, the chains of edited or
-    /// resized faces and edges, every edge of such a face, and every edge with a coarser
-    /// face (what that face shows reads its vertices). Gives exactly the bytes of
-    /// [`PackCache::build`]; the buffers grow to the larger of the two layouts, no more.
+    /// each face interior, edge and vertex chain that reads nothing an edit changed is
+    /// moved, in place, instead of recomputed (a vertex chain re-levelled when the largest
+    /// resolution changed). Computed: the chains of edited or resized faces, edges and
+    /// vertices, every edge of such a face, every vertex of such an edge, the levels ≥ 1 of
+    /// every edge with a coarser face (what that face shows reads its vertices) and of the
+    /// vertices next to one. Gives exactly the bytes of [`PackCache::build`]; each buffer's
+    /// capacity grows to the larger of the two layouts, no more.
     pub fn relayout(
         self,
         store: &ColorStore,
@@ -82,6 +84,11 @@ impl PackCache {
             if let Some(vertex) = vertices.get_mut(v as usize) {
                 *vertex = false;
             }
+        }
+        // From a single level a vertex's colour is the store's, unfiltered (a −0.0 stays
+        // −0.0, where the filter of its next level gives +0.0): then every vertex is computed.
+        if self.layout.vertex_levels == 1 && layout.vertex_levels > 1 {
+            vertices.fill(false);
         }
         kept.vertices = (0..topology.vertex_count as usize)
             .into_par_iter()
@@ -452,6 +459,8 @@ impl Moves {
     /// own overlap is `copy_within`'s).
     fn apply<T: Copy + bytemuck::Zeroable>(self, mut buffer: Vec<T>, len: usize) -> Vec<T> {
         if buffer.len() < len {
+            // Exactly as large as the new layout: `resize` alone may double the capacity.
+            buffer.reserve_exact(len - buffer.len());
             buffer.resize(len, T::zeroed());
         }
         for &(from, to, count) in self.0.iter().filter(|m| m.1 < m.0) {
@@ -462,5 +471,60 @@ impl Moves {
         }
         buffer.truncate(len);
         buffer
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Moves;
+
+    /// Every run moved out of place into a copy: the truth in-place moves must equal.
+    fn moved_aside(buffer: &[u32], moves: &[(usize, usize, usize)], len: usize) -> Vec<u32> {
+        let mut out = buffer.to_vec();
+        out.resize(len.max(buffer.len()), 0);
+        for &(from, to, count) in moves {
+            out[to..to + count].copy_from_slice(&buffer[from..from + count]);
+        }
+        out.truncate(len);
+        out
+    }
+
+    #[test]
+    fn in_place_moves_equal_moves_out_of_place() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |n: u64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % n.max(1)) as usize
+        };
+        for round in 0..400 {
+            // Elements of random lengths, each kept (moved) or not, laid out again with
+            // other lengths for the ones not kept: both layouts keep the order.
+            let elements = 1 + next(40);
+            let (mut from, mut to, mut runs) = (0usize, 0usize, Vec::new());
+            for _ in 0..elements {
+                let len = next(if round % 4 == 0 { 2000 } else { 30 });
+                if next(3) > 0 {
+                    runs.push((from, to, len));
+                    from += len;
+                    to += len;
+                } else {
+                    from += len;
+                    to += next(60);
+                }
+            }
+            let buffer: Vec<u32> = (0..from as u32).collect();
+            let truth_runs: Vec<_> = runs.iter().copied().filter(|r| r.2 > 0).collect();
+            let truth = moved_aside(&buffer, &truth_runs, to);
+            let mut moves = Moves::default();
+            for &(f, t, n) in &runs {
+                moves.push(f, t, n);
+            }
+            let got = moves.apply(buffer.clone(), to);
+            for &(_, t, n) in &truth_runs {
+                assert_eq!(got[t..t + n], truth[t..t + n], "round {round}");
+            }
+        }
     }
 }
