@@ -79,8 +79,13 @@ print(f"| blur (`blur`) | {rate('blur')}; frame-paced {paced('blur_frame_paced')
 up = paint["gpu_upload"]
 print(f"| whole dab with its GPU upload (`gpu_upload`), 100k | {up['samples_per_second_best'] / 1e6:.1f} M/s best, {up['upload_spans']} writes |")
 print(f"| repack after a 100k-sample stroke (`incremental_after_stroke`), RGBA8 | {inc['repack']['best_seconds'] * 1e3:.1f} ms (full repack {inc['full_repack']['best_seconds']:.2f} s, byte-equal: {inc['equal_to_full_pack']}) |")
+rel = pack2m.get("relayout_after_resolution_stroke")
+if rel:
+    print(f"| repack after a resolution stroke adding 100k samples (`relayout_after_resolution_stroke`), RGBA8 | {rel['relayout']['best_seconds'] * 1e3:.0f} ms ({rel['ratio_to_memcpy']:.1f}× memcpy; the full repack into reused buffers it replaces {rel['rebuild']['best_seconds']:.2f} s; byte-equal: {rel['equal_to_full_pack']}) |")
 for row in bunny16:
-    print(f"| full repack, Bunny R = 16, {row['format']} (best of {row['pack']['runs']}) | fresh {row['pack']['best_seconds']:.3f} s ({row['ratio_to_memcpy']:.1f}× memcpy), into reused buffers {row['rebuild']['best_seconds']:.3f} s ({row['rebuild_ratio_to_memcpy']:.1f}×); reading the store alone {row['store_read_ratio_to_memcpy']:.1f}× |")
+    r = row.get("relayout_after_resolution_stroke")
+    after = f"; after a 100k-sample resolution stroke {r['relayout']['best_seconds']:.3f} s ({r['ratio_to_memcpy']:.1f}×)" if r else ""
+    print(f"| full repack, Bunny R = 16, {row['format']} (best of {row['pack']['runs']}) | fresh {row['pack']['best_seconds']:.3f} s ({row['ratio_to_memcpy']:.1f}× memcpy), into reused buffers {row['rebuild']['best_seconds']:.3f} s ({row['rebuild_ratio_to_memcpy']:.1f}×); reading the store alone {row['store_read_ratio_to_memcpy']:.1f}×{after} |")
 def phases(load):
     p = load["phases"]
     names = ["import", "weld", "topology", "store", "pack", "upload", "bvh", "first_frame"]
