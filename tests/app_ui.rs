@@ -527,8 +527,8 @@ fn f_and_shift_f_set_radius_and_strength_interactively() {
     assert!(harness.state().paint.as_ref().unwrap().gesture.is_none());
 }
 
-#[test]
-fn resolution_brush_and_set_r_for_all_change_face_resolutions() {
+/// The Duck in paint mode after one stroke of the resolution brush across the view's middle.
+fn duck_after_a_resolution_stroke() -> Harness<'static, Editor> {
     let mut harness = harness(editor_with_duck());
     harness.run_steps(2);
     harness.key_press(egui::Key::Tab);
@@ -538,6 +538,12 @@ fn resolution_brush_and_set_r_for_all_change_face_resolutions() {
     assert!(matches!(harness.state().brush.tool, meshpaint::paint::brush::Tool::Resolution(_)));
     let center = harness.state().viewport.rect.center();
     left_drag(&mut harness, center - egui::vec2(30.0, 0.0), center + egui::vec2(30.0, 0.0));
+    harness
+}
+
+#[test]
+fn resolution_brush_and_set_r_for_all_change_face_resolutions() {
+    let mut harness = duck_after_a_resolution_stroke();
     let resolutions = |editor: &Editor| editor.document.as_ref().unwrap().document.store.face_resolutions().to_vec();
     let raised = resolutions(harness.state()).iter().filter(|r| r.get() == 16).count();
     assert!(raised > 0, "the resolution brush raised no face: {:?}", harness.state().status);
@@ -554,14 +560,7 @@ fn resolution_brush_and_set_r_for_all_change_face_resolutions() {
 /// full pack's.
 #[test]
 fn leaving_paint_mode_after_a_resolution_stroke_gives_the_full_pack() {
-    let mut harness = harness(editor_with_duck());
-    harness.run_steps(2);
-    harness.key_press(egui::Key::Tab);
-    harness.run_steps(2);
-    harness.get_by_label("Resolution").click();
-    harness.run_steps(2);
-    let center = harness.state().viewport.rect.center();
-    left_drag(&mut harness, center - egui::vec2(30.0, 0.0), center + egui::vec2(30.0, 0.0));
+    let mut harness = duck_after_a_resolution_stroke();
     harness.key_press(egui::Key::Tab);
     harness.run_steps(2);
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));

@@ -27,13 +27,23 @@ pub struct Timing {
 impl Timing {
     /// Times `run` `runs` times (at least once).
     pub fn measure<T>(runs: usize, mut run: impl FnMut() -> T) -> (Timing, T) {
+        Self::measure_prepared(runs, || (), |()| run())
+    }
+
+    /// Times `run` on what `prepare` makes, `runs` times (at least once); neither `prepare`
+    /// nor dropping the previous run's result is timed.
+    pub fn measure_prepared<I, T>(
+        runs: usize,
+        mut prepare: impl FnMut() -> I,
+        mut run: impl FnMut(I) -> T,
+    ) -> (Timing, T) {
         let mut times: Vec<Duration> = Vec::new();
         let mut last;
         loop {
+            let input = prepare();
             let start = Instant::now();
-            let result = run();
+            let result = run(input);
             times.push(start.elapsed());
-            // The previous result is dropped here, untimed.
             last = result;
             if times.len() >= runs.max(1) {
                 break;
@@ -46,33 +56,6 @@ impl Timing {
             runs: times.len(),
         };
         (timing, last)
-    }
-
-    /// Times `run` on what `prepare` makes, `runs` times (at least once); `prepare` is not
-    /// timed.
-    pub fn measure_prepared<I, T>(
-        runs: usize,
-        mut prepare: impl FnMut() -> I,
-        mut run: impl FnMut(I) -> T,
-    ) -> (Timing, T) {
-        let mut best = Timing { best_seconds: f64::INFINITY, median_seconds: 0.0, runs: 0 };
-        let mut times = Vec::new();
-        let mut last;
-        loop {
-            let input = prepare();
-            let start = Instant::now();
-            let result = run(input);
-            times.push(start.elapsed().as_secs_f64());
-            last = result;
-            if times.len() >= runs.max(1) {
-                break;
-            }
-        }
-        times.sort_by(f64::total_cmp);
-        best.best_seconds = times[0];
-        best.median_seconds = times[times.len() / 2];
-        best.runs = times.len();
-        (best, last)
     }
 
     /// As a JSON object.
