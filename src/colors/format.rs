@@ -126,8 +126,7 @@ impl ColorFormat {
             }
             ColorFormat::Rgba16F => {
                 if let Some(b) = bytes.first_chunk::<8>() {
-                    let c = |k: usize| f16_bits_to_f32(u16::from_le_bytes([b[2 * k], b[2 * k + 1]]));
-                    return [c(0), c(1), c(2), c(3)];
+                    return f16x4_to_vec4(b).to_array();
                 }
             }
             ColorFormat::Rgba32F => {
@@ -175,11 +174,8 @@ impl ColorFormat {
                 }
             }
             ColorFormat::Rgba16F => {
-                // Straight into the register: through `decode` and an array, the RGBA16F
-                // rebuild of Bunny R = 16 took 4–6 % longer (three interleaved runs).
                 if let Some(b) = bytes.first_chunk::<8>() {
-                    let c = |k: usize| f16_bits_to_f32(u16::from_le_bytes([b[2 * k], b[2 * k + 1]]));
-                    return glam::Vec4::new(c(0), c(1), c(2), c(3));
+                    return f16x4_to_vec4(b);
                 }
             }
         }
@@ -304,6 +300,42 @@ pub fn f16_bits_to_f32(h: u16) -> f32 {
     f32::from_bits(o | (u32::from(h & 0x8000) << 16))
 }
 
+/// Four binary16 values (little-endian bits, one sample's RGBA16F bytes) as `f32`, exactly
+/// [`f16_bits_to_f32`] of each, in one SSE2 register: the four channels at once in ten
+/// vector operations (F. Giesen's `half_to_float_SSE2`: the exponent and mantissa shifted
+/// into place and rebiased by one multiplication by 2¹¹², exact also for subnormals;
+/// infinities and NaNs given the largest exponent, a NaN made quiet). SSE2 is part of
+/// x86-64, so no CPU check; elsewhere channel by channel. tests/packer.rs checks all
+/// 65,536 bit patterns in every channel against `half`.
+#[inline(always)]
+fn f16x4_to_vec4(bytes: &[u8; 8]) -> glam::Vec4 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 is baseline on x86-64, and `bytes` is 8 readable bytes (the load
+        // reads exactly 8, unaligned).
+        unsafe {
+            let h = _mm_unpacklo_epi16(_mm_loadl_epi64(bytes.as_ptr().cast()), _mm_setzero_si128());
+            let exponent_mantissa = _mm_and_si128(h, _mm_set1_epi32(0x7fff));
+            let sign = _mm_slli_epi32(_mm_xor_si128(h, exponent_mantissa), 16);
+            let rebias = _mm_castsi128_ps(_mm_set1_epi32((254 - 15) << 23));
+            let scaled = _mm_mul_ps(_mm_castsi128_ps(_mm_slli_epi32(exponent_mantissa, 13)), rebias);
+            let inf_nan = _mm_cmpgt_epi32(exponent_mantissa, _mm_set1_epi32(0x7bff));
+            let nan = _mm_cmpgt_epi32(exponent_mantissa, _mm_set1_epi32(0x7c00));
+            let top = _mm_or_si128(
+                _mm_and_si128(inf_nan, _mm_set1_epi32(255 << 23)),
+                _mm_and_si128(nan, _mm_set1_epi32(0x0040_0000)),
+            );
+            glam::Vec4::from(_mm_or_ps(scaled, _mm_castsi128_ps(_mm_or_si128(sign, top))))
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let c = |k: usize| f16_bits_to_f32(u16::from_le_bytes([bytes[2 * k], bytes[2 * k + 1]]));
+        glam::Vec4::new(c(0), c(1), c(2), c(3))
+    }
+}
+
 /// Encodes `colors` (clamped) as RGBA16F into `out` (8 bytes each) and, when given, writes
 /// what decoding gives to `quantized` (all three the same length). Where the CPU has F16C,
 /// two samples an instruction straight from the colours to the bytes
@@ -349,17 +381,17 @@ fn encode_f16_portable(colors: &[Rgba], out: &mut [u8], mut quantized: Option<&m
 mod f16c {
     use std::arch::x86_64::*;
 
-    use super::{MAX_CHANNEL, Rgba, encode_f16_portable};
+    use super::{MAX_CHANNEL, Rgba};
 
     /// Two samples (eight channels) a step: clamped as [`super::clamp_color`] does (NaN and
     /// every zero or negative to +0: `max` returns its second operand for NaN and for two
     /// zeros), converted with `vcvtps2ph` (round to nearest even), stored; the decoded copy
-    /// converted back with `vcvtph2ps`. An odd last sample goes through the portable path.
+    /// converted back with `vcvtph2ps`. An odd last sample takes the same steps at half width.
     ///
     /// # Safety
     /// The CPU must have F16C and AVX.
     #[target_feature(enable = "avx,f16c")]
-    pub(super) unsafe fn encode(colors: &[Rgba], out: &mut [u8], mut quantized: Option<&mut [Rgba]>) {
+    pub(super) unsafe fn encode(colors: &[Rgba], out: &mut [u8], quantized: Option<&mut [Rgba]>) {
         let n = colors.len().min(out.len() / 8).min(quantized.as_ref().map_or(usize::MAX, |q| q.len()));
         let pairs = n / 2;
         let zero = _mm256_setzero_ps();
@@ -367,7 +399,7 @@ mod f16c {
             _mm256_setr_ps(MAX_CHANNEL, MAX_CHANNEL, MAX_CHANNEL, 1.0, MAX_CHANNEL, MAX_CHANNEL, MAX_CHANNEL, 1.0);
         let src = colors.as_ptr().cast::<f32>();
         let dst = out.as_mut_ptr();
-        let decoded = quantized.as_deref_mut().map(|q| q.as_mut_ptr().cast::<f32>());
+        let decoded = quantized.map(|q| q.as_mut_ptr().cast::<f32>());
         for p in 0..pairs {
             // SAFETY: samples 2p and 2p + 1 are below `n`, within all three slices.
             let x = unsafe { _mm256_loadu_ps(src.add(8 * p)) };
@@ -377,9 +409,18 @@ mod f16c {
                 unsafe { _mm256_storeu_ps(decoded.add(8 * p), _mm256_cvtph_ps(halves)) };
             }
         }
-        let done = 2 * pairs;
-        if n > done {
-            encode_f16_portable(&colors[done..n], &mut out[8 * done..8 * n], quantized.map(|q| &mut q[done..n]));
+        if n % 2 == 1 {
+            // The odd last sample, four channels in a 128-bit register (the portable path's
+            // fixed-size runs cost more than the sample for a chain of odd length).
+            let last = n - 1;
+            let max = _mm_setr_ps(MAX_CHANNEL, MAX_CHANNEL, MAX_CHANNEL, 1.0);
+            // SAFETY: sample `last` is below `n`, within all three slices.
+            let x = unsafe { _mm_loadu_ps(src.add(4 * last)) };
+            let halves = _mm_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), max));
+            unsafe { _mm_storel_epi64(dst.add(8 * last).cast(), halves) };
+            if let Some(decoded) = decoded {
+                unsafe { _mm_storeu_ps(decoded.add(4 * last), _mm_cvtph_ps(halves)) };
+            }
         }
     }
 }

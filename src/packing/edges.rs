@@ -11,7 +11,7 @@
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout;
 use crate::colors::store::ColorStore;
-use crate::packing::interiors::prefix_sums;
+use crate::packing::interiors::{prefetch_lines, prefix_sums};
 
 /// Per edge, where its chain starts in the edge section of the colour buffer (`chain`)
 /// and where its levels ≥ 1 start in the upper buffer (`upper`); both `E + 1` long (prefix
@@ -70,6 +70,20 @@ impl EdgeReader<'_> {
             Some(self.format.decode(self.bytes.get(at..at + size)?))
         } else {
             self.upper.get(upper + offset - n0).copied().filter(|_| offset < chain_end - chain)
+        }
+    }
+
+    /// Asks the CPU to start loading `edge`'s chain (its level-0 bytes and its levels ≥ 1)
+    /// into cache, for a pass that visits edges out of order (a hint: no effect on results).
+    #[inline]
+    pub(crate) fn prefetch(&self, edge: u32) {
+        let (chain, upper) = self.prefix.ranges(edge);
+        let size = self.format.bytes_per_sample();
+        if let Some(bytes) = self.bytes.get(chain.start * size..(chain.end - upper.len()) * size) {
+            prefetch_lines(bytes);
+        }
+        if let Some(upper) = self.upper.get(upper) {
+            prefetch_lines(upper);
         }
     }
 

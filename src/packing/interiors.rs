@@ -104,7 +104,7 @@ impl InteriorReader<'_> {
 
 /// Prefetches every 64-byte cache line `slice` touches (x86-64; elsewhere nothing).
 #[inline]
-fn prefetch_lines<T>(slice: &[T]) {
+pub(crate) fn prefetch_lines<T>(slice: &[T]) {
     #[cfg(target_arch = "x86_64")]
     {
         // One item per 64 bytes from the first, and the last (whose line the steps may miss).
