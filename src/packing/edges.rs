@@ -45,6 +45,30 @@ impl EdgePrefix {
     }
 }
 
+/// One edge's chain as [`EdgeReader::chain`] finds it.
+#[derive(Clone, Copy)]
+pub(crate) struct EdgeChain<'a> {
+    /// Level 0's bytes.
+    level0: &'a [u8],
+    /// Levels ≥ 1 in `f32`.
+    upper: &'a [Rgba],
+    format: ColorFormat,
+}
+
+impl EdgeChain<'_> {
+    /// Sample `offset` of the chain, as the `f32` chain holds it, in a SIMD register.
+    #[inline(always)]
+    pub(crate) fn get(&self, offset: usize) -> Option<glam::Vec4> {
+        let size = self.format.bytes_per_sample();
+        let n0 = self.level0.len() / size;
+        if offset < n0 {
+            Some(self.format.decode_vec4(self.level0.get(offset * size..offset * size + size)?))
+        } else {
+            self.upper.get(offset - n0).map(|c| glam::Vec4::from_array(*c))
+        }
+    }
+}
+
 /// The edge section as built so far: its bytes (level 0 decoded from them) and the levels
 /// ≥ 1 in `f32`.
 #[derive(Clone, Copy)]
@@ -60,17 +84,23 @@ impl EdgeReader<'_> {
     /// Sample `offset` of `edge`'s chain, as the `f32` chain holds it.
     #[inline(always)]
     pub(crate) fn get(&self, edge: u32, offset: usize) -> Option<Rgba> {
+        self.chain(edge)?.get(offset).map(|color| color.to_array())
+    }
+
+    /// `edge`'s chain: its level-0 bytes and its levels ≥ 1, looked up once for a loop
+    /// that reads several of its samples.
+    #[inline(always)]
+    pub(crate) fn chain(&self, edge: u32) -> Option<EdgeChain<'_>> {
         let e = edge as usize;
         let (chain, chain_end) = (*self.prefix.chain.get(e)? as usize, *self.prefix.chain.get(e + 1)? as usize);
         let (upper, upper_end) = (*self.prefix.upper.get(e)? as usize, *self.prefix.upper.get(e + 1)? as usize);
-        let n0 = (chain_end - chain) - (upper_end - upper);
-        if offset < n0 {
-            let size = self.format.bytes_per_sample();
-            let at = (chain + offset) * size;
-            Some(self.format.decode(self.bytes.get(at..at + size)?))
-        } else {
-            self.upper.get(upper + offset - n0).copied().filter(|_| offset < chain_end - chain)
-        }
+        let size = self.format.bytes_per_sample();
+        let n0 = (chain_end - chain).checked_sub(upper_end - upper)?;
+        Some(EdgeChain {
+            level0: self.bytes.get(chain * size..(chain + n0) * size)?,
+            upper: self.upper.get(upper..upper_end)?,
+            format: self.format,
+        })
     }
 
     /// Asks the CPU to start loading `edge`'s chain (its level-0 bytes and its levels ≥ 1)

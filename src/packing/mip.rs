@@ -209,6 +209,7 @@ pub(crate) fn reduce_vertex_chain(store: &ColorStore, incident: &[u32], v: u32, 
         let log2 = edge_log2(store, edge);
         let r_edge = Resolution::from_log2(log2).unwrap_or(Resolution::ONE);
         let first = v == topology.edge_vertices[edge as usize][0];
+        let chain = edges.chain(edge);
         // Level `level` reads level `level − 1` of the edge, which has samples while
         // `level ≤ log2`.
         for (level, sum) in sums.iter_mut().enumerate().take(levels.min(log2 as usize + 1)).skip(1) {
@@ -216,7 +217,8 @@ pub(crate) fn reduce_vertex_chain(store: &ColorStore, incident: &[u32], v: u32, 
             let r_previous = 1u32 << (log2 - previous);
             let level_start = layout::edge_level_offset(r_edge, previous).unwrap_or(0) as usize;
             let position = if first { 1 } else { r_previous - 1 };
-            sum.add(edges.get(edge, level_start + position as usize - 1).unwrap_or([0.0; 4]));
+            let offset = level_start + position as usize - 1;
+            sum.add_vec4(chain.and_then(|chain| chain.get(offset)).unwrap_or(glam::Vec4::ZERO));
         }
     }
     for level in 1..levels {
