@@ -100,14 +100,17 @@ impl PackCache {
         let shape = (topology.vertex_count as usize, levels);
         let PackCache { chains, upper, packed, vertex_edge, .. } = self;
         let PackedMesh { positions: old_positions, indices, face_records, colors, .. } = packed;
-        let buffers = Buffers {
-            colors: relaid(colors, bytes, new.total * size, shape, size),
-            chains: relaid(chains, edge_upper, new.vertex_end + new_edges.upper_len(), shape, 1),
-            upper: face_upper.apply(upper, new_prefix.upper_len()),
-            records: face_records,
-            positions: old_positions,
-            indices,
-        };
+        // Three buffers, each moved on one thread (a buffer's moves go in order), side by side.
+        let (colors, (chains, upper)) = rayon::join(
+            || relaid(colors, bytes, new.total * size, shape, size),
+            || {
+                rayon::join(
+                    || relaid(chains, edge_upper, new.vertex_end + new_edges.upper_len(), shape, 1),
+                    || face_upper.apply(upper, new_prefix.upper_len()),
+                )
+            },
+        );
+        let buffers = Buffers { colors, chains, upper, records: face_records, positions: old_positions, indices };
         let plan = Plan { layout, edges: new_edges, prefix: new_prefix, vertex_edge, kept: Some(kept) };
         Self::build_into(store, positions, format, buffers, Some(plan))
     }
