@@ -4,7 +4,7 @@
 
 use glam::Vec4;
 
-use crate::colors::format::Rgba;
+use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::{self, Resolution};
 use crate::colors::store::ColorStore;
 use crate::mesh::topology::Topology;
@@ -143,30 +143,104 @@ pub(crate) fn filter_edge_level(
     equal: &[(FaceLevel, u8, bool)],
     coarse: &[Rgba],
 ) {
-    let r_level = r_edge.get() >> level;
-    let r_previous = 2 * r_level;
-    let previous_start = layout::edge_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
-    let level_start = layout::edge_level_offset(r_edge, level).unwrap_or(0) as usize;
-    let rp = r_previous as usize;
-    let per_k = coarse.len() / (r_level as usize - 1).max(1);
-    for k in 1..r_level {
-        let position = 2 * k;
-        // Positions 2k − 1 … 2k + 1 lie in 1..r_previous: edge samples, never a vertex.
-        let at = |p: u32| chain[previous_start + p as usize - 1];
-        let center = at(position);
-        let mut sum = MipSum::default();
-        sum.add(at(position - 1));
-        sum.add(at(position + 1));
-        for &(face_level, face_edge, reversed) in equal {
-            let p = if reversed { r_previous - position } else { position } as usize;
-            for (i, j) in inside_neighbours(face_edge, p, rp) {
-                sum.add_vec4(face_level.get_vec4(interior_row_start(rp, i) + j - 1));
+    // The faces' reads dispatched once a level, not once a neighbour: one or two faces (a
+    // manifold edge) of one kind, level-0 bytes of one format or `f32` levels above (all
+    // faces are at one level of one resolution), get a loop of their own.
+    let orientation = |n: usize| equal.get(n).map_or((0, false), |&(_, face_edge, reversed)| (face_edge, reversed));
+    let sides = [orientation(0), orientation(1)];
+    let bytes = |n: usize, format: ColorFormat| match equal.get(n).map(|side| side.0) {
+        Some(FaceLevel::Bytes(bytes, f)) if f == format => Some(bytes),
+        None => Some(&[][..]),
+        _ => None,
+    };
+    let upper = |n: usize| match equal.get(n).map(|side| side.0) {
+        Some(FaceLevel::Upper(upper)) => Some(upper),
+        None => Some(&[][..]),
+        _ => None,
+    };
+    let shape = EdgeLevel { r_edge, level, coarse };
+    if equal.len() <= 2 {
+        match equal.first().map(|side| side.0) {
+            Some(FaceLevel::Bytes(_, format)) => {
+                if let (Some(a), Some(b)) = (bytes(0, format), bytes(1, format)) {
+                    let faces = [a, b];
+                    match format {
+                        ColorFormat::Rgba8Srgb => {
+                            return shape.filter(chain, &sides[..equal.len()], |n, o| {
+                                read(faces[n], o, ColorFormat::Rgba8Srgb)
+                            });
+                        }
+                        ColorFormat::Rgba16F => {
+                            return shape
+                                .filter(chain, &sides[..equal.len()], |n, o| read(faces[n], o, ColorFormat::Rgba16F));
+                        }
+                        ColorFormat::Rgba32F => {
+                            return shape
+                                .filter(chain, &sides[..equal.len()], |n, o| read(faces[n], o, ColorFormat::Rgba32F));
+                        }
+                    }
+                }
             }
+            Some(FaceLevel::Upper(_)) => {
+                if let (Some(a), Some(b)) = (upper(0), upper(1)) {
+                    let faces = [a, b];
+                    return shape.filter(chain, &sides[..equal.len()], |n, o| {
+                        faces[n].get(o).map_or(Vec4::ZERO, |c| Vec4::from_array(*c))
+                    });
+                }
+            }
+            None => return shape.filter(chain, &[], |_, _| Vec4::ZERO),
         }
-        for &n in coarse.get((k as usize - 1) * per_k..k as usize * per_k).unwrap_or(&[]) {
-            sum.add(n);
+    }
+    let all: Vec<(u8, bool)> = equal.iter().map(|&(_, face_edge, reversed)| (face_edge, reversed)).collect();
+    shape.filter(chain, &all, |n, o| equal.get(n).map_or(Vec4::ZERO, |side| side.0.get_vec4(o)))
+}
+
+/// Sample `offset` of a face's level-0 bytes in `format` (zero past the end).
+#[inline(always)]
+fn read(bytes: &[u8], offset: usize, format: ColorFormat) -> Vec4 {
+    let size = format.bytes_per_sample();
+    bytes.get(offset * size..offset * size + size).map_or(Vec4::ZERO, |b| format.decode_vec4(b))
+}
+
+/// One level of an edge chain to filter ([`filter_edge_level`]).
+struct EdgeLevel<'a> {
+    r_edge: Resolution,
+    level: u32,
+    coarse: &'a [Rgba],
+}
+
+impl EdgeLevel<'_> {
+    /// The filter with `face(n, offset)` reading sample `offset` of face `n` of `sides`
+    /// (its face edge and reversed flag) at the previous level.
+    #[inline(always)]
+    fn filter(&self, chain: &mut [Rgba], sides: &[(u8, bool)], face: impl Fn(usize, usize) -> Vec4) {
+        let (r_edge, level, coarse) = (self.r_edge, self.level, self.coarse);
+        let r_level = r_edge.get() >> level;
+        let r_previous = 2 * r_level;
+        let previous_start = layout::edge_level_offset(r_edge, level - 1).unwrap_or(0) as usize;
+        let level_start = layout::edge_level_offset(r_edge, level).unwrap_or(0) as usize;
+        let rp = r_previous as usize;
+        let per_k = coarse.len() / (r_level as usize - 1).max(1);
+        for k in 1..r_level {
+            let position = 2 * k;
+            // Positions 2k − 1 … 2k + 1 lie in 1..r_previous: edge samples, never a vertex.
+            let at = |p: u32| chain[previous_start + p as usize - 1];
+            let center = at(position);
+            let mut sum = MipSum::default();
+            sum.add(at(position - 1));
+            sum.add(at(position + 1));
+            for (n, &(face_edge, reversed)) in sides.iter().enumerate() {
+                let p = if reversed { r_previous - position } else { position } as usize;
+                for (i, j) in inside_neighbours(face_edge, p, rp) {
+                    sum.add_vec4(face(n, interior_row_start(rp, i) + j - 1));
+                }
+            }
+            for &n in coarse.get((k as usize - 1) * per_k..k as usize * per_k).unwrap_or(&[]) {
+                sum.add(n);
+            }
+            chain[level_start + k as usize - 1] = sum.finish(center);
         }
-        chain[level_start + k as usize - 1] = sum.finish(center);
     }
 }
 
