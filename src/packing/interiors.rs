@@ -102,7 +102,11 @@ impl InteriorReader<'_> {
     }
 }
 
-/// Prefetches every 64-byte cache line `slice` touches (x86-64; elsewhere nothing).
+/// Prefetches every 64-byte cache line `slice` touches into the L2 cache, not L1 (x86-64;
+/// elsewhere nothing): a pass prefetches whole chains and reads only some of their samples,
+/// so L1 keeps what is being worked on (Bunny R = 16 RGBA16F rebuild, `prefetcht0` →
+/// `prefetcht1`: 0.0568/0.0569/0.0566 → 0.0536/0.0539/0.0536 s, three interleaved runs;
+/// RGBA8 and the 1M-triangle Duck unchanged).
 #[inline]
 pub(crate) fn prefetch_lines<T>(slice: &[T]) {
     #[cfg(target_arch = "x86_64")]
@@ -110,7 +114,7 @@ pub(crate) fn prefetch_lines<T>(slice: &[T]) {
         // One item per 64 bytes from the first, and the last (whose line the steps may miss).
         let step = 64 / std::mem::size_of::<T>().clamp(1, 64);
         for item in slice.iter().step_by(step.max(1)).chain(slice.last()) {
-            safe_arch::prefetch_t0(item);
+            safe_arch::prefetch_t1(item);
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
