@@ -36,7 +36,8 @@ for run in 1 2 3; do "$bin" bench load "$out/duck1m.glb" -r 8 >"$out/load_1m_$ru
 if command -v Xvfb >/dev/null; then
   Xvfb :93 -screen 0 1280x800x24 >/dev/null 2>&1 &
   xvfb=$!
-  sleep 2
+  # Up to 10 s for its socket (a fixed 2 s once left the editor without a display).
+  for _ in $(seq 100); do [ -S /tmp/.X11-unix/X93 ] && break; sleep 0.1; done
   DISPLAY=:93 MESHPAINT_FRAME_COUNT_FILE="$out/frames" MESHPAINT_AUTOSAVE_SECONDS=3600 \
     "$bin" "$duck" >"$out/app.log" 2>&1 &
   app=$!
