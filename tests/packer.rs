@@ -75,7 +75,7 @@ fn rgba16f_decoding_equals_half_on_every_bit_pattern() {
 /// in `f64` against the halves on either side) and on a tie the even one. Inputs: every
 /// 997th f32 bit pattern up to 65,504, every midpoint between neighbouring halves and the
 /// f32 on either side of it, in every channel position of an odd-length slice (the vector
-/// path's scalar tail runs too); the decoded copy is the half's value.
+/// path's odd last sample runs too); the decoded copy is the half's value.
 #[test]
 fn rgba16f_encoding_rounds_to_the_nearest_half_ties_to_even() {
     use half::f16;

@@ -40,7 +40,9 @@ fn cases() -> Vec<(&'static str, Vec<[f32; 3]>, ColorStore)> {
     let (positions, topology) = octahedron();
     out.push(("octahedron mixed", positions, random_store(topology, [1, 2, 4, 8, 16, 4, 1, 32].map(r).to_vec(), 1)));
     let (positions, topology) = fins();
-    out.push(("fins", positions, random_store(topology, [8, 2, 4, 16].map(r).to_vec(), 2)));
+    out.push(("fins", positions.clone(), random_store(topology.clone(), [8, 2, 4, 16].map(r).to_vec(), 2)));
+    // Three fins of one resolution on one edge: the edge filter's path for more than two faces.
+    out.push(("fins of one resolution", positions, random_store(topology, [8, 8, 8, 16].map(r).to_vec(), 6)));
     let (positions, triangles) = icosphere(3);
     let topology = Topology::build(positions.len() as u32, &triangles).unwrap();
     let faces = topology.face_count() as usize;

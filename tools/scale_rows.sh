@@ -38,17 +38,22 @@ if command -v Xvfb >/dev/null; then
   xvfb=$!
   # Up to 10 s for its socket (a fixed 2 s once left the editor without a display).
   for _ in $(seq 100); do [ -S /tmp/.X11-unix/X93 ] && break; sleep 0.1; done
-  DISPLAY=:93 MESHPAINT_FRAME_COUNT_FILE="$out/frames" MESHPAINT_AUTOSAVE_SECONDS=3600 \
-    "$bin" "$duck" >"$out/app.log" 2>&1 &
-  app=$!
-  sleep 20
-  ticks() { awk '{print $14 + $15}' "/proc/$app/stat"; }
-  f0=$(cat "$out/frames" 2>/dev/null || echo 0); t0=$(ticks)
-  sleep 10
-  f1=$(cat "$out/frames" 2>/dev/null || echo 0); t1=$(ticks)
-  kill "$app" "$xvfb" 2>/dev/null || true
-  wait 2>/dev/null || true
-  echo "{\"frames\": $((f1 - f0)), \"cpu_seconds\": $(python3 -c "print(($t1 - $t0) / $(getconf CLK_TCK))"), \"seconds\": 10}" >"$out/idle.json"
+  if ! kill -0 "$xvfb" 2>/dev/null || [ ! -S /tmp/.X11-unix/X93 ]; then
+    echo "Xvfb :93 did not start (a stale /tmp/.X93-lock?)" >&2
+    echo '{"skipped": "Xvfb :93 did not start"}' >"$out/idle.json"
+  else
+    DISPLAY=:93 MESHPAINT_FRAME_COUNT_FILE="$out/frames" MESHPAINT_AUTOSAVE_SECONDS=3600 \
+      "$bin" "$duck" >"$out/app.log" 2>&1 &
+    app=$!
+    sleep 20
+    ticks() { awk '{print $14 + $15}' "/proc/$app/stat"; }
+    f0=$(cat "$out/frames" 2>/dev/null || echo 0); t0=$(ticks)
+    sleep 10
+    f1=$(cat "$out/frames" 2>/dev/null || echo 0); t1=$(ticks)
+    kill "$app" "$xvfb" 2>/dev/null || true
+    wait 2>/dev/null || true
+    echo "{\"frames\": $((f1 - f0)), \"cpu_seconds\": $(python3 -c "print(($t1 - $t0) / $(getconf CLK_TCK))"), \"seconds\": 10}" >"$out/idle.json"
+  fi
 else
   echo '{"skipped": "no Xvfb"}' >"$out/idle.json"
 fi

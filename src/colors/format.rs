@@ -301,12 +301,14 @@ pub fn f16_bits_to_f32(h: u16) -> f32 {
 }
 
 /// Four binary16 values (little-endian bits, one sample's RGBA16F bytes) as `f32`, exactly
-/// [`f16_bits_to_f32`] of each, in one SSE2 register: the four channels at once in ten
-/// vector operations (F. Giesen's `half_to_float_SSE2`: the exponent and mantissa shifted
-/// into place and rebiased by one multiplication by 2¹¹², exact also for subnormals;
-/// infinities and NaNs given the largest exponent, a NaN made quiet). SSE2 is part of
-/// x86-64, so no CPU check; elsewhere channel by channel. tests/packer.rs checks all
-/// 65,536 bit patterns in every channel against `half`.
+/// [`f16_bits_to_f32`] of each, in one SSE2 register: the four channels at once in about
+/// fifteen vector operations (F. Giesen's `half_to_float_SSE2`: the exponent and mantissa
+/// shifted into place and rebiased by one multiplication by 2¹¹², exact also for subnormals,
+/// whose product has a subnormal `f32` operand, exact as long as the thread does not set
+/// "denormals are zero", which Rust never does; infinities and NaNs given the largest
+/// exponent, a NaN made quiet). SSE2 is part of x86-64, so no CPU check; elsewhere channel
+/// by channel. tests/packer.rs checks all 65,536 bit patterns in every channel against
+/// `half`.
 #[inline(always)]
 fn f16x4_to_vec4(bytes: &[u8; 8]) -> glam::Vec4 {
     #[cfg(target_arch = "x86_64")]
@@ -580,4 +582,57 @@ pub fn weighted_sum<const N: usize>(terms: [(f32, Rgba); N]) -> Rgba {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use half::f16;
+
+    use super::{Rgba, encode_f16_portable, encode_f16_runs};
+
+    /// The portable RGBA16F encoder (CPUs without F16C) against `half`, value by value, and
+    /// against the encoder this CPU runs, bit for bit, on runs of every length around its
+    /// batch sizes: on a CPU with F16C nothing else runs the portable path.
+    #[test]
+    fn portable_rgba16f_encoder_equals_half_and_the_dispatched_one() {
+        let values = [
+            0.0,
+            -0.0,
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -1.0,
+            1e-8,
+            6.0e-8,
+            6.1e-5,
+            0.333_333_34,
+            0.5,
+            1.0,
+            1.5,
+            65_519.996,
+            65_520.0,
+            1e9,
+        ];
+        for len in [1, 2, 7, 31, 32, 33, 65] {
+            let colors: Vec<Rgba> =
+                (0..len).map(|i| std::array::from_fn(|c| values[(4 * i + c) % values.len()])).collect();
+            let (mut portable, mut dispatched) = (vec![0u8; 8 * len], vec![0u8; 8 * len]);
+            let (mut portable_q, mut dispatched_q) = (vec![[0.0f32; 4]; len], vec![[0.0f32; 4]; len]);
+            encode_f16_portable(&colors, &mut portable, Some(&mut portable_q));
+            encode_f16_runs(&colors, &mut dispatched, Some(&mut dispatched_q));
+            assert_eq!(portable, dispatched, "length {len}");
+            for (i, color) in colors.iter().enumerate() {
+                for c in 0..4 {
+                    // NaN, negatives and both zeros to +0; then at most the channel's top.
+                    let top = if c == 3 { 1.0 } else { 65504.0 };
+                    let clamped = if color[c] > 0.0 { color[c].min(top) } else { 0.0 };
+                    let want = f16::from_f32(clamped);
+                    let got = u16::from_le_bytes([portable[8 * i + 2 * c], portable[8 * i + 2 * c + 1]]);
+                    assert_eq!(got, want.to_bits(), "length {len}, sample {i}, channel {c}: {}", color[c]);
+                    assert_eq!(portable_q[i][c].to_bits(), want.to_f32().to_bits());
+                    assert_eq!(dispatched_q[i][c].to_bits(), want.to_f32().to_bits());
+                }
+            }
+        }
+    }
 }

@@ -95,7 +95,7 @@ impl EdgeReader<'_> {
         let (chain, chain_end) = (*self.prefix.chain.get(e)? as usize, *self.prefix.chain.get(e + 1)? as usize);
         let (upper, upper_end) = (*self.prefix.upper.get(e)? as usize, *self.prefix.upper.get(e + 1)? as usize);
         let size = self.format.bytes_per_sample();
-        let n0 = (chain_end - chain).checked_sub(upper_end - upper)?;
+        let n0 = chain_end.checked_sub(chain)?.checked_sub(upper_end.checked_sub(upper)?)?;
         Some(EdgeChain {
             level0: self.bytes.get(chain * size..(chain + n0) * size)?,
             upper: self.upper.get(upper..upper_end)?,
@@ -109,7 +109,7 @@ impl EdgeReader<'_> {
     pub(crate) fn prefetch(&self, edge: u32) {
         let (chain, upper) = self.prefix.ranges(edge);
         let size = self.format.bytes_per_sample();
-        if let Some(bytes) = self.bytes.get(chain.start * size..(chain.end - upper.len()) * size) {
+        if let Some(bytes) = self.bytes.get(chain.start * size..chain.end.saturating_sub(upper.len()) * size) {
             prefetch_lines(bytes);
         }
         if let Some(upper) = self.upper.get(upper) {

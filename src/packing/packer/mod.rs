@@ -57,7 +57,8 @@ pub fn pack_threads() -> usize {
 /// Elements per parallel task.
 const BLOCK: usize = 1024;
 
-/// How many edges ahead the one-pass edge chains prefetch their faces' interiors.
+/// How many elements ahead a pass prefetches what it will read: the one-pass edge chains
+/// their faces' interiors, the vertex pass its vertices' edges.
 const PREFETCH_AHEAD: u32 = 24;
 
 /// The colour buffer's three sections.
