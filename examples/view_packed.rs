@@ -7,7 +7,7 @@
 //! It uses nothing of meshpaint's code — only wgpu, glam, bytemuck, crc32fast and image —
 //! so it is the proof that the exported buffers are usable outside meshpaint. With the same
 //! size and camera it renders the same pixels as `meshpaint render FILE` (lit, trilinear;
-//! tests/examples.rs compares them): the camera below is meshpaint's default orbit camera.
+//! tests/app/examples.rs compares them): the camera below is meshpaint's default orbit camera.
 
 use std::path::{Path, PathBuf};
 
@@ -15,7 +15,11 @@ use anyhow::{Context, Result, bail, ensure};
 use glam::{DMat4, DVec3};
 
 /// The shader exactly as meshpaint compiles it: the uniform block first, then mesh colors.
-const WGSL: &str = concat!(include_str!("../shaders/frame.wgsl"), "\n", include_str!("../shaders/mesh_colors.wgsl"));
+const WGSL: &str = concat!(
+    include_str!("../crates/render/shaders/frame.wgsl"),
+    "\n",
+    include_str!("../crates/render/shaders/mesh_colors.wgsl")
+);
 
 /// A packed file's content (docs/FORMAT.md, "Sections").
 pub struct Packed {
@@ -79,7 +83,7 @@ pub fn read_packed(path: &Path) -> Result<Packed> {
     })
 }
 
-/// meshpaint's default orbit camera (src/camera.rs): a sphere around the axis-aligned bounds,
+/// meshpaint's default orbit camera (crates/core/src/camera.rs): a sphere around the axis-aligned bounds,
 /// framed at a 40° vertical field of view with a 10 % margin, near/far around the sphere.
 /// Returns `(render origin, clip_from_world relative to it, unit vector towards the light,
 /// eye relative to the origin)`.

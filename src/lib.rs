@@ -1,57 +1,32 @@
-//! # meshpaint — paint colour directly on triangle meshes with mesh colors
+//! # meshpaint — the application: the editor, the command line and the benchmarks
 //!
-//! Colour lives in *mesh colors* (Yuksel et al. 2010): samples on every vertex, edge
-//! and face of each triangle at a per-face power-of-two resolution `R`, shared along
-//! edges so that painting has no seams and needs no UV map.
+//! Paint colour directly on triangle meshes with *mesh colors* (Yuksel et al. 2010):
+//! samples on every vertex, edge and face of each triangle at a per-face power-of-two
+//! resolution `R`, shared along edges so that painting has no seams and needs no UV map.
 //!
 //! ## Architecture
 //!
-//! The crate is split into a GPU-free core and an application shell. Core modules never
-//! import `wgpu`, `egui` or `winit`; they are exact, deterministic and tested against
-//! independent truths (closed-form counts, brute-force enumeration).
+//! The workspace has three crates; data flows one way, from the core through the renderer
+//! to the application:
 //!
-//! | folder | holds |
-//! |---|---|
-//! | [`mesh`] | [`mesh::scene`] (imported data), [`mesh::import`] (glTF → scene, every bad input refused with a message), [`mesh::formats`] (OBJ / PLY / STL → scene, the same refusals), [`mesh::weld`] (one indexed mesh, bitwise-equal positions merged per instance), [`mesh::topology`] (edges, incidence, boundary / non-manifold, valence), [`mesh::orientation`] (winding consistency, signed volume of closed components) |
-//! | [`colors`] | the mesh-colors core: [`colors::layout`] (sample counts, classification, MIP offsets, filtering), [`colors::format`] (linear RGBA, sRGB, RGBA8 / 16F / 32F), [`colors::store`] (the map-based store with per-face R and dirty tracking), [`colors::resample`] (exact 2× refine / reduce), [`colors::stats`] (the sample budget `info` prints), [`colors::budget`] (the limits every operation that creates samples checks first: counts, memory, packed format, GPU) |
-//! | [`packing`] | [`packing::linear`] (16-byte face records, colour buffer with MIP chains), [`packing::canonical`] (where each chain starts), [`packing::packer`] (store ⇄ linear, eq. 2.5/2.6, rayon; `PackCache` repacks only the chains an edit reaches, lays out anew after resolution changes moving the chains no edit reached, or packs all of them into its old buffers), [`packing::reference`] (the serial packer both are tested against byte for byte), [`packing::unpack`] (linear → store), [`packing::paint_layout`] (paint-mode blocks with slack, dirty ranges), [`packing::sampler`] (the CPU reference sampler, the truth the GPU is tested against), [`packing::file`] (the packed file format) |
-//! | [`paint`] | [`paint::picking`] (obvhs BVH, watertight rays), [`paint::occlusion`] (a CPU depth map of the view: brush occlusion without a ray per sample), [`paint::brush`] (colour / blur / resolution brushes, tools, replay), [`paint::undo`] (per stroke, memory cap; the one write path, `StoreWriter`), [`paint::split`] (that write path split per element for parallel dabs) |
-//! | [`io`] | [`io::document`] (open glTF or packed files into a store; pack for export), [`io::export_gltf`], [`io::bake`] (texture → mesh colors, point bake), [`io::least_squares`] (the bake refined to the least-squares fit of the reconstruction), [`io::autosave`], [`io::subdivide`] (1→4 midpoint split of a scene, budget first) |
-//! | [`atomic_write`] | the one way files are written: temporary file, `sync_all`, rename, directory sync |
-//! | [`memory`] | fresh buffers a document's bulk is written into once (the store's chunks on open, packed colours, the paint layout's bytes): transparent huge pages advised before the first write |
-//! | [`threads`] | the main thread's pool (the editor's UI thread works in it, so a small parallel call does not wait for sleeping workers); background jobs use rayon's global pool |
-//! | [`camera`] | the orbit camera: matrices, framing, pixel rays (shared by render, picking, replay) |
-//! | [`render`] | **GPU**: wgpu context, packed buffers on the GPU, sampling pipelines, readback |
-//! | [`bench`](mod@bench) | **GPU**: the measurements behind `meshpaint bench` (time, size and error, as JSON; [`bench::trade`] every choice's cost and error side by side, [`bench::plot`] its PNG plots; [`bench::extremes`]: the numerical extremes, each against an independent truth with the tolerance its test enforces) |
-//! | [`app`] | **GPU + UI**: the desktop editor (winit, egui, wgpu): window, panels, input, background jobs |
+//! | crate | holds | depends on |
+//! |---|---|---|
+//! | `meshpaint-core` (`crates/core`) | everything that is not drawing: meshes, the mesh-colors layout and store, packing and the packed file, picking, brush and undo, conversion, files (its `lib.rs` has the table of its folders) | no GPU or UI crate |
+//! | `meshpaint-render` (`crates/render`) | the GPU: wgpu context, packed buffers on the GPU, the WGSL sampling pipelines (`crates/render/shaders/`), the UV baseline, readback | core, wgpu |
+//! | `meshpaint` (this crate) | [`app`]: the desktop editor (winit, egui, wgpu): window, panels, input, background jobs; [`bench`](mod@bench): the measurements behind `meshpaint bench` (time, size and error, as JSON; [`bench::trade`] every choice's cost and error side by side, [`bench::plot`] its PNG plots; [`bench::extremes`] the numerical extremes); the binary's command line (`src/cli/`) | core, render, egui, winit, plotters, nv-flip |
 //!
-//! `mesh`, `colors`, `packing`, `paint`, `io`, `camera`, `atomic_write`, `memory` and `threads` are the core: they never import
-//! `wgpu`, `egui` or `winit` (`tests/architecture.rs` checks it).
+//! `app` and `bench` do not import each other: what both need (the PSNR of two images)
+//! lives in the core. The binary (`src/main.rs`) and the editor are the only places where
+//! everything meets.
 //!
 //! ## Data flow
 //!
-//! Data flows one way:
-//!
 //! ```text
-//! load:   file ─ import ─▶ Scene ─ weld ─▶ WeldedMesh ─ topology ─▶ Topology
-//!                                                         │
-//! edit:                         store (maps: vertex / edge / face → samples)
-//!                                                         │ pack (MIP chains)
-//! show:                         linear buffers (face records + colours) ─▶ GPU / export
-//! paint:  cursor → ray → BVH → brush → store → dirty ranges → GPU upload
+//! load:   file ─ import ─▶ Scene ─ weld ─▶ WeldedMesh ─ topology ─▶ Topology      (core)
+//! edit:   store (maps: vertex / edge / face → samples)                            (core)
+//! show:   pack (MIP chains) ─▶ linear buffers ─▶ GPU (render) / export (core)
+//! paint:  cursor → ray → BVH → brush → StoreWriter → store → dirty ranges → GPU upload
 //! ```
-//!
-//! The binary (`src/main.rs`) and the editor ([`app`]) are the only places where everything meets.
 
 pub mod app;
-pub mod atomic_write;
 pub mod bench;
-pub mod camera;
-pub mod colors;
-pub mod io;
-pub mod memory;
-pub mod mesh;
-pub mod packing;
-pub mod paint;
-pub mod render;
-pub mod threads;

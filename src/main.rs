@@ -12,8 +12,8 @@ fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let args = cli::Cli::parse();
     // This thread works in the parallel calls it makes instead of waiting for a pool
-    // (`meshpaint::threads`); if that pool cannot be set up, the global pool still works.
-    if let Err(error) = meshpaint::threads::init() {
+    // (`meshpaint_core::threads`); if that pool cannot be set up, the global pool still works.
+    if let Err(error) = meshpaint_core::threads::init() {
         log::warn!("thread pool: {error}");
     }
     match cli::run(args) {

@@ -1,4 +1,4 @@
-//! Autosave state of the editor, on top of [`crate::io::autosave`]: the settings, the timer,
+//! Autosave state of the editor, on top of [`meshpaint_core::io::autosave`]: the settings, the timer,
 //! the recovery file of the open document and the recovery offer. The editor's autosave
 //! tick, settings and recovery dialog are in [`super::autosave_ui`].
 //!
@@ -9,8 +9,8 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use crate::colors::format::ColorFormat;
-use crate::io::autosave::{self, Autosaver, RecoveryInfo, RecoveryWrite};
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::io::autosave::{self, Autosaver, RecoveryInfo, RecoveryWrite};
 
 use super::document::OpenDocument;
 use super::text::human_bytes;

@@ -4,8 +4,8 @@
 
 use std::time::{Duration, Instant};
 
-use crate::io::autosave;
-use crate::io::document::Source;
+use meshpaint_core::io::autosave;
+use meshpaint_core::io::document::Source;
 
 use super::autosave::{Autosaved, Restoring};
 use super::editor::{Editor, JobOutput};

@@ -1,5 +1,5 @@
 //! The open document as the editor holds it: the [`Document`] (its editable
-//! [`crate::colors::store::ColorStore`]) side by side with its [`GpuMesh`] and picking BVH, and
+//! [`meshpaint_core::colors::store::ColorStore`]) side by side with its [`GpuMesh`] and picking BVH, and
 //! the work that makes one (open a file, the built-in scene) or writes one (save, export).
 //!
 //! Everything here runs on a job's worker thread ([`super::jobs`]); the GPU upload too
@@ -11,14 +11,14 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 
-use crate::camera::BoundingSphere;
-use crate::colors::budget::Budget;
-use crate::colors::format::ColorFormat;
-use crate::io::adaptive::ResolutionRule;
-use crate::io::document::{Document, DocumentError, Source, SourceKind};
-use crate::packing::packer::PackCache;
-use crate::paint::picking::{BvhPreset, MeshBvh};
-use crate::render::{BaselineMesh, Gpu, GpuMesh};
+use meshpaint_core::camera::BoundingSphere;
+use meshpaint_core::colors::budget::Budget;
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::convert::adaptive::ResolutionRule;
+use meshpaint_core::io::document::{Document, DocumentError, Source, SourceKind};
+use meshpaint_core::packing::packer::PackCache;
+use meshpaint_core::paint::picking::{BvhPreset, MeshBvh};
+use meshpaint_render::{BaselineMesh, Gpu, GpuMesh};
 
 use super::jobs::JobContext;
 use super::state::Shown;
@@ -94,7 +94,7 @@ pub fn build_alternate(
         Shown::MeshColors => None,
         Shown::SourceTexture => {
             job.progress(0.1, "reading the source file");
-            let built = match crate::io::document::import_source_scene(source, budget) {
+            let built = match meshpaint_core::io::document::import_source_scene(source, budget) {
                 Ok(Some(scene)) => {
                     job.progress(0.5, "uploading the UV-textured mesh");
                     match gpu.upload_baseline(&scene) {
@@ -110,9 +110,9 @@ pub fn build_alternate(
         }
         Shown::PositionColors => {
             job.progress(0.1, "colouring by position");
-            let store = crate::io::document::position_colored(&document.store, &document.positions);
+            let store = meshpaint_core::io::document::position_colored(&document.store, &document.positions);
             job.progress(0.4, "packing");
-            let built = crate::packing::packer::pack(&store, &document.positions, document.display_format())
+            let built = meshpaint_core::packing::packer::pack(&store, &document.positions, document.display_format())
                 .map_err(|error| format!("{name}: {error}"))
                 .and_then(|packed| gpu.upload(&packed).map_err(|error| format!("{name}: {error}")));
             Some(AlternateView::PositionColors(Box::new(built)))
@@ -211,7 +211,7 @@ pub fn write_packed(document: &Document, format: ColorFormat, path: &Path, job: 
     let packed = document.pack(format).with_context(|| format!("packing for {}", path.display()))?;
     let repack = started.elapsed();
     job.progress(0.6, "writing");
-    crate::packing::file::write_file(path, &packed)?;
+    meshpaint_core::packing::file::write_file(path, &packed)?;
     let bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     job.progress(1.0, "done");
     Ok(Written {
@@ -226,7 +226,7 @@ pub fn write_packed(document: &Document, format: ColorFormat, path: &Path, job: 
 /// Writes `document` tessellated at each face's resolution as a vertex-colour .glb.
 pub fn write_gltf(document: &Document, path: &Path, job: &JobContext) -> Result<Written> {
     job.progress(0.1, "tessellating");
-    let summary = crate::io::export_gltf::write_tessellated_glb(path, &document.positions, &document.store)
+    let summary = meshpaint_core::io::export_gltf::write_tessellated_glb(path, &document.positions, &document.store)
         .with_context(|| format!("exporting {}", path.display()))?;
     job.progress(1.0, "done");
     Ok(Written {

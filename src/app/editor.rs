@@ -1,8 +1,8 @@
 //! The editor's state and its per-frame UI: everything between the window shell
 //! ([`super::window`]) and the library.
 //!
-//! The editor holds the open document (the [`crate::io::document::Document`] with its colour
-//! store side by side with its [`crate::render::GpuMesh`]), the camera, the view settings,
+//! The editor holds the open document (the [`meshpaint_core::io::document::Document`] with its colour
+//! store side by side with its [`meshpaint_render::GpuMesh`]), the camera, the view settings,
 //! the mode, the job runner and the status line. [`Editor::ui`] draws one frame of panels
 //! and the 3D view's area; input is handled in one place, [`super::input`]. It needs no
 //! window, so `tests/app_ui.rs` drives it with egui_kittest.
@@ -13,13 +13,13 @@ use std::time::Duration;
 
 use glam::DVec3;
 
-use crate::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera};
-use crate::colors::format::ColorFormat;
-use crate::colors::layout::Resolution;
-use crate::render::{DrawItem, FilterMode, RenderSettings};
+use meshpaint_core::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera};
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::colors::layout::Resolution;
+use meshpaint_render::{DrawItem, FilterMode, RenderSettings};
 
-use crate::io::document::Source;
-use crate::render::Gpu;
+use meshpaint_core::io::document::Source;
+use meshpaint_render::Gpu;
 
 use super::autosave::{AutosaveState, Autosaved};
 use super::document::{self, AlternateView, OpenDocument, Written};
@@ -54,7 +54,7 @@ pub type PsnrKey = (RenderSettings, [u32; 2], u64);
 #[derive(Debug)]
 pub struct Optimized {
     /// The changes, planned on the store as it was at `generation`.
-    pub plan: crate::paint::optimize::OptimizePlan,
+    pub plan: meshpaint_core::paint::optimize::OptimizePlan,
     /// [`Editor::edit_generation`] when the job started.
     pub generation: u64,
     /// The error bound used.
@@ -99,11 +99,11 @@ pub struct Editor {
     /// Set when the user asked to quit.
     pub quit_requested: bool,
     /// The brush settings (kept between paint sessions).
-    pub brush: crate::paint::brush::BrushSettings,
+    pub brush: meshpaint_core::paint::brush::BrushSettings,
     /// Paint mode's state while it is on.
     pub paint: Option<PaintSession>,
     /// Undo / redo of paint mode, one step per stroke (cleared when another document opens).
-    pub history: crate::paint::undo::UndoHistory,
+    pub history: meshpaint_core::paint::undo::UndoHistory,
     /// The GPU mesh holds the paint layout (level 0 only): the filter is limited to level 0.
     pub gpu_paint_layout: bool,
     /// Bytes uploaded to the GPU during the previous frame.
@@ -120,8 +120,8 @@ pub struct Editor {
     /// measured in (render settings, view size, scene generation).
     pub source_psnr: Option<(PsnrKey, Result<f64, String>)>,
     /// A memory budget that replaces the machine's (tests set a small one; `None`:
-    /// [`crate::colors::budget::Budget::from_environment`]).
-    pub budget_override: Option<crate::colors::budget::Budget>,
+    /// [`meshpaint_core::colors::budget::Budget::from_environment`]).
+    pub budget_override: Option<meshpaint_core::colors::budget::Budget>,
     /// Autosave settings and state.
     pub autosave: AutosaveState,
     /// A load error to report once the built-in scene has replaced a failed start-up file.
@@ -145,7 +145,7 @@ impl Editor {
     /// An editor with no document. `waker` is called from worker threads to request a
     /// repaint (progress, completion).
     pub fn new(gpu: Option<Arc<Gpu>>, waker: Waker) -> Self {
-        let sphere = crate::camera::BoundingSphere { center: [0.0; 3], radius: 1.0 };
+        let sphere = meshpaint_core::camera::BoundingSphere { center: [0.0; 3], radius: 1.0 };
         Editor {
             gpu,
             document: None,
@@ -167,9 +167,9 @@ impl Editor {
             scene_generation: 0,
             viewport_pointer: None,
             quit_requested: false,
-            brush: crate::paint::brush::BrushSettings::default(),
+            brush: meshpaint_core::paint::brush::BrushSettings::default(),
             paint: None,
-            history: crate::paint::undo::UndoHistory::new(crate::paint::undo::DEFAULT_CAP_BYTES),
+            history: meshpaint_core::paint::undo::UndoHistory::new(meshpaint_core::paint::undo::DEFAULT_CAP_BYTES),
             gpu_paint_layout: false,
             upload_bytes_last_frame: 0,
             upload_bytes_this_frame: 0,
@@ -238,8 +238,8 @@ impl Editor {
 
     /// The budget every R-changing operation checks first: this machine's, with the GPU's
     /// limits when there is a GPU.
-    pub fn budget(&self) -> crate::colors::budget::Budget {
-        let budget = self.budget_override.unwrap_or_else(crate::colors::budget::Budget::from_environment);
+    pub fn budget(&self) -> meshpaint_core::colors::budget::Budget {
+        let budget = self.budget_override.unwrap_or_else(meshpaint_core::colors::budget::Budget::from_environment);
         match &self.gpu {
             Some(gpu) => budget.with_gpu(gpu.budget_limits()),
             None => budget,
@@ -327,7 +327,7 @@ impl Editor {
                 // Untextured documents start at the lowest R where nothing is painted, and
                 // resolution follows the brush there; textured ones keep the chosen R.
                 self.brush.follow_resolution =
-                    (!document.document.textured).then_some(crate::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
+                    (!document.document.textured).then_some(meshpaint_core::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
                 self.autosave.document_opened(&mut document, self.edit_generation);
                 self.document = Some(document);
                 self.scene_generation += 1;
@@ -623,7 +623,7 @@ impl Editor {
         let settings = self.render_settings();
         let render = |item| gpu.render_image(item, &settings, w, h).map_err(|error| error.to_string());
         Some(render(DrawItem::MeshColors(mesh)).and_then(|ours| {
-            render(DrawItem::Baseline(baseline)).map(|theirs| crate::bench::adaptive::psnr(&ours, &theirs))
+            render(DrawItem::Baseline(baseline)).map(|theirs| meshpaint_core::colors::psnr::psnr(&ours, &theirs))
         }))
     }
 

@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::colors::format::ColorFormat;
+use meshpaint_core::colors::format::ColorFormat;
 
 use super::import_settings::ImportSettings;
 

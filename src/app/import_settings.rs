@@ -1,8 +1,8 @@
 //! How the editor gives an opened mesh its face resolutions: the choice in the open dialog
-//! (and the file panel), turned into one [`ResolutionRule`] of [`crate::io::adaptive`].
+//! (and the file panel), turned into one [`ResolutionRule`] of [`meshpaint_core::convert::adaptive`].
 
-use crate::colors::layout::Resolution;
-use crate::io::adaptive::ResolutionRule;
+use meshpaint_core::colors::layout::Resolution;
+use meshpaint_core::convert::adaptive::ResolutionRule;
 
 /// The kinds of choice the open dialog offers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -7,7 +7,7 @@
 
 use egui::{Key, Modifiers, PointerButton};
 
-use crate::render::{FilterMode, Shading};
+use meshpaint_render::{FilterMode, Shading};
 
 use super::editor::Editor;
 use super::file_dialog::DialogPurpose;
@@ -212,7 +212,7 @@ pub fn global_input(editor: &mut Editor, ctx: &egui::Context) {
     let dropped: Vec<std::path::PathBuf> =
         ctx.input(|i| i.raw.dropped_files.iter().map(|file| file.path().to_owned()).collect());
     if let Some(path) = dropped.into_iter().next() {
-        editor.open(crate::io::document::Source::File(path));
+        editor.open(meshpaint_core::io::document::Source::File(path));
     }
     if editor.gesture_input(ctx) {
         return;

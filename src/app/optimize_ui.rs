@@ -4,7 +4,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::paint::optimize;
+use meshpaint_core::paint::optimize;
 
 use super::editor::{Editor, JobOutput, Optimized};
 use super::jobs::JobKind;

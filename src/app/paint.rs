@@ -4,21 +4,21 @@
 //! the brush cursor.
 //!
 //! Entering paint mode switches the GPU mesh to the paint layout
-//! ([`crate::packing::paint_layout::PaintLayout`], level 0 only); leaving repacks the store into the
+//! ([`meshpaint_core::packing::paint_layout::PaintLayout`], level 0 only); leaving repacks the store into the
 //! compact layout with MIP chains on a worker thread ([`Editor::leave_paint_mode`]).
 
 use std::sync::Arc;
 use std::time::Instant;
 
-use crate::colors::layout::Resolution;
-use crate::colors::store::{ColorStore, DirtyAccumulator};
-use crate::packing::packer::PackCache;
-use crate::packing::paint_layout::PaintLayout;
-use crate::paint::brush::{
+use meshpaint_core::colors::layout::Resolution;
+use meshpaint_core::colors::store::{ColorStore, DirtyAccumulator};
+use meshpaint_core::packing::packer::PackCache;
+use meshpaint_core::packing::paint_layout::PaintLayout;
+use meshpaint_core::paint::brush::{
     self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, ResolutionOp, StrokeUpdate,
     Tool,
 };
-use crate::paint::undo::UndoHistory;
+use meshpaint_core::paint::undo::UndoHistory;
 
 use super::editor::{Editor, JobOutput};
 use super::jobs::JobKind;
@@ -127,7 +127,7 @@ impl Editor {
             // Only the chains the session changed when no resolution changed; else a new
             // layout in the old packing's buffers, with the chains no edit reached moved
             // into it; all of them when the format changed.
-            let failed = |error: crate::packing::PackError| format!("repacking failed: {error}");
+            let failed = |error: meshpaint_core::packing::PackError| format!("repacking failed: {error}");
             let (store, positions) = (&document.store, &document.positions);
             let (cache, ranges, how) = match cache {
                 Some(mut cache) if cache.packed().format == format => match cache.update(store, &dirty) {
@@ -141,7 +141,7 @@ impl Editor {
             job.progress(0.7, "uploading to the GPU");
             let packed = cache.packed();
             let upload_error =
-                |error: crate::render::RenderError| format!("uploading the repacked buffers failed: {error}");
+                |error: meshpaint_render::RenderError| format!("uploading the repacked buffers failed: {error}");
             let gpu_mesh = match (gpu, compact_gpu_mesh, &ranges) {
                 (Some(gpu), Some(mesh), Some(ranges)) => {
                     let size = packed.format.bytes_per_sample();
@@ -351,7 +351,7 @@ impl Editor {
         match picked {
             Some(color) => {
                 self.brush.color = color;
-                let [r, g, b, _] = color.map(crate::colors::format::encode_srgb8);
+                let [r, g, b, _] = color.map(meshpaint_core::colors::format::encode_srgb8);
                 self.set_status(Severity::Info, format!("Picked colour #{r:02x}{g:02x}{b:02x}"));
             }
             None => self.set_status(Severity::Info, "Eyedropper: nothing under the cursor."),
@@ -521,7 +521,7 @@ impl Editor {
             let radius = self.brush_radius_points(None);
             painter.circle_stroke(pos, radius, shadow);
             painter.circle_stroke(pos, radius, stroke);
-            let [r, g, b, _] = self.brush.color.map(crate::colors::format::encode_srgb8);
+            let [r, g, b, _] = self.brush.color.map(meshpaint_core::colors::format::encode_srgb8);
             painter.circle_filled(pos, 2.5, egui::Color32::from_rgb(r, g, b));
         }
     }
@@ -645,7 +645,7 @@ fn brush_settings_ui(ui: &mut egui::Ui, brush: &mut BrushSettings, bounds_radius
         if egui::color_picker::color_edit_button_rgba(ui, &mut color, egui::color_picker::Alpha::OnlyBlend).changed() {
             brush.color = color.to_rgba_unmultiplied();
         }
-        let [r, g, b, _] = brush.color.map(crate::colors::format::encode_srgb8);
+        let [r, g, b, _] = brush.color.map(meshpaint_core::colors::format::encode_srgb8);
         ui.label(egui::RichText::new(format!("#{r:02x}{g:02x}{b:02x}")).monospace().weak());
     });
     ui.horizontal(|ui| {
@@ -706,7 +706,7 @@ fn brush_settings_ui(ui: &mut egui::Ui, brush: &mut BrushSettings, bounds_radius
     let mut follow = brush.follow_resolution.is_some();
     ui.checkbox(&mut follow, "Resolution follows the brush")
         .on_hover_text("Raise the faces under each dab to the R that resolves the brush (spacing at most a quarter of the radius, R up to 64)");
-    brush.follow_resolution = follow.then_some(crate::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
+    brush.follow_resolution = follow.then_some(meshpaint_core::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
 }
 
 /// A labelled combo box of resolutions 1 … 64.

@@ -5,12 +5,12 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::colors::store::{ColorStore, DirtyAccumulator};
-use crate::io::document::Document;
-use crate::packing::packer::PackCache;
-use crate::packing::paint_layout::{EncodedBuffer, PaintLayout};
-use crate::paint::brush::{self, Painter};
-use crate::render::GpuMesh;
+use meshpaint_core::colors::store::{ColorStore, DirtyAccumulator};
+use meshpaint_core::io::document::Document;
+use meshpaint_core::packing::packer::PackCache;
+use meshpaint_core::packing::paint_layout::{EncodedBuffer, PaintLayout};
+use meshpaint_core::paint::brush::{self, Painter};
+use meshpaint_render::GpuMesh;
 
 /// Points of pointer travel for strength 0 → 1 in the Shift+F gesture.
 pub const STRENGTH_GESTURE_POINTS: f32 = 200.0;

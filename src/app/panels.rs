@@ -1,7 +1,7 @@
 //! The editor's panels: menu bar, side panel (file, view, scene), status line, help
 //! window and the 3D view's area. [`Editor::ui`] lays out one frame.
 
-use crate::render::{FilterMode, RenderSettings, Shading};
+use meshpaint_render::{FilterMode, RenderSettings, Shading};
 
 use super::editor::{Editor, PsnrKey};
 use super::input::{self, POINTER_HELP, SHORTCUTS, shortcut_text};
@@ -382,7 +382,7 @@ impl Editor {
                 painter.image(texture, rect, uv, egui::Color32::WHITE);
             }
             _ => {
-                let [r, g, b, _] = RenderSettings::DEFAULT_BACKGROUND.map(crate::colors::format::encode_srgb8);
+                let [r, g, b, _] = RenderSettings::DEFAULT_BACKGROUND.map(meshpaint_core::colors::format::encode_srgb8);
                 painter.rect_filled(rect, 0.0, egui::Color32::from_rgb(r, g, b));
                 let text = if self.jobs.is_busy() {
                     "Loading…"

@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use crate::render::{FilterMode, Overlays, Shading};
+use meshpaint_render::{FilterMode, Overlays, Shading};
 
 /// What the editor is doing with the pointer in the 3D view. Paint mode (Tab) slots in
 /// here: its tools get the pointer in [`super::input::viewport_input`], edit the document's

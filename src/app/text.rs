@@ -17,10 +17,10 @@ pub fn error_text(error: &anyhow::Error) -> String {
 
 /// `1234567` → `1,234,567`.
 pub fn thousands(value: u64) -> String {
-    crate::colors::budget::thousands_with(value, ',')
+    meshpaint_core::colors::budget::thousands_with(value, ',')
 }
 
 /// `bytes` as B / KiB / MiB / GiB / TiB with one decimal (the budget messages' format).
 pub fn human_bytes(bytes: u64) -> String {
-    crate::colors::budget::bytes_text(bytes)
+    meshpaint_core::colors::budget::bytes_text(bytes)
 }

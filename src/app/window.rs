@@ -24,11 +24,11 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::window::{Window, WindowId};
 
-use crate::render::{DEPTH_FORMAT, GpuContext, OFFSCREEN_FORMAT, RenderTarget, Renderer};
+use meshpaint_render::{DEPTH_FORMAT, GpuContext, OFFSCREEN_FORMAT, RenderTarget, Renderer};
 
 use super::editor::Editor;
-use crate::io::document::Source;
-use crate::render::Gpu;
+use meshpaint_core::io::document::Source;
+use meshpaint_render::Gpu;
 
 /// How the application starts.
 #[derive(Debug, Clone, Default)]
@@ -143,7 +143,7 @@ struct Running {
     editor: Editor,
     last_logged_viewport: Option<([i32; 2], [u32; 2])>,
     /// What the 3D view's target holds: it is redrawn only when this changes.
-    drawn_view: Option<(crate::render::RenderSettings, super::state::Shown, [u32; 2], u64)>,
+    drawn_view: Option<(meshpaint_render::RenderSettings, super::state::Shown, [u32; 2], u64)>,
     /// UI passes run so far, and where to write that count after each one
     /// (`MESHPAINT_FRAME_COUNT_FILE`, for the idle test: at rest the count must not grow).
     frame_count: (u64, Option<std::path::PathBuf>),
@@ -161,7 +161,7 @@ impl Shell {
 
         let mut descriptor =
             wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(event_loop.owned_display_handle()));
-        descriptor.backends = crate::render::backends_from_env();
+        descriptor.backends = meshpaint_render::backends_from_env();
         let instance = wgpu::Instance::new(descriptor);
         let surface = instance.create_surface(Arc::clone(&window)).context("creating the window surface")?;
         let ctx = Arc::new(pollster::block_on(GpuContext::with_instance(instance, Some(&surface)))?);

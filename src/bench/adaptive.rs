@@ -23,14 +23,15 @@ use std::time::Instant;
 
 use image::RgbaImage;
 
-use crate::camera::default_camera;
-use crate::colors::format::ColorFormat;
-use crate::colors::layout::Resolution;
-use crate::io::adaptive::ResolutionRule;
-use crate::io::document::{Document, OpenPhases};
-use crate::io::least_squares::BakeFit;
-use crate::mesh::scene::Scene;
-use crate::render::{DrawItem, FilterMode, Gpu, RenderSettings, Shading};
+use meshpaint_core::camera::default_camera;
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::colors::layout::Resolution;
+use meshpaint_core::colors::psnr::psnr;
+use meshpaint_core::convert::adaptive::ResolutionRule;
+use meshpaint_core::convert::least_squares::BakeFit;
+use meshpaint_core::io::document::{Document, OpenPhases};
+use meshpaint_core::mesh::scene::Scene;
+use meshpaint_render::{DrawItem, FilterMode, Gpu, RenderSettings, Shading};
 
 use super::BenchRenderError;
 
@@ -167,7 +168,7 @@ pub fn bench_adaptive(
             rule,
             fit,
             path,
-            &crate::colors::budget::Budget::from_environment(),
+            &meshpaint_core::colors::budget::Budget::from_environment(),
             &mut OpenPhases::default(),
         )?;
         let convert_seconds = started.elapsed().as_secs_f64();
@@ -232,7 +233,7 @@ pub fn render_supersampled(
     item: DrawItem<'_>,
     settings: &RenderSettings,
     size: u32,
-) -> Result<Supersampled, crate::render::RenderError> {
+) -> Result<Supersampled, meshpaint_render::RenderError> {
     render_supersampled_by(gpu, item, settings, size, SUPERSAMPLE)
 }
 
@@ -244,7 +245,7 @@ pub fn render_supersampled_by(
     settings: &RenderSettings,
     size: u32,
     supersample: u32,
-) -> Result<Supersampled, crate::render::RenderError> {
+) -> Result<Supersampled, meshpaint_render::RenderError> {
     let supersample = supersample.max(1);
     let big = size * supersample;
     Ok(box_down(&gpu.render_image(item, settings, big, big)?, supersample))
@@ -273,47 +274,22 @@ fn box_down(image: &RgbaImage, factor: u32) -> Supersampled {
     Supersampled { image, interior }
 }
 
-/// PSNR in dB over RGB of the pixels either image covers (alpha > 0); `inf` when equal.
-pub fn psnr(a: &RgbaImage, b: &RgbaImage) -> f64 {
-    let covered: Vec<bool> = a.pixels().zip(b.pixels()).map(|(pa, pb)| pa.0[3] > 0 || pb.0[3] > 0).collect();
-    psnr_over(a, b, &covered)
-}
-
-/// PSNR in dB over RGB of the pixels where `mask` (row-major) is true; `inf` when they are
-/// equal there or the mask is empty.
-pub fn psnr_over(a: &RgbaImage, b: &RgbaImage, mask: &[bool]) -> f64 {
-    let (mut sum, mut count) = (0.0f64, 0u64);
-    for ((pa, pb), &keep) in a.pixels().zip(b.pixels()).zip(mask) {
-        if !keep {
-            continue;
-        }
-        for c in 0..3 {
-            sum += (f64::from(pa.0[c]) - f64::from(pb.0[c])).powi(2);
-        }
-        count += 3;
-    }
-    if count == 0 || sum == 0.0 {
-        return f64::INFINITY;
-    }
-    10.0 * (255.0f64 * 255.0 / (sum / count as f64)).log10()
-}
-
 /// Texels the UV islands of `scene` cover in their base-colour textures (per texture, UVs
 /// wrapped; texels several faces cover count once), summed over the textures.
 pub fn uv_island_texels(scene: &Scene) -> u64 {
-    uv_texels(scene, |faces, size| crate::io::bake_uv::uv_island_texels(faces, size))
+    uv_texels(scene, |faces, size| meshpaint_core::convert::bake_uv::uv_island_texels(faces, size))
 }
 
 /// Texels the faces of `scene` show: as [`uv_island_texels`], but a texel counts once per
-/// face that maps it ([`crate::io::bake_uv::uv_face_texels`]); larger where UV islands
+/// face that maps it ([`meshpaint_core::convert::bake_uv::uv_face_texels`]); larger where UV islands
 /// overlap (BoxTextured: each of the 6 sides maps the whole texture).
 pub fn uv_face_texels(scene: &Scene) -> u64 {
-    uv_texels(scene, |faces, size| crate::io::bake_uv::uv_face_texels(faces, size))
+    uv_texels(scene, |faces, size| meshpaint_core::convert::bake_uv::uv_face_texels(faces, size))
 }
 
 /// `count(faces of each base-colour texture, its size)` summed over the textures.
 fn uv_texels(scene: &Scene, count: impl Fn(Vec<&[[f32; 2]; 3]>, [u32; 2]) -> u64) -> u64 {
-    let welded = crate::mesh::weld::weld_scene(scene);
+    let welded = meshpaint_core::mesh::weld::weld_scene(scene);
     let texture_of = |material: &Option<u32>| {
         material.and_then(|m| scene.materials.get(m as usize)).and_then(|m| m.base_color_texture)
     };

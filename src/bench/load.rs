@@ -1,13 +1,13 @@
 //! `meshpaint bench load`: the seconds from a mesh file to the document on screen and on to
 //! the first frame in paint mode, phase by phase, on the editor's own opening path
-//! ([`crate::app::document::load`] does the same: pack and upload in parallel with the
-//! picking BVH), and the peak memory.
+//! ([`meshpaint_core::io::display::open_for_display`], which the editor opens with: pack and
+//! upload in parallel with the picking BVH), and the peak memory.
 //!
 //! Phases: import (read and parse), subdivide (only with `--subdivide N`, not counted in
 //! the total: it stands in for a larger file), weld, topology, store (allocate and colour),
 //! then pack + upload next to the BVH build (both branches timed; the total counts the
 //! wall time of the pair), and one rendered frame: `total_seconds`, the document on screen.
-//! Then what Tab does in the editor ([`crate::render::Gpu::upload_paint_layout`], the same
+//! Then what Tab does in the editor ([`meshpaint_render::Gpu::upload_paint_layout`], the same
 //! call): enter paint mode (paint layout, its upload, the base snapshot of the store) and
 //! the first frame of it: `total_to_paint_seconds`, the first frame a brush can touch. The
 //! peak memory is read twice: with the document on screen (`peak_resident_on_screen_bytes`)
@@ -19,15 +19,14 @@ use std::time::{Duration, Instant};
 
 use thiserror::Error;
 
-use crate::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, default_camera};
-use crate::colors::budget::{Budget, BudgetError};
-use crate::colors::layout::Resolution;
-use crate::io::document::{Document, DocumentError, OpenPhases, import_scene_within};
-use crate::io::least_squares::BakeFit;
-use crate::packing::packer::{PackCache, PackError};
-use crate::packing::paint_layout::PaintLayout;
-use crate::paint::picking::{BvhPreset, MeshBvh};
-use crate::render::{DrawItem, Gpu, RenderError, RenderSettings};
+use meshpaint_core::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, default_camera};
+use meshpaint_core::colors::budget::{Budget, BudgetError};
+use meshpaint_core::colors::layout::Resolution;
+use meshpaint_core::io::display::{Displayed, OpenError, OpenOptions, open_for_display};
+use meshpaint_core::io::document::{DocumentError, Source};
+use meshpaint_core::packing::packer::PackError;
+use meshpaint_core::packing::paint_layout::PaintLayout;
+use meshpaint_render::{DrawItem, Gpu, RenderError, RenderSettings};
 
 /// Errors of the load benchmark.
 #[derive(Debug, Error)]
@@ -44,6 +43,15 @@ pub enum BenchLoadError {
     /// The GPU failed.
     #[error(transparent)]
     Render(#[from] RenderError),
+}
+
+impl From<OpenError<RenderError>> for BenchLoadError {
+    fn from(error: OpenError<RenderError>) -> Self {
+        match error {
+            OpenError::Document(error) => error.into(),
+            OpenError::Upload { source, .. } => source.into(),
+        }
+    }
 }
 
 /// Peak resident memory of this process so far (`VmHWM` of `/proc/self/status`), bytes;
@@ -70,39 +78,16 @@ pub fn bench_load(
     let gpu_seconds = gpu_started.elapsed().as_secs_f64();
     let budget = (*budget).with_gpu(gpu.budget_limits());
     let started = Instant::now();
-    let (scene, kind) = import_scene_within(path, &budget)?;
-    let import = started.elapsed();
-    let subdivide_started = Instant::now();
-    let scene = if subdivide > 0 { crate::io::subdivide::subdivide_scene(&scene, subdivide, &budget)? } else { scene };
-    let subdivide_time = subdivide_started.elapsed();
-    let mut phases = OpenPhases::default();
-    let mut document = Document::from_scene_phased(scene, resolution, BakeFit::default(), path, &budget, &mut phases)?;
-    document.source = kind;
+    let options = OpenOptions { rule: resolution.into(), subdivide, budget };
+    let source = Source::File(path.to_owned());
+    let displayed = open_for_display(&source, &options, &|_, _| {}, |packed| gpu.upload(packed))?;
+    let Displayed { document, cache, bvh, upload: mesh, timings } = displayed;
     let format = document.display_format();
-    let parallel_started = Instant::now();
-    let (packed, (bvh, bvh_time)) = rayon::join(
-        || -> Result<_, BenchLoadError> {
-            let started = Instant::now();
-            let cache = PackCache::build(&document.store, &document.positions, format)?;
-            let pack = started.elapsed();
-            let started = Instant::now();
-            let mesh = gpu.upload(cache.packed())?;
-            Ok((cache, mesh, pack, started.elapsed()))
-        },
-        || {
-            let started = Instant::now();
-            let bvh =
-                MeshBvh::build(&document.positions, &document.store.topology().face_vertices, BvhPreset::FastBuild);
-            (bvh, started.elapsed())
-        },
-    );
-    let (cache, mesh, pack_time, upload_time) = packed?;
-    let parallel = parallel_started.elapsed();
     let frame_started = Instant::now();
     let settings = RenderSettings::new(default_camera(mesh.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None));
     let image = gpu.render_image(DrawItem::MeshColors(&mesh), &settings, width, height)?;
     let frame = frame_started.elapsed();
-    let total = started.elapsed().saturating_sub(subdivide_time);
+    let total = started.elapsed().saturating_sub(timings.subdivide);
     let peak_on_screen = peak_resident_bytes();
     // Tab: entering paint mode as the editor does (paint layout, its upload, the base
     // snapshot of the store), then the first frame that shows it.
@@ -114,7 +99,7 @@ pub fn bench_load(
     let paint_frame_started = Instant::now();
     let paint_image = gpu.render_image(DrawItem::MeshColors(&paint.mesh), &settings, width, height)?;
     let paint_frame = paint_frame_started.elapsed();
-    let total_to_paint = started.elapsed().saturating_sub(subdivide_time);
+    let total_to_paint = started.elapsed().saturating_sub(timings.subdivide);
     // The same frame again: drawing alone (the first one also ran the upload's GPU copies).
     let redraw_started = Instant::now();
     let redraw = gpu.render_image(DrawItem::MeshColors(&paint.mesh), &settings, width, height)?;
@@ -133,15 +118,15 @@ pub fn bench_load(
         "threads": rayon::current_num_threads(),
         "gpu_init_seconds": gpu_seconds,
         "phases": {
-            "import_seconds": seconds(import),
-            "subdivide_seconds": seconds(subdivide_time),
-            "weld_seconds": seconds(phases.weld),
-            "topology_seconds": seconds(phases.topology),
-            "store_seconds": seconds(phases.store),
-            "pack_seconds": seconds(pack_time),
-            "upload_seconds": seconds(upload_time),
-            "bvh_seconds": seconds(bvh_time),
-            "pack_upload_bvh_wall_seconds": seconds(parallel),
+            "import_seconds": seconds(timings.import),
+            "subdivide_seconds": seconds(timings.subdivide),
+            "weld_seconds": seconds(timings.phases.weld),
+            "topology_seconds": seconds(timings.phases.topology),
+            "store_seconds": seconds(timings.phases.store),
+            "pack_seconds": seconds(timings.pack),
+            "upload_seconds": seconds(timings.upload),
+            "bvh_seconds": seconds(timings.bvh),
+            "pack_upload_bvh_wall_seconds": seconds(timings.pack_upload_bvh),
             "first_frame_seconds": seconds(frame),
             "enter_paint_seconds": seconds(enter_paint),
             "paint_frame_seconds": seconds(paint_frame),

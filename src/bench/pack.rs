@@ -7,11 +7,12 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
-use crate::colors::format::{ColorFormat, Rgba};
-use crate::colors::store::ColorStore;
-use crate::io::document::Document;
-use crate::packing::linear::PackedMesh;
-use crate::packing::packer::{PackCache, PackError};
+use meshpaint_core::colors::format::{ColorFormat, Rgba};
+use meshpaint_core::colors::store::ColorStore;
+use meshpaint_core::io::document::Document;
+use meshpaint_core::packing::linear::PackedMesh;
+use meshpaint_core::packing::packer::{PackCache, PackError};
+use meshpaint_core::paint::undo::{StoreWriter, UndoHistory};
 
 /// Best and median of repeated timings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -245,35 +246,39 @@ pub fn bench_incremental(
     runs: usize,
     target_samples: u64,
 ) -> Result<IncrementalBench, PackError> {
-    use crate::colors::store::SampleRef;
+    use meshpaint_core::colors::store::SampleRef;
     let mut store = document.store.clone();
     let positions = &document.positions;
     let topology = store.topology().clone();
-    let mut cache = crate::packing::packer::PackCache::build(&store, positions, format)?;
+    let mut cache = meshpaint_core::packing::packer::PackCache::build(&store, positions, format)?;
     let (mut samples_changed, mut faces_painted) = (0u64, 0u64);
     let color = [0.8, 0.1, 0.3, 1.0];
+    // Through the one write path, as the editor's tools write (no undo step open).
+    let mut history = UndoHistory::new(0);
+    let mut writer = StoreWriter::new(&mut store, &mut history);
     for face in faces_around_the_middle(document) {
         if samples_changed >= target_samples {
             break;
         }
         faces_painted += 1;
         for &v in &topology.face_vertices[face as usize] {
-            samples_changed += u64::from(store.set(SampleRef::Vertex(v), color));
+            samples_changed += u64::from(writer.set(SampleRef::Vertex(v), color));
         }
         for &edge in &topology.face_edges[face as usize] {
-            for offset in 0..store.edge_samples(edge).len() as u32 {
-                samples_changed += u64::from(store.set(SampleRef::Edge { edge, offset }, color));
+            for offset in 0..writer.store().edge_samples(edge).len() as u32 {
+                samples_changed += u64::from(writer.set(SampleRef::Edge { edge, offset }, color));
             }
         }
-        for offset in 0..store.interior_samples(face).len() as u32 {
-            samples_changed += u64::from(store.set(SampleRef::Interior { face, offset }, color));
+        for offset in 0..writer.store().interior_samples(face).len() as u32 {
+            samples_changed += u64::from(writer.set(SampleRef::Interior { face, offset }, color));
         }
     }
     let dirty = store.take_dirty();
     // Repeated updates with the same edit redo the same work (the result is the same).
     let (repack, ranges) = Timing::measure(runs, || cache.update(&store, &dirty));
     let samples_rewritten = ranges.unwrap_or_default().iter().map(|&(_, n)| n).sum();
-    let (full, packed) = Timing::measure(runs.min(3), || crate::packing::packer::pack(&store, positions, format));
+    let (full, packed) =
+        Timing::measure(runs.min(3), || meshpaint_core::packing::packer::pack(&store, positions, format));
     Ok(IncrementalBench {
         faces_painted,
         samples_changed,
@@ -351,12 +356,14 @@ pub fn bench_relayout(
     let cache = PackCache::build(&store, positions, format)?;
     let before = store.sample_count();
     let mut faces_resized = 0u64;
+    let mut history = UndoHistory::new(0);
+    let mut writer = StoreWriter::new(&mut store, &mut history);
     for face in faces_around_the_middle(document) {
-        if store.sample_count() - before >= target_samples {
+        if writer.store().sample_count() - before >= target_samples {
             break;
         }
-        let raised = store.face_resolution(face).and_then(|r| r.doubled());
-        if raised.is_some_and(|r| store.set_face_resolution(face, r).is_ok()) {
+        let raised = writer.store().face_resolution(face).and_then(|r| r.doubled());
+        if raised.is_some_and(|r| writer.set_face_resolution(face, r).is_ok()) {
             faces_resized += 1;
         }
     }
@@ -372,7 +379,7 @@ pub fn bench_relayout(
         target.copy_from_slice(std::hint::black_box(&source));
         std::hint::black_box(&mut target);
     });
-    let full = crate::packing::packer::pack(&store, positions, format)?;
+    let full = meshpaint_core::packing::packer::pack(&store, positions, format)?;
     Ok(RelayoutBench {
         faces_resized,
         samples_added,

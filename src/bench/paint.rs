@@ -11,16 +11,18 @@ use std::time::Instant;
 use glam::DVec3;
 
 use crate::bench::pack::Timing;
-use crate::camera::{BoundingSphere, DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera, default_camera};
-use crate::colors::format::ColorFormat;
-use crate::colors::store::ColorStore;
-use crate::io::document::Document;
-use crate::packing::linear::FaceRecord;
-use crate::packing::paint_layout::PaintLayout;
-use crate::paint::brush::{BlendMode, BrushError, BrushSettings, Falloff, PaintView, Painter, Tool, samples_within};
-use crate::paint::picking::{BvhPreset, MeshBvh};
-use crate::paint::undo::UndoHistory;
-use crate::render::Gpu;
+use meshpaint_core::camera::{BoundingSphere, DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera, default_camera};
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::colors::store::ColorStore;
+use meshpaint_core::io::document::Document;
+use meshpaint_core::packing::linear::FaceRecord;
+use meshpaint_core::packing::paint_layout::PaintLayout;
+use meshpaint_core::paint::brush::{
+    BlendMode, BrushError, BrushSettings, Falloff, PaintView, Painter, Tool, samples_within,
+};
+use meshpaint_core::paint::picking::{BvhPreset, MeshBvh};
+use meshpaint_core::paint::undo::UndoHistory;
+use meshpaint_render::Gpu;
 
 /// Options of [`bench_paint`].
 #[derive(Debug, Clone, PartialEq)]
@@ -160,20 +162,20 @@ pub fn bench_paint(document: &Document, options: &PaintBenchOptions) -> Result<s
     let repack = everything.then(|| {
         let (timing, packed) = Timing::measure(options.pack_runs, || document.pack(ColorFormat::Rgba8Srgb));
         let bytes = packed.map(|p| p.face_record_bytes() + p.color_bytes()).unwrap_or(0);
-        serde_json::json!({ "timing": timing.to_json(), "bytes": bytes, "threads": crate::packing::packer::pack_threads() })
+        serde_json::json!({ "timing": timing.to_json(), "bytes": bytes, "threads": meshpaint_core::packing::packer::pack_threads() })
     });
     Ok(serde_json::json!({
         "bench": "paint",
         "triangles": document.store.topology().face_count(),
         "samples": document.store.sample_count(),
-        "threads": rayon::current_num_threads(), "caller_in_pool": crate::threads::caller_in_pool(),
+        "threads": rayon::current_num_threads(), "caller_in_pool": meshpaint_core::threads::caller_in_pool(),
         "viewport_px": options.viewport_px,
         "headline": headline,
         "occlusion_depth_map": {
             "build_seconds": depth_timing.best_seconds,
             "maps_built": built,
             "pixels": u64::from(width) * u64::from(height),
-            "tolerance_px": crate::paint::occlusion::DEPTH_TOLERANCE_PX,
+            "tolerance_px": meshpaint_core::paint::occlusion::DEPTH_TOLERANCE_PX,
         },
         "bvh_presets": presets,
         "pick_latency": pick_timing.to_json(),
@@ -335,7 +337,7 @@ fn measure_dabs(
     (dabs, gap): (usize, Option<std::time::Duration>),
     step_per_dab: bool,
 ) -> Result<serde_json::Value, BrushError> {
-    let mut history = UndoHistory::new(crate::paint::undo::DEFAULT_CAP_BYTES);
+    let mut history = UndoHistory::new(meshpaint_core::paint::undo::DEFAULT_CAP_BYTES);
     store.take_dirty();
     let (mut times, mut sync_times) = (Vec::new(), Vec::new());
     let (mut covered, mut upload_bytes, mut upload_ranges) = (0, 0, 0);
@@ -395,7 +397,7 @@ fn upload_like_the_editor(layout: &mut PaintLayout, store: &mut ColorStore) -> (
 
 /// Times `dabs` dabs of `settings` (the editor's defaults) at `sphere` as the editor runs
 /// them, each followed by the paint-mode upload it triggers ([`PaintLayout::sync`],
-/// [`crate::packing::paint_layout::EncodedBuffer::apply`], [`crate::render::GpuMesh::write_paint_upload`] and the
+/// [`meshpaint_core::packing::paint_layout::EncodedBuffer::apply`], [`meshpaint_render::GpuMesh::write_paint_upload`] and the
 /// queue submitted and waited for): the dab, the encode and the GPU write apart, and the
 /// samples per second of the whole.
 fn measure_gpu_upload(
@@ -413,7 +415,7 @@ fn measure_gpu_upload(
         Ok(upload) => (upload.mesh, upload.encoded),
         Err(error) => return Ok(serde_json::json!({ "skipped": error.to_string() })),
     };
-    let mut history = UndoHistory::new(crate::paint::undo::DEFAULT_CAP_BYTES);
+    let mut history = UndoHistory::new(meshpaint_core::paint::undo::DEFAULT_CAP_BYTES);
     store.take_dirty();
     history.begin_step(store, "bench")?;
     let mut rows = Vec::new();
@@ -464,7 +466,7 @@ fn measure_gpu_upload(
         "upload_ranges": best[4] as u64,
         "upload_spans": best[5] as u64,
         "upload_span_samples": best[6] as u64,
-        "max_upload_gap": crate::packing::paint_layout::MAX_UPLOAD_GAP,
+        "max_upload_gap": meshpaint_core::packing::paint_layout::MAX_UPLOAD_GAP,
         "samples_per_second_best": covered as f64 / best[3],
         "samples_per_second_median": covered as f64 / median[3],
     }))

@@ -14,13 +14,13 @@
 
 use std::time::Instant;
 
-use crate::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera, default_camera};
-use crate::colors::format::ColorFormat;
-use crate::io::document::{Document, bounds};
-use crate::mesh::import::import_gltf;
-use crate::mesh::scene::Texture;
+use meshpaint_core::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera, default_camera};
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::io::document::{Document, bounds};
+use meshpaint_core::mesh::import::import_gltf;
+use meshpaint_core::mesh::scene::Texture;
 
-use crate::render::{
+use meshpaint_render::{
     BaselineMesh, DrawItem, FilterMode, Gpu, OFFSCREEN_FORMAT, RenderError, RenderSettings, RenderTarget, Renderer,
     Shading,
 };
@@ -248,7 +248,7 @@ pub(crate) fn baseline(
                 format!("synthetic planar {side}x{side}"),
                 BaselineMesh::new(
                     ctx,
-                    renderer,
+                    renderer.layouts(),
                     &document.positions,
                     &document.store.topology().face_vertices,
                     &corner_uvs,
@@ -268,10 +268,10 @@ pub enum BenchRenderError {
     Render(#[from] RenderError),
     /// Packing the document failed.
     #[error(transparent)]
-    Pack(#[from] crate::packing::packer::PackError),
+    Pack(#[from] meshpaint_core::packing::packer::PackError),
     /// Converting the scene into a document failed.
     #[error(transparent)]
-    Document(#[from] crate::io::document::DocumentError),
+    Document(#[from] meshpaint_core::io::document::DocumentError),
     /// The measurement needs a reference the file does not have.
     #[error("{0}")]
     NoReference(String),

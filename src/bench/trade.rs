@@ -51,23 +51,24 @@ use std::time::Instant;
 use glam::DVec3;
 use image::RgbaImage;
 
-use crate::bench::adaptive::{Supersampled, psnr_over, render_supersampled};
+use crate::bench::adaptive::{Supersampled, render_supersampled};
 use crate::bench::pack::Timing;
 pub use crate::bench::plot::pareto_front;
 use crate::bench::plot::{PlotError, PlotPoint, plot_tradeoff};
 use crate::bench::render::FrameTimer;
 use crate::bench::{BenchRenderError, paint};
-use crate::camera::{BoundingSphere, OrbitCamera, default_camera};
-use crate::colors::budget::Budget;
-use crate::colors::format::ColorFormat;
-use crate::colors::layout::Resolution;
-use crate::io::adaptive::ResolutionRule;
-use crate::io::document::Document;
-use crate::mesh::import::import_gltf;
-use crate::packing::linear::PackedMesh;
-use crate::packing::sampler::{Filter, sample, sample_trilinear};
-use crate::paint::picking::{BvhPreset, MeshBvh};
-use crate::render::{DrawItem, FilterMode, Gpu, GpuMesh, RenderSettings, Shading};
+use meshpaint_core::camera::{BoundingSphere, OrbitCamera, default_camera};
+use meshpaint_core::colors::budget::Budget;
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::colors::layout::Resolution;
+use meshpaint_core::colors::psnr::psnr_over;
+use meshpaint_core::convert::adaptive::ResolutionRule;
+use meshpaint_core::io::document::Document;
+use meshpaint_core::mesh::import::import_gltf;
+use meshpaint_core::packing::linear::PackedMesh;
+use meshpaint_core::packing::sampler::{Filter, sample, sample_trilinear};
+use meshpaint_core::paint::picking::{BvhPreset, MeshBvh};
+use meshpaint_render::{DrawItem, FilterMode, Gpu, GpuMesh, RenderSettings, Shading};
 
 /// What `bench trade` measures.
 #[derive(Debug, Clone, PartialEq)]
@@ -216,10 +217,9 @@ struct Packed {
 /// Runs the study on the file at `path` and returns its JSON rows: one `meta` row, one
 /// `baseline` row per view (textured input), one `config` row per configuration and view, one
 /// `seam` row per resolution choice with mixed resolutions, filter and level, one `bvh` row
-/// per preset.
-/// Long: the study's one pass (choices → packs → interleaved frames → per-view errors →
-/// seams → BVH rows) keeps the GPU, references and timers in scope; its stages are the
-/// helpers below.
+/// per preset. The stages: the resolution choices ([`resolution_choices`]), their packs and
+/// dabs ([`prepare`]), then per view the references, interleaved frame times and errors
+/// ([`Study::view_rows`]), then seams and BVH presets.
 pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json::Value>, BenchRenderError> {
     let gpu = Gpu::new_headless()?;
     let budget = Budget::from_environment().with_gpu(gpu.budget_limits());
@@ -230,63 +230,11 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
     };
     let textured = baseline.is_some();
     let file = path.display().to_string();
-    let mut rows = Vec::new();
-
-    // The resolution choices: a glTF is swept over uniform R (and, with a texture, the error
-    // bounds); any other file is measured as it is.
-    let mut choices: Vec<Choice> = Vec::new();
     let started = Instant::now();
-    let mut push = |label, error_bound, document, convert_seconds| {
-        choices.push(Choice {
-            label,
-            error_bound,
-            document,
-            convert_seconds,
-            packs: Vec::new(),
-            dab: 0.into(),
-            reference: None,
-        });
-    };
-    match &scene {
-        Some(scene) => {
-            let mut rules: Vec<ResolutionRule> = options.uniform.iter().copied().map(ResolutionRule::Uniform).collect();
-            // Error bounds fit a texture: only with one.
-            let bounds: &[f32] = if textured { &options.error_bounds } else { &[] };
-            rules.extend(bounds.iter().map(|&bound| ResolutionRule::ErrorBound { bound, max: options.max_resolution }));
-            for rule in rules {
-                let started = Instant::now();
-                let document = Document::from_scene_within(scene.clone(), rule, path, &budget)?;
-                let convert_seconds = started.elapsed().as_secs_f64();
-                let (label, error_bound) = match rule {
-                    ResolutionRule::ErrorBound { bound, .. } => (format!("error<={bound}").into(), Some(bound)),
-                    _ => (rule_resolution(&document), None),
-                };
-                push(label, error_bound, document, convert_seconds);
-            }
-        }
-        None => {
-            let document = Document::open_within(path, Resolution::from_log2(3).unwrap_or(Resolution::MAX), &budget)?;
-            push(rule_resolution(&document), None, document, started.elapsed().as_secs_f64());
-        }
-    }
-    for choice in &mut choices {
-        for &format in &options.formats {
-            let (timing, packed) = Timing::measure(3, || choice.document.pack(format));
-            let packed = packed?;
-            let mesh = gpu.upload(&packed)?;
-            choice.packs.push(Packed { format, packed, mesh, pack_seconds: timing.best_seconds });
-        }
-        if !textured {
-            choice.reference = Some(gpu.upload(&choice.document.pack(ColorFormat::Rgba32F)?)?);
-        }
-        // A brush of a tenth of the samples (at least 64: a brush at the rim of one sample
-        // paints nothing), at most 10k as `bench paint`'s middle size.
-        let target = (choice.document.store.sample_count() / 10).clamp(64, 10_000);
-        choice.dab = paint::dab_throughput(&choice.document, target, options.dabs)
-            .unwrap_or_else(|error| serde_json::json!({ "error": error.to_string() }));
-    }
+    let mut choices = resolution_choices(path, scene.as_ref(), textured, options, &budget)?;
+    prepare(&gpu, &mut choices, textured, options)?;
     let Some(first) = choices.first() else {
-        return Ok(rows);
+        return Ok(Vec::new());
     };
     let reference_name = if textured {
         "uv-texture render, 4x4 supersampled"
@@ -299,113 +247,20 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
         Some(mesh) => mesh,
         None => super::render::baseline(&gpu, path, &first.document)?.1,
     };
-    let baseline_bytes = timing_baseline.gpu_bytes();
     let bounds =
         first.packs.first().map_or_else(|| BoundingSphere::of_points(&first.document.positions), |p| p.mesh.bounds);
     let face_count = first.document.store.topology().face_count();
-    rows.push(serde_json::json!({
+    let mut rows = vec![serde_json::json!({
         "bench": "trade", "kind": "meta", "file": file, "adapter": gpu.describe(),
         "size": options.size, "supersample": super::adaptive::SUPERSAMPLE, "views": options.views,
         "distances": DISTANCES.iter().map(|(n, f)| serde_json::json!({"view": n, "distance_factor": f})).collect::<Vec<_>>(),
         "frames": options.frames, "triangles": face_count, "reference": reference_name,
         "convert_seconds_total": started.elapsed().as_secs_f64(),
-    }));
-
-    let size = options.size;
+    })];
+    let study = Study { gpu: &gpu, choices: &choices, baseline: &timing_baseline, textured, file: &file, options };
     for view in views(bounds, options.views) {
-        let settings = unlit(view.camera, FilterMode::Linear);
-        // One reference per view (textured), or one per resolution choice.
-        let mut references: Vec<Supersampled> = Vec::new();
-        if textured {
-            references.push(render_supersampled(&gpu, DrawItem::Baseline(&timing_baseline), &settings, size)?);
-        } else {
-            for mesh in choices.iter().filter_map(|c| c.reference.as_ref()) {
-                references.push(render_supersampled(&gpu, DrawItem::MeshColors(mesh), &settings, size)?);
-            }
-        }
-        let reference_of = |c: usize| &references[if textured { 0 } else { c.min(references.len().saturating_sub(1)) }];
-        // Frame times, interleaved: each round times the baseline, then every configuration,
-        // the baseline again after every eight.
-        let timer = FrameTimer::new(&gpu, size, size);
-        let items: Vec<(usize, usize, usize)> = (0..choices.len())
-            .flat_map(|c| (0..choices[c].packs.len()).flat_map(move |p| (0..FILTERS.len()).map(move |f| (c, p, f))))
-            .collect();
-        let item = |&(c, p, _): &(usize, usize, usize)| DrawItem::MeshColors(&choices[c].packs[p].mesh);
-        let time_baseline =
-            |timer: &FrameTimer| timer.frame(DrawItem::Baseline(&timing_baseline), FilterMode::Linear, view.camera);
-        time_baseline(&timer);
-        for key in &items {
-            timer.frame(item(key), FILTERS[key.2].1, view.camera);
-        }
-        let mut baseline_times = Vec::new();
-        let mut times: Vec<Vec<f64>> = vec![Vec::new(); items.len()];
-        for _ in 0..options.frames.max(1) {
-            for (k, key) in items.iter().enumerate() {
-                if k % 8 == 0 {
-                    baseline_times.push(time_baseline(&timer));
-                }
-                times[k].push(timer.frame(item(key), FILTERS[key.2].1, view.camera));
-            }
-        }
-        let baseline_ms = median(&mut baseline_times) * 1e3;
-        let mask_for = |reference: &Supersampled, test: &RgbaImage| -> Vec<bool> {
-            reference.interior.iter().zip(test.pixels()).map(|(&inside, p)| inside && p.0[3] > 0).collect()
-        };
-        let covered = reference_of(0).interior.iter().filter(|&&x| x).count() as f64;
-        let view_json = serde_json::json!({
-            "view": view.name, "direction": view.direction, "distance_factor": view.distance_factor,
-            "interior_pixels": covered, "pixels_per_face": covered / f64::from(face_count.max(1)),
-        });
-        if textured {
-            // The baseline itself at the image size: the error floor of texture filtering.
-            let native = gpu.render_image(DrawItem::Baseline(&timing_baseline), &settings, size, size)?;
-            let reference = reference_of(0);
-            let error = compare(&reference.image, &native, &mask_for(reference, &native));
-            let mut row = error_json(&error);
-            merge(&mut row, &view_json);
-            merge(
-                &mut row,
-                &serde_json::json!({
-                    "bench": "trade", "kind": "baseline", "file": file, "filter": "baseline-uv",
-                    "gpu_bytes": baseline_bytes, "frame_ms": baseline_ms, "frame_ratio": 1.0,
-                }),
-            );
-            rows.push(row);
-        }
-        for (k, &(c, p, f)) in items.iter().enumerate() {
-            let (choice, packed) = (&choices[c], &choices[c].packs[p]);
-            let (filter_name, filter) = FILTERS[f];
-            let image =
-                gpu.render_image(DrawItem::MeshColors(&packed.mesh), &unlit(view.camera, filter), size, size)?;
-            let reference = reference_of(c);
-            let error = compare(&reference.image, &image, &mask_for(reference, &image));
-            let frame_ms = median(&mut times[k]) * 1e3;
-            let resolutions = choice.document.store.face_resolutions();
-            let mut row = error_json(&error);
-            merge(&mut row, &view_json);
-            merge(
-                &mut row,
-                &serde_json::json!({
-                    "bench": "trade", "kind": "config", "file": file,
-                    "filter": filter_name, "resolution": choice.label, "error_bound": choice.error_bound,
-                    "resolution_min": resolutions.iter().map(|r| r.get()).min(),
-                    "resolution_max": resolutions.iter().map(|r| r.get()).max(),
-                    "format": packed.format.name(),
-                    "samples": choice.document.store.sample_count(),
-                    "samples_with_mips": packed.packed.sample_count(),
-                    "gpu_bytes": packed.mesh.gpu_bytes(),
-                    "pack_seconds": packed.pack_seconds,
-                    "convert_seconds": choice.convert_seconds,
-                    "frame_ms": frame_ms, "baseline_frame_ms": baseline_ms, "frame_ratio": frame_ms / baseline_ms,
-                    "dab_samples_per_second": choice.dab.get("samples_per_second_median"),
-                    "dab_samples": choice.dab.get("samples_covered"),
-                    "dab_seconds": choice.dab.get("dab_seconds_median"),
-                }),
-            );
-            rows.push(row);
-        }
+        rows.extend(study.view_rows(&view, face_count)?);
     }
-
     for choice in &choices {
         let Some(packed) = choice.packs.iter().find(|p| p.format == ColorFormat::Rgba32F) else {
             continue;
@@ -424,6 +279,189 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
         rows.push(row);
     }
     Ok(rows)
+}
+
+/// The resolution choices: a glTF `scene` is swept over uniform R (and, with a texture, the
+/// error bounds); any other file is measured as it is.
+fn resolution_choices(
+    path: &Path,
+    scene: Option<&meshpaint_core::mesh::scene::Scene>,
+    textured: bool,
+    options: &TradeOptions,
+    budget: &Budget,
+) -> Result<Vec<Choice>, BenchRenderError> {
+    let choice = |label, error_bound, document, convert_seconds| Choice {
+        label,
+        error_bound,
+        document,
+        convert_seconds,
+        packs: Vec::new(),
+        dab: 0.into(),
+        reference: None,
+    };
+    let Some(scene) = scene else {
+        let started = Instant::now();
+        let document = Document::open_within(path, Resolution::from_log2(3).unwrap_or(Resolution::MAX), budget)?;
+        return Ok(vec![choice(rule_resolution(&document), None, document, started.elapsed().as_secs_f64())]);
+    };
+    let mut rules: Vec<ResolutionRule> = options.uniform.iter().copied().map(ResolutionRule::Uniform).collect();
+    // Error bounds fit a texture: only with one.
+    let bounds: &[f32] = if textured { &options.error_bounds } else { &[] };
+    rules.extend(bounds.iter().map(|&bound| ResolutionRule::ErrorBound { bound, max: options.max_resolution }));
+    let mut choices = Vec::new();
+    for rule in rules {
+        let started = Instant::now();
+        let document = Document::from_scene_within(scene.clone(), rule, path, budget)?;
+        let convert_seconds = started.elapsed().as_secs_f64();
+        let (label, error_bound) = match rule {
+            ResolutionRule::ErrorBound { bound, .. } => (format!("error<={bound}").into(), Some(bound)),
+            _ => (rule_resolution(&document), None),
+        };
+        choices.push(choice(label, error_bound, document, convert_seconds));
+    }
+    Ok(choices)
+}
+
+/// Packs and uploads every choice in every format (best of three packs), its RGBA32F
+/// reference when there is no texture, and times a dab on it.
+fn prepare(gpu: &Gpu, choices: &mut [Choice], textured: bool, options: &TradeOptions) -> Result<(), BenchRenderError> {
+    for choice in choices {
+        for &format in &options.formats {
+            let (timing, packed) = Timing::measure(3, || choice.document.pack(format));
+            let packed = packed?;
+            let mesh = gpu.upload(&packed)?;
+            choice.packs.push(Packed { format, packed, mesh, pack_seconds: timing.best_seconds });
+        }
+        if !textured {
+            choice.reference = Some(gpu.upload(&choice.document.pack(ColorFormat::Rgba32F)?)?);
+        }
+        // A brush of a tenth of the samples (at least 64: a brush at the rim of one sample
+        // paints nothing), at most 10k as `bench paint`'s middle size.
+        let target = (choice.document.store.sample_count() / 10).clamp(64, 10_000);
+        choice.dab = paint::dab_throughput(&choice.document, target, options.dabs)
+            .unwrap_or_else(|error| serde_json::json!({ "error": error.to_string() }));
+    }
+    Ok(())
+}
+
+/// What every view of the study draws and compares.
+struct Study<'a> {
+    gpu: &'a Gpu,
+    choices: &'a [Choice],
+    /// The UV-texture mesh frame times are divided by.
+    baseline: &'a meshpaint_render::BaselineMesh,
+    textured: bool,
+    file: &'a str,
+    options: &'a TradeOptions,
+}
+
+impl Study<'_> {
+    /// Every (choice, pack, filter) drawn in a view.
+    fn items(&self) -> Vec<(usize, usize, usize)> {
+        (0..self.choices.len())
+            .flat_map(|c| {
+                (0..self.choices[c].packs.len()).flat_map(move |p| (0..FILTERS.len()).map(move |f| (c, p, f)))
+            })
+            .collect()
+    }
+
+    /// Median frame times in ms of the baseline and of every item, interleaved: each round
+    /// times the baseline, then every item, the baseline again after every eight.
+    fn frame_times(&self, view: &View, items: &[(usize, usize, usize)]) -> (f64, Vec<f64>) {
+        let timer = FrameTimer::new(self.gpu, self.options.size, self.options.size);
+        let item = |&(c, p, _): &(usize, usize, usize)| DrawItem::MeshColors(&self.choices[c].packs[p].mesh);
+        let time_baseline =
+            |timer: &FrameTimer| timer.frame(DrawItem::Baseline(self.baseline), FilterMode::Linear, view.camera);
+        time_baseline(&timer);
+        for key in items {
+            timer.frame(item(key), FILTERS[key.2].1, view.camera);
+        }
+        let mut baseline_times = Vec::new();
+        let mut times: Vec<Vec<f64>> = vec![Vec::new(); items.len()];
+        for _ in 0..self.options.frames.max(1) {
+            for (k, key) in items.iter().enumerate() {
+                if k % 8 == 0 {
+                    baseline_times.push(time_baseline(&timer));
+                }
+                times[k].push(timer.frame(item(key), FILTERS[key.2].1, view.camera));
+            }
+        }
+        (median(&mut baseline_times) * 1e3, times.iter_mut().map(|t| median(t) * 1e3).collect())
+    }
+
+    /// The `baseline` row (textured input) and the `config` rows of one view.
+    fn view_rows(&self, view: &View, face_count: u32) -> Result<Vec<serde_json::Value>, BenchRenderError> {
+        let (gpu, size, file) = (self.gpu, self.options.size, self.file);
+        let settings = unlit(view.camera, FilterMode::Linear);
+        // One reference per view (textured), or one per resolution choice.
+        let mut references: Vec<Supersampled> = Vec::new();
+        if self.textured {
+            references.push(render_supersampled(gpu, DrawItem::Baseline(self.baseline), &settings, size)?);
+        } else {
+            for mesh in self.choices.iter().filter_map(|c| c.reference.as_ref()) {
+                references.push(render_supersampled(gpu, DrawItem::MeshColors(mesh), &settings, size)?);
+            }
+        }
+        let reference_of =
+            |c: usize| &references[if self.textured { 0 } else { c.min(references.len().saturating_sub(1)) }];
+        let items = self.items();
+        let (baseline_ms, frame_ms) = self.frame_times(view, &items);
+        let mask_for = |reference: &Supersampled, test: &RgbaImage| -> Vec<bool> {
+            reference.interior.iter().zip(test.pixels()).map(|(&inside, p)| inside && p.0[3] > 0).collect()
+        };
+        let covered = reference_of(0).interior.iter().filter(|&&x| x).count() as f64;
+        let view_json = serde_json::json!({
+            "view": view.name, "direction": view.direction, "distance_factor": view.distance_factor,
+            "interior_pixels": covered, "pixels_per_face": covered / f64::from(face_count.max(1)),
+        });
+        let mut rows = Vec::new();
+        if self.textured {
+            // The baseline itself at the image size: the error floor of texture filtering.
+            let native = gpu.render_image(DrawItem::Baseline(self.baseline), &settings, size, size)?;
+            let reference = reference_of(0);
+            let mut row = error_json(&compare(&reference.image, &native, &mask_for(reference, &native)));
+            merge(&mut row, &view_json);
+            merge(
+                &mut row,
+                &serde_json::json!({
+                    "bench": "trade", "kind": "baseline", "file": file, "filter": "baseline-uv",
+                    "gpu_bytes": self.baseline.gpu_bytes(), "frame_ms": baseline_ms, "frame_ratio": 1.0,
+                }),
+            );
+            rows.push(row);
+        }
+        for (k, &(c, p, f)) in items.iter().enumerate() {
+            let (choice, packed) = (&self.choices[c], &self.choices[c].packs[p]);
+            let (filter_name, filter) = FILTERS[f];
+            let image =
+                gpu.render_image(DrawItem::MeshColors(&packed.mesh), &unlit(view.camera, filter), size, size)?;
+            let reference = reference_of(c);
+            let mut row = error_json(&compare(&reference.image, &image, &mask_for(reference, &image)));
+            let resolutions = choice.document.store.face_resolutions();
+            merge(&mut row, &view_json);
+            merge(
+                &mut row,
+                &serde_json::json!({
+                    "bench": "trade", "kind": "config", "file": file,
+                    "filter": filter_name, "resolution": choice.label, "error_bound": choice.error_bound,
+                    "resolution_min": resolutions.iter().map(|r| r.get()).min(),
+                    "resolution_max": resolutions.iter().map(|r| r.get()).max(),
+                    "format": packed.format.name(),
+                    "samples": choice.document.store.sample_count(),
+                    "samples_with_mips": packed.packed.sample_count(),
+                    "gpu_bytes": packed.mesh.gpu_bytes(),
+                    "pack_seconds": packed.pack_seconds,
+                    "convert_seconds": choice.convert_seconds,
+                    "frame_ms": frame_ms[k], "baseline_frame_ms": baseline_ms, "frame_ratio": frame_ms[k] / baseline_ms,
+                    "dab_samples_per_second": choice.dab.get("samples_per_second_median"),
+                    "dab_samples": choice.dab.get("samples_covered"),
+                    "dab_seconds": choice.dab.get("dab_seconds_median"),
+                }),
+            );
+            rows.push(row);
+        }
+        Ok(rows)
+    }
 }
 
 /// The `resolution` of a document: its R when uniform, else `"R a..b"`.

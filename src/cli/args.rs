@@ -5,14 +5,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use meshpaint::colors::budget::Budget;
-use meshpaint::colors::format::ColorFormat;
-use meshpaint::colors::layout::Resolution;
-use meshpaint::io::adaptive::ResolutionRule;
-use meshpaint::io::document::{Document, SourceKind};
-use meshpaint::io::export_gltf::ExportSummary;
-use meshpaint::packing::file as packed_file;
-use meshpaint::packing::linear::PackedMesh;
+use meshpaint_core::colors::budget::Budget;
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::colors::layout::Resolution;
+use meshpaint_core::convert::adaptive::ResolutionRule;
+use meshpaint_core::io::document::{Document, SourceKind};
+use meshpaint_core::io::export_gltf::ExportSummary;
+use meshpaint_core::packing::file as packed_file;
+use meshpaint_core::packing::linear::PackedMesh;
 
 /// The help of `-r/--resolution` (one text for both groups below).
 const RESOLUTION_HELP: &str = "Uniform face resolution R for glTF input (a power of two, 1..=4096)";
@@ -28,7 +28,7 @@ pub(super) struct ResolutionArg {
 }
 
 // `--error E`, `--texel-density` and `--max-resolution R`: per-face resolution chosen by
-// the content of a textured glTF (src/io/adaptive.rs) instead of a uniform `-r`.
+// the content of a textured glTF (crates/core/src/convert/adaptive.rs) instead of a uniform `-r`.
 #[derive(Debug, Clone, Copy, Default, clap::Args)]
 pub(super) struct AdaptiveArgs {
     /// Per-face R for textured glTF: the lowest R whose reconstruction stays within E of the
@@ -144,9 +144,12 @@ impl OutputArgs {
     /// `packed_format` to any other name.
     pub(super) fn write(&self, document: &Document, input: &Path, packed_format: ColorFormat) -> Result<Written> {
         if self.is_glb()? {
-            let summary =
-                meshpaint::io::export_gltf::write_tessellated_glb(&self.output, &document.positions, &document.store)
-                    .with_context(|| format!("exporting {}", input.display()))?;
+            let summary = meshpaint_core::io::export_gltf::write_tessellated_glb(
+                &self.output,
+                &document.positions,
+                &document.store,
+            )
+            .with_context(|| format!("exporting {}", input.display()))?;
             return Ok(Written::Glb(summary));
         }
         let packed = document.pack(packed_format).with_context(|| format!("packing {}", input.display()))?;
@@ -199,8 +202,8 @@ pub(super) fn open_subdivided(
     if subdivide == 0 {
         return open(path, resolution, budget);
     }
-    let (scene, kind) = meshpaint::io::document::import_scene_within(path, budget)?;
-    let scene = meshpaint::io::subdivide::subdivide_scene(&scene, subdivide, budget)?;
+    let (scene, kind) = meshpaint_core::io::document::import_scene_within(path, budget)?;
+    let scene = meshpaint_core::convert::subdivide::subdivide_scene(&scene, subdivide, budget)?;
     let mut document = Document::from_scene_within(scene, resolution.rule()?, path, budget)?;
     document.source = kind;
     for warning in &document.warnings {

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Subcommand;
 
-use meshpaint::colors::format::ColorFormat;
-use meshpaint::io::least_squares::BakeFit;
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::convert::least_squares::BakeFit;
 
 use super::args::{ResolutionArg, ResolutionArg16, budget, open, open_subdivided, parse_format};
 
@@ -180,154 +180,209 @@ pub(super) enum BenchCommand {
     },
 }
 
+/// Runs one benchmark command.
 pub(super) fn run(what: BenchCommand) -> Result<()> {
     match what {
         BenchCommand::Extremes { json } => extremes(json),
         BenchCommand::Trade { file, views, out, max_resolution, size, max_uniform, frames, errors, no_extremes } => {
-            use meshpaint::colors::layout::Resolution;
-            anyhow::ensure!(size >= 8, "--size must be at least 8");
-            anyhow::ensure!(errors.iter().all(|e| e.is_finite() && *e >= 0.0), "--errors must be numbers ≥ 0");
-            let max_uniform = Resolution::new(max_uniform).context("--max-uniform")?;
-            let options = meshpaint::bench::trade::TradeOptions {
-                views,
-                size,
-                max_resolution: Resolution::new(max_resolution).context("--max-resolution")?,
-                uniform: (0..=max_uniform.log2()).filter_map(|l| Resolution::from_log2(l).ok()).collect(),
-                frames,
-                error_bounds: errors,
-                ..Default::default()
-            };
-            let rows = meshpaint::bench::trade::bench_trade(&file, &options)?;
-            for row in &rows {
-                println!("{row}");
-            }
-            if !no_extremes {
-                let gpu = meshpaint::render::Gpu::new_headless()?;
-                for mut row in meshpaint::bench::extremes::extremes_rows(&gpu)? {
-                    row["bench"] = "extremes".into();
-                    println!("{row}");
-                }
-            }
-            if let Some(dir) = out {
-                std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-                let stem = file.file_stem().map_or("mesh".to_owned(), |s| s.to_string_lossy().to_lowercase());
-                for written in meshpaint::bench::trade::write_plots(&rows, &dir, &stem)? {
-                    eprintln!("wrote {}", written.display());
-                }
-            }
-            Ok(())
+            trade(file, views, out, max_resolution, size, max_uniform, frames, errors, no_extremes)
         }
         BenchCommand::Adaptive { file, max_resolution, size, views, supersample, bake } => {
-            let max = meshpaint::colors::layout::Resolution::new(max_resolution).context("--max-resolution")?;
-            let scene = meshpaint::mesh::import::import_gltf(&file)?;
-            let rules = meshpaint::bench::adaptive::default_rules(max);
-            let fits: Vec<BakeFit> = bake.iter().map(|&b| b.into()).collect();
-            let options = meshpaint::bench::adaptive::AdaptiveOptions {
-                budget_max: Some(max),
-                size,
-                views,
-                supersample,
-                fits: fits.clone(),
-            };
-            let rows = meshpaint::bench::adaptive::bench_adaptive(&file, &scene, &rules, &options)?;
-            for row in &rows {
-                let mut value = row.to_json();
-                value["bench"] = "adaptive".into();
-                value["file"] = file.display().to_string().into();
-                println!("{value}");
-            }
-            let texels = meshpaint::bench::adaptive::uv_island_texels(&scene);
-            for fit in fits {
-                let mut summary = meshpaint::bench::adaptive::summary(&rows, fit, texels);
-                summary["uv_face_texels"] = meshpaint::bench::adaptive::uv_face_texels(&scene).into();
-                summary["bench"] = "adaptive-summary".into();
-                summary["file"] = file.display().to_string().into();
-                println!("{summary}");
-            }
-            Ok(())
+            adaptive(file, max_resolution, size, views, supersample, bake)
         }
         BenchCommand::Pack { file, resolution, format, runs, subdivide, stroke_samples } => {
-            let document = open_subdivided(&file, resolution.into(), subdivide, &budget(None))?;
-            let formats = if format.is_empty() { ColorFormat::ALL.to_vec() } else { format };
-            let mut results = Vec::new();
-            for format in formats {
-                let result = meshpaint::bench::pack::bench_pack(&document, format, runs)?;
-                let mut value = result.to_json();
-                let incremental =
-                    meshpaint::bench::pack::bench_incremental(&document, format, runs.max(3), stroke_samples)?;
-                value["incremental_after_stroke"] = incremental.to_json();
-                let relayout = meshpaint::bench::pack::bench_relayout(&document, format, runs.max(3), stroke_samples)?;
-                value["relayout_after_resolution_stroke"] = relayout.to_json();
-                results.push(value);
-            }
-            let report = serde_json::json!({
-                "bench": "pack",
-                "file": file.display().to_string(),
-                "subdivide": subdivide,
-                "triangles": document.store.topology().face_count(),
-                "resolution": resolution.resolution,
-                "threads": meshpaint::packing::packer::pack_threads(),
-                "caller_in_pool": meshpaint::threads::caller_in_pool(),
-                "results": results,
-            });
-            println!("{report}");
-            Ok(())
+            pack(file, resolution, format, runs, subdivide, stroke_samples)
         }
         BenchCommand::Load { file, resolution, subdivide, width, height } => {
-            let r = meshpaint::colors::layout::Resolution::new(resolution).context("--resolution")?;
-            let report = meshpaint::bench::bench_load(&file, r, subdivide, &budget(None), width, height)?;
-            println!("{report}");
-            Ok(())
+            load(file, resolution, subdivide, width, height)
         }
         BenchCommand::Paint { file, resolution, dabs, subdivide, dab_samples, json, rows } => {
-            let document = if subdivide == 0 {
-                open(&file, resolution, &budget(None))?
-            } else {
-                let budget = budget(None);
-                let (scene, _) = meshpaint::io::document::import_scene_within(&file, &budget)?;
-                let scene = meshpaint::io::subdivide::subdivide_scene(&scene, subdivide, &budget)?;
-                meshpaint::io::document::Document::from_scene_within(scene, resolution.rule()?, &file, &budget)?
-            };
-            let known = |row: &String| {
-                meshpaint::bench::paint::ROWS.iter().any(|&(name, ..)| {
-                    *row == name
-                        || (meshpaint::bench::paint::FRAME_PACED_ROWS.contains(&name)
-                            && *row == format!("{name}_frame_paced"))
-                })
-            };
-            if let Some(row) = rows.iter().find(|row| !known(row)) {
-                anyhow::bail!("--rows: no row named {row:?}");
-            }
-            let mut options = meshpaint::bench::PaintBenchOptions { dabs, rows, ..Default::default() };
-            if !dab_samples.is_empty() {
-                options.target_samples = dab_samples;
-            }
-            let mut report = meshpaint::bench::bench_paint(&document, &options)?;
-            report["file"] = file.display().to_string().into();
-            report["resolution"] = resolution.resolution.into();
-            report["subdivide"] = subdivide.into();
-            if json {
-                println!("{report}");
-            } else {
-                println!("{}", serde_json::to_string_pretty(&report)?);
-            }
-            Ok(())
+            paint(file, resolution, dabs, subdivide, dab_samples, json, rows)
         }
         BenchCommand::Render { file, resolution, width, height, frames } => {
-            let document = open(&file, resolution, &budget(None))?;
-            let result = meshpaint::bench::bench_render(&file, &document, width, height, frames)?;
-            let mut report = result.to_json();
-            report["file"] = file.display().to_string().into();
-            report["resolution"] = resolution.resolution.into();
-            println!("{report}");
-            Ok(())
+            render(file, resolution, width, height, frames)
         }
     }
 }
 
+/// `bench trade`: every choice's cost and error side by side, the extremes, the plots.
+#[allow(clippy::too_many_arguments)] // one parameter per command-line flag
+fn trade(
+    file: PathBuf,
+    views: u32,
+    out: Option<PathBuf>,
+    max_resolution: u64,
+    size: u32,
+    max_uniform: u64,
+    frames: usize,
+    errors: Vec<f32>,
+    no_extremes: bool,
+) -> Result<()> {
+    use meshpaint_core::colors::layout::Resolution;
+    anyhow::ensure!(size >= 8, "--size must be at least 8");
+    anyhow::ensure!(errors.iter().all(|e| e.is_finite() && *e >= 0.0), "--errors must be numbers ≥ 0");
+    let max_uniform = Resolution::new(max_uniform).context("--max-uniform")?;
+    let options = meshpaint::bench::trade::TradeOptions {
+        views,
+        size,
+        max_resolution: Resolution::new(max_resolution).context("--max-resolution")?,
+        uniform: (0..=max_uniform.log2()).filter_map(|l| Resolution::from_log2(l).ok()).collect(),
+        frames,
+        error_bounds: errors,
+        ..Default::default()
+    };
+    let rows = meshpaint::bench::trade::bench_trade(&file, &options)?;
+    for row in &rows {
+        println!("{row}");
+    }
+    if !no_extremes {
+        let gpu = meshpaint_render::Gpu::new_headless()?;
+        for mut row in meshpaint::bench::extremes::extremes_rows(&gpu)? {
+            row["bench"] = "extremes".into();
+            println!("{row}");
+        }
+    }
+    if let Some(dir) = out {
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        let stem = file.file_stem().map_or("mesh".to_owned(), |s| s.to_string_lossy().to_lowercase());
+        for written in meshpaint::bench::trade::write_plots(&rows, &dir, &stem)? {
+            eprintln!("wrote {}", written.display());
+        }
+    }
+    Ok(())
+}
+
+/// `bench adaptive`: each resolution rule's samples, time and error against a supersampled reference.
+fn adaptive(
+    file: PathBuf,
+    max_resolution: u64,
+    size: u32,
+    views: u32,
+    supersample: u32,
+    bake: Vec<BakeArg>,
+) -> Result<()> {
+    let max = meshpaint_core::colors::layout::Resolution::new(max_resolution).context("--max-resolution")?;
+    let scene = meshpaint_core::mesh::import::import_gltf(&file)?;
+    let rules = meshpaint::bench::adaptive::default_rules(max);
+    let fits: Vec<BakeFit> = bake.iter().map(|&b| b.into()).collect();
+    let options = meshpaint::bench::adaptive::AdaptiveOptions {
+        budget_max: Some(max),
+        size,
+        views,
+        supersample,
+        fits: fits.clone(),
+    };
+    let rows = meshpaint::bench::adaptive::bench_adaptive(&file, &scene, &rules, &options)?;
+    for row in &rows {
+        let mut value = row.to_json();
+        value["bench"] = "adaptive".into();
+        value["file"] = file.display().to_string().into();
+        println!("{value}");
+    }
+    let texels = meshpaint::bench::adaptive::uv_island_texels(&scene);
+    for fit in fits {
+        let mut summary = meshpaint::bench::adaptive::summary(&rows, fit, texels);
+        summary["uv_face_texels"] = meshpaint::bench::adaptive::uv_face_texels(&scene).into();
+        summary["bench"] = "adaptive-summary".into();
+        summary["file"] = file.display().to_string().into();
+        println!("{summary}");
+    }
+    Ok(())
+}
+
+/// `bench pack`: the full repack, the incremental repack after a stroke and the relayout after a resolution stroke, per format.
+fn pack(
+    file: PathBuf,
+    resolution: ResolutionArg16,
+    format: Vec<ColorFormat>,
+    runs: usize,
+    subdivide: u32,
+    stroke_samples: u64,
+) -> Result<()> {
+    let document = open_subdivided(&file, resolution.into(), subdivide, &budget(None))?;
+    let formats = if format.is_empty() { ColorFormat::ALL.to_vec() } else { format };
+    let mut results = Vec::new();
+    for format in formats {
+        let result = meshpaint::bench::pack::bench_pack(&document, format, runs)?;
+        let mut value = result.to_json();
+        let incremental = meshpaint::bench::pack::bench_incremental(&document, format, runs.max(3), stroke_samples)?;
+        value["incremental_after_stroke"] = incremental.to_json();
+        let relayout = meshpaint::bench::pack::bench_relayout(&document, format, runs.max(3), stroke_samples)?;
+        value["relayout_after_resolution_stroke"] = relayout.to_json();
+        results.push(value);
+    }
+    let report = serde_json::json!({
+        "bench": "pack",
+        "file": file.display().to_string(),
+        "subdivide": subdivide,
+        "triangles": document.store.topology().face_count(),
+        "resolution": resolution.resolution,
+        "threads": meshpaint_core::packing::packer::pack_threads(),
+        "caller_in_pool": meshpaint_core::threads::caller_in_pool(),
+        "results": results,
+    });
+    println!("{report}");
+    Ok(())
+}
+
+/// `bench load`: from a file to the document on screen and on to paint mode, phase by phase.
+fn load(file: PathBuf, resolution: u64, subdivide: u32, width: u32, height: u32) -> Result<()> {
+    let r = meshpaint_core::colors::layout::Resolution::new(resolution).context("--resolution")?;
+    let report = meshpaint::bench::bench_load(&file, r, subdivide, &budget(None), width, height)?;
+    println!("{report}");
+    Ok(())
+}
+
+/// `bench paint`: the brush rows (samples per second) on the document.
+fn paint(
+    file: PathBuf,
+    resolution: ResolutionArg,
+    dabs: usize,
+    subdivide: u32,
+    dab_samples: Vec<u64>,
+    json: bool,
+    rows: Vec<String>,
+) -> Result<()> {
+    let document = open_subdivided(&file, resolution, subdivide, &budget(None))?;
+    let known = |row: &String| {
+        meshpaint::bench::paint::ROWS.iter().any(|&(name, ..)| {
+            *row == name
+                || (meshpaint::bench::paint::FRAME_PACED_ROWS.contains(&name) && *row == format!("{name}_frame_paced"))
+        })
+    };
+    if let Some(row) = rows.iter().find(|row| !known(row)) {
+        anyhow::bail!("--rows: no row named {row:?}");
+    }
+    let mut options = meshpaint::bench::PaintBenchOptions { dabs, rows, ..Default::default() };
+    if !dab_samples.is_empty() {
+        options.target_samples = dab_samples;
+    }
+    let mut report = meshpaint::bench::bench_paint(&document, &options)?;
+    report["file"] = file.display().to_string().into();
+    report["resolution"] = resolution.resolution.into();
+    report["subdivide"] = subdivide.into();
+    if json {
+        println!("{report}");
+    } else {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    }
+    Ok(())
+}
+
+/// `bench render`: frame times of the view.
+fn render(file: PathBuf, resolution: ResolutionArg, width: u32, height: u32, frames: usize) -> Result<()> {
+    let document = open(&file, resolution, &budget(None))?;
+    let result = meshpaint::bench::bench_render(&file, &document, width, height, frames)?;
+    let mut report = result.to_json();
+    report["file"] = file.display().to_string().into();
+    report["resolution"] = resolution.resolution.into();
+    println!("{report}");
+    Ok(())
+}
+
 /// `bench extremes`: every case, as JSON lines or a table; an error when a case fails.
 fn extremes(json: bool) -> Result<()> {
-    let gpu = meshpaint::render::Gpu::new_headless()?;
+    let gpu = meshpaint_render::Gpu::new_headless()?;
     let cases = meshpaint::bench::extremes::extreme_cases(&gpu)?;
     for case in &cases {
         if json {

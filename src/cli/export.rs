@@ -5,13 +5,13 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use meshpaint::colors::format::ColorFormat;
-use meshpaint::io::bake_uv::{bake_uv_texture, default_padding};
-use meshpaint::io::document::{Document, SourceKind, import_scene};
-use meshpaint::io::export_fit::{FitOptions, write_fitted_glb};
-use meshpaint::io::export_gltf::ColorEncoding;
-use meshpaint::io::export_textured::{TexturedMesh, encode_png, textured_glb};
-use meshpaint::mesh::weld::weld_scene;
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::convert::bake_uv::{bake_uv_texture, default_padding};
+use meshpaint_core::io::document::{Document, SourceKind, import_scene};
+use meshpaint_core::io::export_fit::{FitOptions, write_fitted_glb};
+use meshpaint_core::io::export_gltf::ColorEncoding;
+use meshpaint_core::io::export_textured::{TexturedMesh, encode_png, textured_glb};
+use meshpaint_core::mesh::weld::weld_scene;
 
 use super::args::{LOG_TARGET, OutputArgs, ResolutionArg, Written, budget, open, parse_format};
 
@@ -71,7 +71,7 @@ pub(super) fn run(args: ExportArgs) -> Result<()> {
     let packed_format = format.unwrap_or_default();
     let mut budget = budget(Some(packed_format));
     if output.is_glb()? {
-        budget.output_check = Some(meshpaint::io::export_gltf::check_tessellation_counts);
+        budget.output_check = Some(meshpaint_core::io::export_gltf::check_tessellation_counts);
     }
     let document = open(&path, resolution, &budget)?;
     match output.write(&document, &path, packed_format)? {
@@ -155,7 +155,7 @@ fn export_texture(args: &ExportArgs, size: u32) -> Result<()> {
         };
         textured_glb(&mesh, &png)?.bytes
     };
-    meshpaint::atomic_write::write_atomically(out, &bytes)
+    meshpaint_core::atomic_write::write_atomically(out, &bytes)
         .map_err(|error| anyhow::anyhow!("{}: cannot {}: {}", error.path.display(), error.action, error.source))?;
     eprintln!(
         "{} → {}: {size}×{size} texture, {coverage:.1}% of the texels in UV islands, {} of {faces} faces without UVs, {} B",

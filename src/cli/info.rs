@@ -4,15 +4,15 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use meshpaint::colors::budget::{Budget, SampleCounts, bytes_text};
-use meshpaint::colors::format::ColorFormat;
-use meshpaint::colors::layout::Resolution;
-use meshpaint::colors::stats::MeshStats;
-use meshpaint::io::adaptive::ResolutionRule;
-use meshpaint::io::document::SourceKind;
-use meshpaint::mesh::orientation::Orientation;
-use meshpaint::mesh::topology::Topology;
-use meshpaint::packing::file as packed_file;
+use meshpaint_core::colors::budget::{Budget, SampleCounts, bytes_text};
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::colors::layout::Resolution;
+use meshpaint_core::colors::stats::MeshStats;
+use meshpaint_core::convert::adaptive::ResolutionRule;
+use meshpaint_core::io::document::SourceKind;
+use meshpaint_core::mesh::orientation::Orientation;
+use meshpaint_core::mesh::topology::Topology;
+use meshpaint_core::packing::file as packed_file;
 
 use super::args::{LOG_TARGET, ResolutionArg, open};
 
@@ -93,11 +93,11 @@ fn gltf_info(path: &Path, resolution_arg: ResolutionArg, json: bool) -> Result<(
     let resolution = resolution_arg.get()?;
     let rule = resolution_arg.rule();
     let budget = Budget::from_environment();
-    let (scene, _) = meshpaint::io::document::import_scene_within(path, &budget)?;
+    let (scene, _) = meshpaint_core::io::document::import_scene_within(path, &budget)?;
     for warning in &scene.warnings {
         log::warn!(target: LOG_TARGET, "{}: {warning}", path.display());
     }
-    let mesh = meshpaint::mesh::weld::weld_scene(&scene);
+    let mesh = meshpaint_core::mesh::weld::weld_scene(&scene);
     let topology = Topology::build(mesh.positions_world.len() as u32, &mesh.triangles)
         .with_context(|| format!("{}: building topology", path.display()))?;
     let mut stats = MeshStats::new(&topology, mesh.degenerate_triangles_dropped, resolution);
@@ -112,8 +112,8 @@ fn gltf_info(path: &Path, resolution_arg: ResolutionArg, json: bool) -> Result<(
             // fit runs, the document's store is not allocated (a budget's calibration stores are
             // bounded by `least_squares::MAX_SAMPLES`).
             let face_count = topology.face_count() as usize;
-            let fit = meshpaint::io::least_squares::BakeFit::default();
-            let resolutions = meshpaint::io::adaptive::face_resolutions(&mesh, &scene, face_count, rule, fit);
+            let fit = meshpaint_core::convert::least_squares::BakeFit::default();
+            let resolutions = meshpaint_core::convert::adaptive::face_resolutions(&mesh, &scene, face_count, rule, fit);
             let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);
             stats.samples = counts.samples;
             stats.samples_with_mips = counts.samples_with_mips;

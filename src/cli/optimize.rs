@@ -4,9 +4,9 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use meshpaint::colors::format::ColorFormat;
-use meshpaint::paint::UndoHistory;
-use meshpaint::paint::optimize::optimize;
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::paint::UndoHistory;
+use meshpaint_core::paint::optimize::optimize;
 
 use super::args::{OutputArgs, ResolutionArg, Written, budget, open, packed_format, parse_format};
 

@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use meshpaint::colors::format::ColorFormat;
-use meshpaint::packing::file as packed_file;
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::packing::file as packed_file;
 
 use super::args::{ResolutionArg, budget, open, packed_format, parse_format};
 

@@ -4,9 +4,11 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use meshpaint::colors::format::{ColorFormat, Rgba};
-use meshpaint::colors::layout::Resolution;
-use meshpaint::paint::brush::{BlendMode, BrushRadius, BrushSettings, Falloff, PaintView, Painter, ResolutionOp, Tool};
+use meshpaint_core::colors::format::{ColorFormat, Rgba};
+use meshpaint_core::colors::layout::Resolution;
+use meshpaint_core::paint::brush::{
+    BlendMode, BrushRadius, BrushSettings, Falloff, PaintView, Painter, ResolutionOp, Tool,
+};
 
 use super::args::{CameraArgs, OutputArgs, ResolutionArg, budget, open, packed_format, parse_format};
 
@@ -132,8 +134,9 @@ fn brush_settings(args: &PaintArgs, color: Rgba) -> Result<BrushSettings> {
 
 pub(super) fn run(args: PaintArgs) -> Result<()> {
     let glb = args.output.is_glb()?;
-    let stroke = meshpaint::paint::brush::parse_stroke(&args.stroke).map_err(|e| anyhow::anyhow!("--stroke: {e}"))?;
-    let color = meshpaint::paint::brush::parse_hex_color(&args.color)
+    let stroke =
+        meshpaint_core::paint::brush::parse_stroke(&args.stroke).map_err(|e| anyhow::anyhow!("--stroke: {e}"))?;
+    let color = meshpaint_core::paint::brush::parse_hex_color(&args.color)
         .with_context(|| format!("--color '{}' is not #rrggbb", args.color))?;
     args.camera.check()?;
     anyhow::ensure!(args.width > 0 && args.height > 0, "--width and --height must be positive");
@@ -142,17 +145,17 @@ pub(super) fn run(args: PaintArgs) -> Result<()> {
     let started = std::time::Instant::now();
     let mut budget = budget(args.format);
     if glb {
-        budget.output_check = Some(meshpaint::io::export_gltf::check_tessellation_counts);
+        budget.output_check = Some(meshpaint_core::io::export_gltf::check_tessellation_counts);
     }
     let mut document = open(&args.file, args.resolution, &budget)?;
     let format = packed_format(args.format, document.source);
     let CameraArgs { yaw, pitch, distance } = args.camera;
-    let bounds = meshpaint::camera::BoundingSphere::of_points(&document.positions);
-    let camera = meshpaint::camera::default_camera(bounds, yaw, pitch, distance);
-    let bvh = meshpaint::paint::picking::MeshBvh::build(
+    let bounds = meshpaint_core::camera::BoundingSphere::of_points(&document.positions);
+    let camera = meshpaint_core::camera::default_camera(bounds, yaw, pitch, distance);
+    let bvh = meshpaint_core::paint::picking::MeshBvh::build(
         &document.positions,
         &document.store.topology().face_vertices,
-        meshpaint::paint::picking::BvhPreset::default(),
+        meshpaint_core::paint::picking::BvhPreset::default(),
     );
     let base = document.store.clone();
     let view = PaintView {
@@ -165,9 +168,9 @@ pub(super) fn run(args: PaintArgs) -> Result<()> {
     let mut painter = Painter::new(&document.positions);
     painter.set_settings(settings);
     painter.set_budget(Some((budget, format)));
-    let mut history = meshpaint::paint::undo::UndoHistory::default();
+    let mut history = meshpaint_core::paint::undo::UndoHistory::default();
     let (update, _) =
-        meshpaint::paint::brush::replay_stroke(&mut painter, &view, &mut document.store, &mut history, &stroke)?;
+        meshpaint_core::paint::brush::replay_stroke(&mut painter, &view, &mut document.store, &mut history, &stroke)?;
 
     if glb {
         anyhow::ensure!(args.format.is_none(), "--format applies to packed output only");

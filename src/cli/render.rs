@@ -4,10 +4,11 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use meshpaint::camera::default_camera;
-use meshpaint::colors::budget::Budget;
-use meshpaint::io::document::{Source, open_for_display_within};
-use meshpaint::render::{DrawItem, FilterMode, Gpu, Overlays, RenderSettings, Shading};
+use meshpaint_core::camera::default_camera;
+use meshpaint_core::colors::budget::Budget;
+use meshpaint_core::io::display::{OpenOptions, open_for_display};
+use meshpaint_core::io::document::Source;
+use meshpaint_render::{DrawItem, FilterMode, Gpu, Overlays, RenderSettings, Shading};
 
 use super::args::{CameraArgs, LOG_TARGET, ResolutionArg};
 
@@ -106,7 +107,7 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
     let gpu = Gpu::new_headless()?;
     let budget = Budget::from_environment().with_gpu(gpu.budget_limits());
     let (image, triangles, samples) = if args.baseline_uv {
-        let (scene, _) = meshpaint::io::document::import_scene_within(&args.file, &budget)?;
+        let (scene, _) = meshpaint_core::io::document::import_scene_within(&args.file, &budget)?;
         let mesh = gpu.upload_baseline(&scene)?.with_context(|| {
             format!(
                 "{}: --baseline-uv needs a glTF file with a base-colour texture, and no material has one",
@@ -117,17 +118,20 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
         (image, mesh.vertex_count / 3, 0)
     } else {
         let source = Source::File(args.file.clone());
-        let displayed = open_for_display_within(&source, args.resolution.get()?, &budget, &mut |_, _| {})?;
+        let options = OpenOptions::new(args.resolution.get()?, budget);
+        let upload = |packed: &_| if args.position_colors { Ok(None) } else { gpu.upload(packed).map(Some) };
+        let displayed = open_for_display(&source, &options, &|_, _| {}, upload)?;
         for warning in &displayed.document.warnings {
             log::warn!(target: LOG_TARGET, "{}: {warning}", args.file.display());
         }
-        let mesh = if args.position_colors {
-            let document = &displayed.document;
-            let store = meshpaint::io::document::position_colored(&document.store, &document.positions);
-            let view = meshpaint::io::document::Document { store, ..document.clone() };
-            gpu.upload(&view.pack(document.display_format())?)?
-        } else {
-            gpu.upload(&displayed.packed)?
+        let mesh = match displayed.upload {
+            Some(mesh) => mesh,
+            None => {
+                let document = &displayed.document;
+                let store = meshpaint_core::io::document::position_colored(&document.store, &document.positions);
+                let view = meshpaint_core::io::document::Document { store, ..document.clone() };
+                gpu.upload(&view.pack(document.display_format())?)?
+            }
         };
         let image = gpu.render_image(DrawItem::MeshColors(&mesh), &settings(mesh.bounds), args.width, args.height)?;
         (image, mesh.face_count, mesh.atlas.samples)

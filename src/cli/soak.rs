@@ -1,15 +1,16 @@
-//! The hidden `meshpaint autosave-soak` test helper (used by tests/autosave.rs).
+//! The hidden `meshpaint autosave-soak` test helper (used by tests/app/autosave.rs).
 
 use std::path::PathBuf;
 
 use anyhow::Result;
 
-use meshpaint::colors::store::SampleRef;
-use meshpaint::packing::file as packed_file;
+use meshpaint_core::colors::store::SampleRef;
+use meshpaint_core::packing::file as packed_file;
+use meshpaint_core::paint::undo::{StoreWriter, UndoHistory};
 
 use super::args::{ResolutionArg, budget, open};
 
-/// Arguments of the hidden `meshpaint autosave-soak` (used by tests/autosave.rs).
+/// Arguments of the hidden `meshpaint autosave-soak` (used by tests/app/autosave.rs).
 #[derive(Debug, clap::Args)]
 pub(super) struct SoakArgs {
     /// The document (glTF or packed).
@@ -43,19 +44,21 @@ pub(super) fn run(args: SoakArgs) -> Result<()> {
     let last = args.start_generation.saturating_add(args.iterations.saturating_sub(1));
     loop {
         let marker = generation as f32;
-        document.store.set(SampleRef::Vertex(0), [marker, 0.0, 0.0, 1.0]);
-        for face in (0..document.store.topology().face_count()).step_by(7) {
-            let len = document.store.interior_samples(face).len() as u32;
+        let mut history = UndoHistory::new(0);
+        let mut writer = StoreWriter::new(&mut document.store, &mut history);
+        writer.set(SampleRef::Vertex(0), [marker, 0.0, 0.0, 1.0]);
+        for face in (0..writer.store().topology().face_count()).step_by(7) {
+            let len = writer.store().interior_samples(face).len() as u32;
             for offset in 0..len {
                 let shade = ((generation + u64::from(offset)) % 17) as f32 / 16.0;
-                document.store.set(SampleRef::Interior { face, offset }, [shade, 0.5, 1.0 - shade, 1.0]);
+                writer.set(SampleRef::Interior { face, offset }, [shade, 0.5, 1.0 - shade, 1.0]);
             }
         }
-        meshpaint::io::autosave::write_recovery(&args.recovery, &document)?;
+        meshpaint_core::io::autosave::write_recovery(&args.recovery, &document)?;
         writeln!(stdout, "recovery {generation}")?;
         stdout.flush()?;
         if generation.is_multiple_of(3) {
-            let packed = document.pack(meshpaint::io::autosave::RECOVERY_FORMAT)?;
+            let packed = document.pack(meshpaint_core::io::autosave::RECOVERY_FORMAT)?;
             packed_file::write_file(&args.saved, &packed)?;
             writeln!(stdout, "saved {generation}")?;
             stdout.flush()?;

@@ -5,18 +5,19 @@
 use glam::DVec3;
 use serde_json::json;
 
-use crate::camera::{BoundingSphere, OrbitCamera};
-use crate::colors::format::{ColorFormat, Rgba};
-use crate::colors::layout::{self, Resolution};
-use crate::colors::store::ColorStore;
-use crate::mesh::topology::Topology;
-use crate::packing::linear::PackedMesh;
-use crate::packing::packer::pack;
-use crate::packing::sampler::{Filter, sample};
-use crate::paint::brush::{BlendMode, BrushRadius, BrushSettings, Falloff, PaintView, Painter, Tool};
-use crate::paint::picking::{BvhPreset, MeshBvh};
-use crate::paint::undo::UndoHistory;
-use crate::render::{FilterMode, Gpu, GpuMesh};
+use meshpaint_core::camera::{BoundingSphere, OrbitCamera};
+use meshpaint_core::colors::format::{ColorFormat, Rgba};
+use meshpaint_core::colors::layout::{self, Resolution};
+use meshpaint_core::colors::store::ColorStore;
+use meshpaint_core::mesh::topology::Topology;
+use meshpaint_core::packing::linear::PackedMesh;
+use meshpaint_core::packing::packer::pack;
+use meshpaint_core::packing::sampler::{Filter, sample};
+use meshpaint_core::paint::brush::{BlendMode, BrushRadius, BrushSettings, Falloff, PaintView, Painter, Tool};
+use meshpaint_core::paint::picking::{BvhPreset, MeshBvh};
+use meshpaint_core::paint::undo::UndoHistory;
+use meshpaint_core::synth::{OCTAHEDRON_POSITIONS, OCTAHEDRON_TRIANGLES};
+use meshpaint_render::{FilterMode, Gpu, GpuMesh};
 
 use super::probe::{
     Comparison, Probe, Rng, SIZE, Truth, cast_all, compare, compare_fixed, dvec, nearest_boundary_distance,
@@ -24,7 +25,7 @@ use super::probe::{
 };
 use super::{CELL_MARGIN, ExtremeCase, ExtremesError, MAX_STEPS};
 
-const GPU_TEST: &str = "tests/extremes.rs (every case); tests/gpu_render.rs (same procedure)";
+const GPU_TEST: &str = "tests/app/extremes.rs (every case); tests/app/gpu_render.rs (same procedure)";
 
 fn r(log2: u32) -> Resolution {
     Resolution::from_log2(log2).unwrap_or(Resolution::ONE)
@@ -155,12 +156,8 @@ fn nearest_exact(res: Resolution, bary: [f64; 3]) -> (u32, u32) {
 /// vertices are not representable in `f32`: moving it rounds every one of them).
 fn octahedron(size: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let rotation = glam::DMat3::from_euler(glam::EulerRot::YXZ, 0.3, 0.7, 0.1);
-    let positions =
-        [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]
-            .map(|p| (rotation * DVec3::from_array(p) * size).to_array())
-            .to_vec();
-    let triangles = vec![[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
-    (positions, triangles)
+    let positions = OCTAHEDRON_POSITIONS.map(|p| (rotation * DVec3::from_array(p) * size).to_array()).to_vec();
+    (positions, OCTAHEDRON_TRIANGLES.to_vec())
 }
 
 /// The spacing of `f32` values at magnitude `m` (one ulp).
@@ -275,7 +272,7 @@ fn offset_pick(transform: Transform, meshes: &Meshes, ulp: f64) -> ExtremeCase {
         measured: worst,
         unit: "ulps of f32 at the mesh's coordinates, along the face normal (moved hit − transformed unmoved hit)",
         tolerance: 3f64.sqrt() / 2.0 + 0.05,
-        test: "tests/extremes.rs; tests/picking.rs extremes_match_brute_force",
+        test: "tests/app/extremes.rs; crates/core/tests/core/picking.rs extremes_match_brute_force",
         outcome: "measured".into(),
         sound: compared > 500 && faces_differ == 0,
         detail: json!({
@@ -327,7 +324,7 @@ fn offset_paint(transform: Transform, meshes: &Meshes, ulp: f64) -> Result<Extre
         measured: f64::from(differ),
         unit: "samples painted on one mesh and not the other, outside a band of 4 ulps at the brush rim",
         tolerance: 0.0,
-        test: "tests/extremes.rs",
+        test: "tests/app/extremes.rs",
         outcome: "measured".into(),
         sound: painted > 50,
         detail: json!({ "painted_samples": painted, "samples_in_rim_band": in_band, "band_world": band * transform.scale }),
@@ -374,7 +371,7 @@ fn dab_on(
     Ok(Dabbed { store, center, radius_world: radius })
 }
 
-/// A sliver next to a zero-area face (as `tests/gpu_render.rs` `sliver_and_degenerate_faces`),
+/// A sliver next to a zero-area face (as `tests/app/gpu_render.rs` `sliver_and_degenerate_faces`),
 /// a thin prism picked by rays, and a vertex of valence 200, rendered and picked.
 pub fn slivers_and_valence(gpu: &Gpu) -> Result<Vec<ExtremeCase>, ExtremesError> {
     let camera = OrbitCamera::framing(BoundingSphere { center: [0.0; 3], radius: 1.0 }, 0.0, 0.0);
@@ -478,7 +475,7 @@ fn pick_row(case: &str, positions: &[[f32; 3]], triangles: &[[u32; 3]], rays: &[
         measured: f64::from(differ),
         unit: "rays whose BVH hit differs from the brute-force f64 ray cast",
         tolerance: 0.0,
-        test: "tests/extremes.rs; tests/picking.rs high_valence_apex_and_slivers",
+        test: "tests/app/extremes.rs; crates/core/tests/core/picking.rs high_valence_apex_and_slivers",
         outcome: "measured".into(),
         sound: compared * 2 > rays.len() as u32,
         detail: json!({ "rays": rays.len(), "compared": compared }),
@@ -529,7 +526,7 @@ pub fn grazing_brush() -> Result<Vec<ExtremeCase>, ExtremesError> {
             measured: f64::from(differ),
             unit: "samples whose painted state differs from the closed-form disc |p − c| ≤ r",
             tolerance: 0.0,
-            test: "tests/extremes.rs",
+            test: "tests/app/extremes.rs",
             outcome: "measured".into(),
             sound: inside >= 3 && pick_error_px < 1e-3,
             detail: json!({

@@ -3,7 +3,7 @@
 //!
 //! One [`ExtremeCase`] per case: `case`, the `measured` error with its `unit`, the
 //! `tolerance`, the `test` that enforces it, and the `outcome` (what the program does:
-//! measured, sanitised or refused, with the message). `tests/extremes.rs` runs
+//! measured, sanitised or refused, with the message). `tests/app/extremes.rs` runs
 //! [`extreme_cases`] and fails when any case is over its tolerance or unsound (too few
 //! pixels compared, coverage errors), and runs `meshpaint bench extremes --json`.
 //!
@@ -23,13 +23,13 @@ mod values;
 
 use thiserror::Error;
 
-use crate::render::{Gpu, RenderError};
+use meshpaint_render::{Gpu, RenderError};
 
 /// Largest per-channel GPU-vs-CPU difference the render cases allow, 8-bit steps (the
-/// `MAX_STEPS` of `tests/gpu_render.rs`).
+/// `MAX_STEPS` of `tests/app/gpu_render.rs`).
 pub const MAX_STEPS: f64 = 1.0;
 /// Nearest filtering: pixels within this many lattice units of a cell boundary cannot be
-/// called (the `CELL_MARGIN` of `tests/gpu_render.rs`).
+/// called (the `CELL_MARGIN` of `tests/app/gpu_render.rs`).
 pub const CELL_MARGIN: f64 = 1e-3;
 
 /// Errors of the extremes benchmark (a case that could not be set up, or the GPU).

@@ -1,17 +1,18 @@
 //! The truths the extreme cases are measured against: a per-pixel `f64` ray cast over
 //! every triangle (no BVH), the CPU reference sampler at the hit, and the comparison of a
-//! GPU render with it in 8-bit steps (the same procedure as `tests/gpu_render.rs`).
+//! GPU render with it in 8-bit steps (the same procedure as `tests/app/gpu_render.rs`).
 
 use glam::DVec3;
 
-use crate::camera::OrbitCamera;
-use crate::colors::format::{Rgba, encode_rgba8_srgb};
-use crate::colors::layout::{self, Resolution};
-use crate::colors::store::ColorStore;
-use crate::mesh::topology::Topology;
-use crate::packing::linear::PackedMesh;
-use crate::packing::sampler::{Filter, sample};
-use crate::render::{DrawItem, FilterMode, Gpu, GpuMesh, RenderSettings, Shading};
+use meshpaint_core::camera::OrbitCamera;
+use meshpaint_core::colors::format::{Rgba, encode_rgba8_srgb};
+use meshpaint_core::colors::layout::{self, Resolution};
+use meshpaint_core::colors::store::ColorStore;
+use meshpaint_core::mesh::topology::Topology;
+use meshpaint_core::packing::linear::PackedMesh;
+use meshpaint_core::packing::sampler::{Filter, sample};
+use meshpaint_core::paint::undo::{StoreWriter, UndoHistory};
+use meshpaint_render::{DrawItem, FilterMode, Gpu, GpuMesh, RenderSettings, Shading};
 
 use super::ExtremesError;
 
@@ -20,26 +21,9 @@ pub const SIZE: u32 = 256;
 /// Pixels whose centre has a barycentric coordinate below this are edge pixels (skipped).
 pub const EDGE_MARGIN: f64 = 1e-4;
 
-/// A deterministic source of numbers in `[0, 1)` (SplitMix64).
-#[derive(Debug, Clone)]
-pub struct Rng(pub u64);
-
-impl Rng {
-    /// The next number in `[0, 1)`.
-    pub fn unit(&mut self) -> f32 {
-        self.unit_f64() as f32
-    }
-
-    /// The next number in `[0, 1)`, full `f64` precision (53 bits).
-    pub fn unit_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+/// The deterministic source of the cases (SplitMix64, shared with the tests and the fuzzer);
+/// `unit_f64() as f32` where an `f32` is drawn.
+pub use meshpaint_core::synth::SplitMix64 as Rng;
 
 /// Triangles, a camera and their colours.
 #[derive(Debug, Clone)]
@@ -76,7 +60,8 @@ pub fn random_store(
     let topology = Topology::build(vertex_count as u32, triangles).map_err(ExtremesError::setup)?;
     let mut store = ColorStore::with_resolutions(topology, resolutions, [0.0; 4]).map_err(ExtremesError::setup)?;
     let mut rng = Rng(seed);
-    store.fill_with(|_| [rng.unit(), rng.unit(), rng.unit(), 0.5 + 0.5 * rng.unit()]);
+    let mut unit = || rng.unit_f64() as f32;
+    StoreWriter::new(&mut store, &mut UndoHistory::new(0)).fill_with(|_| [unit(), unit(), unit(), 0.5 + 0.5 * unit()]);
     Ok(store)
 }
 
@@ -259,7 +244,7 @@ fn level_resolution(packed: &PackedMesh, face: u32, level: u32) -> Option<Resolu
 }
 
 /// Whether nearest filtering could pick another sample within [`super::CELL_MARGIN`]
-/// lattice units of `bary` (as `tests/gpu_render.rs` decides).
+/// lattice units of `bary` (as `tests/app/gpu_render.rs` decides).
 pub fn near_cell_boundary(packed: &PackedMesh, face: u32, bary: [f32; 3], level: u32) -> bool {
     let Some(res) = level_resolution(packed, face, level) else { return true };
     let chosen = layout::nearest_sample(res, bary);
@@ -270,7 +255,7 @@ pub fn near_cell_boundary(packed: &PackedMesh, face: u32, bary: [f32; 3], level:
 
 /// Whether the linear reference moves by more than ⅓ of an 8-bit step when the
 /// barycentrics move by 5·10⁻⁷ (a rasteriser's interpolation noise on faces thousands of
-/// pixels wide), as `tests/gpu_render.rs` decides.
+/// pixels wide), as `tests/app/gpu_render.rs` decides.
 pub fn ill_conditioned(packed: &PackedMesh, face: u32, bary: [f32; 3], level: u32) -> bool {
     const BARY_NOISE: f32 = 5e-7;
     let Some(center) = sample(packed, face, bary, Filter::Linear, level) else { return true };

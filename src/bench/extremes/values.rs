@@ -3,21 +3,23 @@
 
 use serde_json::json;
 
-use crate::colors::format::{ColorFormat, MAX_CHANNEL, Rgba, is_storable};
-use crate::colors::layout::Resolution;
-use crate::colors::store::{ColorStore, SampleRef};
-use crate::mesh::topology::Topology;
-use crate::packing::file as packed_file;
-use crate::packing::linear::{FaceRecord, PackedMesh};
-use crate::packing::packer::pack;
-use crate::packing::sampler::{Filter, sample};
-use crate::paint::brush::{BlendMode, BrushSettings};
-use crate::render::{FilterMode, Gpu};
+use meshpaint_core::colors::format::{ColorFormat, MAX_CHANNEL, Rgba, is_storable};
+use meshpaint_core::colors::layout::Resolution;
+use meshpaint_core::colors::store::{ColorStore, SampleRef};
+use meshpaint_core::mesh::topology::Topology;
+use meshpaint_core::packing::file as packed_file;
+use meshpaint_core::packing::linear::{FaceRecord, PackedMesh};
+use meshpaint_core::packing::packer::pack;
+use meshpaint_core::packing::sampler::{Filter, sample};
+use meshpaint_core::paint::brush::{BlendMode, BrushSettings};
+use meshpaint_core::paint::undo::UndoHistory;
+use meshpaint_render::{FilterMode, Gpu};
 
 use super::probe::{Rng, render};
 use super::{ExtremeCase, ExtremesError};
 
-const TEST: &str = "tests/extremes.rs; tests/budget.rs the_store_blends_and_encoders_never_hold_a_non_finite_colour";
+const TEST: &str =
+    "tests/app/extremes.rs; tests/app/budget.rs the_store_blends_and_encoders_never_hold_a_non_finite_colour";
 
 /// One triangle facing the default camera, uniform `color` at R = `2^log2`.
 fn triangle_store(color: Rgba, log2: u32) -> Result<(Vec<[f32; 3]>, ColorStore), ExtremesError> {
@@ -46,7 +48,11 @@ fn rgba16f_max(gpu: &Gpu) -> Result<Vec<ExtremeCase>, ExtremesError> {
         .map(|c| (0..4).map(|ch| f64::from((c[ch] - top[ch]).abs())).fold(0.0, f64::max))
         .fold(0.0, f64::max);
     let mesh = gpu.upload(&packed)?;
-    let camera = crate::camera::OrbitCamera::framing(crate::camera::BoundingSphere::of_points(&positions), 0.0, 0.0);
+    let camera = meshpaint_core::camera::OrbitCamera::framing(
+        meshpaint_core::camera::BoundingSphere::of_points(&positions),
+        0.0,
+        0.0,
+    );
     let mut render_error = 0u8;
     let mut covered = 0u32;
     for filter in [FilterMode::Linear, FilterMode::Trilinear] {
@@ -90,12 +96,12 @@ fn add_blend_hdr() -> Result<ExtremeCase, ExtremesError> {
     store.for_each_site(|site| sites.push(site));
     for (k, site) in sites.iter().enumerate() {
         // Magnitudes from 1e-3 to 2 · 65504 (log-uniform), so both rounding and saturation show.
-        let magnitude = |rng: &mut Rng| 10f32.powf(-3.0 + 8.12 * rng.unit()).min(MAX_CHANNEL);
+        let magnitude = |rng: &mut Rng| 10f32.powf(-3.0 + 8.12 * (rng.unit_f64() as f32)).min(MAX_CHANNEL);
         let (a, b) = ([0; 3].map(|_| magnitude(&mut rng)), [0; 3].map(|_| magnitude(&mut rng)));
         let old = [a[0], a[1], a[2], 1.0];
         let color = [b[0], b[1], b[2], 1.0];
         let blended = BlendMode::Add.blend(old, color, old, 1.0);
-        store.set(site.sample, blended);
+        UndoHistory::new(0).set_sample(&mut store, site.sample, blended);
         wanted.push((k, [0, 1, 2].map(|c| (f64::from(a[c]) + f64::from(b[c])).min(f64::from(MAX_CHANNEL)))));
     }
     let packed = pack(&store, &positions, ColorFormat::Rgba16F).map_err(ExtremesError::setup)?;
@@ -120,7 +126,7 @@ fn add_blend_hdr() -> Result<ExtremeCase, ExtremesError> {
         measured: worst,
         unit: "relative error of the packed RGBA16F value against min(a + b, 65504)",
         tolerance: 2f64.powi(-11),
-        test: "tests/extremes.rs",
+        test: "tests/app/extremes.rs",
         outcome: format!(
             "sanitised: Add saturates at 65504 (65504 + 65504 = {}), RGBA8 clamps HDR to 1 (1.5 → {:?})",
             at_top[0],
@@ -145,7 +151,7 @@ fn non_finite() -> Result<ExtremeCase, ExtremesError> {
     let mut through = 0u32;
     let mut stored = Vec::new();
     for color in bad {
-        store.set(SampleRef::Vertex(0), color);
+        UndoHistory::new(0).set_sample(&mut store, SampleRef::Vertex(0), color);
         let got = store.get(SampleRef::Vertex(0)).unwrap_or([f32::NAN; 4]);
         through += u32::from(!is_storable(got));
         stored.push(format!("{color:?} → {got:?}"));

@@ -1,0 +1,739 @@
+//! Per-face resolution chosen by the content when a textured mesh is converted.
+//!
+//! # Rules ([`ResolutionRule`])
+//!
+//! - **Uniform** `R` on every face (the first round's behaviour).
+//! - **Texel density**: `R_f` = the smallest power of two ≥ the face's longest UV edge in
+//!   texels of the base-colour texture's level 0 (one sample per texel along that edge),
+//!   capped at `max`. Faces without a texture get `R = 1` (their colour is one constant).
+//! - **Error bound** `E`: `R_f` = the lowest power of two (up to `max`) whose
+//!   reconstruction stays within `E` of the texture on the face.
+//!
+//! # The error of a face at `R` (the metric behind `--error E`)
+//!
+//! The face's lattice at `R` is baked as [`crate::convert::bake::bake_texture`] bakes it (the
+//! texture read trilinearly at the level matched to the sample spacing, in linear light,
+//! times the base-colour factor), and reconstructed with the linear filter (eq. 2.4) at
+//! the centroids of the `D²` sub-triangles of a denser lattice `D` — the *test points*,
+//! `D` = twice the smallest power of two ≥ the face's longest UV edge in texels, at least
+//! 8, at least `2R` and at most `2·max`, so every texel the face covers holds several
+//! points and so does every strip one sample spacing wide along an edge (where a UV seam's
+//! foreign colours fade out: with `D` from the texture alone, faces under a texel were
+//! tested on a lattice of 8 at every `R`, and at `R ≥ 32` the strip held no point). The truth
+//! at a test point is the texture's level 0 read bilinearly there (what a magnified UV
+//! render shows) times the factor. The error is the **root mean square** of the
+//! differences over the test points and the four channels, the colour channels compared
+//! **sRGB-encoded** (as a display and the PSNR of 8-bit images see them; alpha as is;
+//! colour units: full range = 1, RMS 0.01 ≈ 40 dB PSNR of 8-bit images). RMS, not the maximum, because a
+//! single texel spike should not force a whole face to the finest `R`; the PSNR the
+//! measurements report is an RMS measure too.
+//!
+//! Errors at or below [`ROUNDING`] count as zero (the float rounding of the bake and of
+//! the reconstruction), so `E = 0` means lossless within rounding, as for `optimize`, and a
+//! constant colour (a 1 × 1 texture, a face whose UVs have no area) needs only `R = 1`.
+//!
+//! The fit treats each face alone (its edges at its own `R`). In the mesh an edge takes
+//! the larger `R` of its two faces, which only adds texture samples along it. Faces are
+//! fitted in parallel (rayon).
+//!
+//! The errors the texel-density and error-bound rules predict are the point bake's. The
+//! conversion then refines the bake to the least-squares fit ([`crate::convert::least_squares`],
+//! [`BakeFit::LeastSquares`], the default), which shows most faces closer to the texture; an
+//! error bound is verified on the store as fitted ([`bake_and_verify`]).
+//!
+//! A **budget** allocation for the least-squares bake measures what the fit shows instead:
+//! the whole mesh is baked and fitted at each uniform `R` whose sample count is at most
+//! [`CALIBRATION_FACTOR`] × the budget (counted before the store is allocated), and each
+//! face's error at that `R` is measured on that store (its neighbours at the same `R`, as the
+//! fit balances shared samples between them). Above the finest such `R`, a face's point-bake
+//! error is scaled by the gain its fit made there. (A face fitted alone, every sample free,
+//! predicts far too little error at low `R`, where the global fit cannot give each face its
+//! own vertices: Fox's budget rows fell from 26.6–51.0 dB to 22.2–31.8 dB with it.)
+//!
+//! Those predictions come from uniform stores, where a face's neighbours share its `R`. In
+//! the allocated store a coarse face fans towards finer edges and the fit balances shared
+//! samples between faces of different `R`, so a face can show more or less error than
+//! predicted. [`REFINEMENT_ROUNDS`] times, the allocation is baked, fitted and measured as
+//! shown, each face's predicted distortions are scaled by measured / predicted at its `R`,
+//! and the budget is allocated again; the allocation whose store showed the least
+//! area-weighted squared error is kept (the first one included).
+
+use rayon::prelude::*;
+
+use crate::colors::budget::SampleCounts;
+use crate::colors::format::{Rgba, linear_to_srgb};
+use crate::colors::layout::{self, Resolution};
+use crate::colors::store::ColorStore;
+use crate::convert::bake::{FaceMaterial, bake_texture, face_materials, interpolate_uv, material_color, world_area};
+use crate::convert::least_squares::{self, BakeFit};
+use crate::mesh::scene::Scene;
+use crate::mesh::topology::Topology;
+use crate::mesh::weld::WeldedMesh;
+use crate::packing::sampler::{Filter, sample};
+
+/// Errors (RMS, sRGB-encoded colour units) at or below this are float rounding and count as
+/// zero: a constant colour baked and reconstructed differs from its texel by a few ulps.
+/// The same value as [`crate::paint::optimize::LOSSLESS_TOLERANCE`].
+pub const ROUNDING: f32 = 1e-6;
+
+/// How faces get their resolution when a glTF mesh is converted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ResolutionRule {
+    /// The same `R` on every face.
+    Uniform(Resolution),
+    /// `R` on faces whose material has a base-colour texture, `R = 1` (the lowest) on the
+    /// others: what the editor opens a mesh at by default. A face without a texture shows
+    /// one colour, or its vertex colours, which `R = 1` holds exactly; painting raises it
+    /// (resolution follows the brush), so memory grows only where the artist paints.
+    WhereTextured(Resolution),
+    /// One sample per texel along each face's longest UV edge, up to `max`.
+    TexelDensity {
+        /// The largest `R` given.
+        max: Resolution,
+    },
+    /// The face resolutions that minimise the area-weighted squared error over the mesh
+    /// with at most `samples` level-0 samples (rate–distortion allocation, module docs).
+    Budget {
+        /// The level-0 sample budget.
+        samples: u64,
+        /// The largest `R` given.
+        max: Resolution,
+    },
+    /// The lowest `R` whose reconstruction error (RMS of sRGB-encoded differences) is at most `bound`.
+    ErrorBound {
+        /// `E`, colour units (full range = 1).
+        bound: f32,
+        /// The largest `R` given.
+        max: Resolution,
+    },
+}
+
+impl From<Resolution> for ResolutionRule {
+    fn from(r: Resolution) -> Self {
+        ResolutionRule::Uniform(r)
+    }
+}
+
+impl ResolutionRule {
+    /// A short description for reports (`R = 8`, `texel density ≤ 64`, `error ≤ 0.01, R ≤ 64`).
+    pub fn describe(&self) -> String {
+        match self {
+            ResolutionRule::Uniform(r) => format!("R = {}", r.get()),
+            ResolutionRule::WhereTextured(r) => format!("R = {} where textured, 1 elsewhere", r.get()),
+            ResolutionRule::TexelDensity { max } => format!("texel density, R ≤ {}", max.get()),
+            ResolutionRule::ErrorBound { bound, max } => format!("error ≤ {bound}, R ≤ {}", max.get()),
+            ResolutionRule::Budget { samples, max } => format!("≤ {samples} samples, R ≤ {}", max.get()),
+        }
+    }
+}
+
+/// Each face's resolution under `rule` (`face_count` faces of `mesh`).
+/// A budget's allocation predicts the error of the bake `fit` will make (module docs).
+pub fn face_resolutions(
+    mesh: &WeldedMesh,
+    scene: &Scene,
+    face_count: usize,
+    rule: ResolutionRule,
+    fit: BakeFit,
+) -> Vec<Resolution> {
+    if let ResolutionRule::Uniform(r) = rule {
+        return vec![r; face_count];
+    }
+    let (materials, pyramids) = face_materials(mesh, scene, face_count);
+    let shared = shared_uvs(mesh);
+    if shared.len() != face_count {
+        return vec![Resolution::ONE; face_count];
+    }
+    if let ResolutionRule::Budget { samples, max } = rule {
+        let faces = Faces { mesh, materials: &materials, shared: &shared, pyramids: &pyramids, max };
+        // The calibration stores are dropped before the refinement allocates its own.
+        let mut distortion = faces.predicted_distortions(&calibration_stores(mesh, scene, samples, max, fit));
+        let first = allocate_budget(mesh, &distortion, samples, max);
+        return refine_allocation(&faces, scene, &mut distortion, first, samples, fit);
+    }
+    let material_boundary = if matches!(rule, ResolutionRule::WhereTextured(_)) {
+        faces_on_material_boundaries(mesh, face_count)
+    } else {
+        Vec::new()
+    };
+    (0..face_count)
+        .into_par_iter()
+        .map(|face| {
+            let material = &materials[face];
+            if material.texture.is_none() {
+                // Shared vertices hold one colour: a face touching another material keeps
+                // `R` so the blend between the two colours stays within one sample spacing.
+                return match rule {
+                    ResolutionRule::WhereTextured(r) if material_boundary.get(face).copied().unwrap_or(false) => r,
+                    _ => Resolution::ONE,
+                };
+            }
+            let uvs = mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
+            match rule {
+                ResolutionRule::Uniform(r)
+                | ResolutionRule::WhereTextured(r)
+                | ResolutionRule::Budget { max: r, .. } => r,
+                ResolutionRule::TexelDensity { max } => power_of_two_at_least(material.longest_uv_edge_texels, max),
+                ResolutionRule::ErrorBound { bound, max } => {
+                    let fit = FaceFit::new(&materials, face, shared[face], &pyramids, uvs, max);
+                    (0..=max.log2())
+                        .filter_map(|log2| Resolution::from_log2(log2).ok())
+                        .find(|&r| fit.error(r) <= bound.max(ROUNDING))
+                        .unwrap_or(max)
+                }
+            }
+        })
+        .collect()
+}
+
+/// For each face, whether one of its vertices is shared with a face of another material.
+fn faces_on_material_boundaries(mesh: &WeldedMesh, face_count: usize) -> Vec<bool> {
+    const NONE: u32 = u32::MAX;
+    const MIXED: u32 = u32::MAX - 1;
+    let material = |f: usize| mesh.triangle_materials.get(f).copied().flatten().unwrap_or(NONE - 2);
+    let mut vertex_material = vec![NONE; mesh.positions_world.len()];
+    for (f, triangle) in mesh.triangles.iter().enumerate().take(face_count) {
+        for &v in triangle {
+            if let Some(slot) = vertex_material.get_mut(v as usize) {
+                *slot = match *slot {
+                    NONE => material(f),
+                    m if m == material(f) => m,
+                    _ => MIXED,
+                };
+            }
+        }
+    }
+    (0..face_count)
+        .map(|f| {
+            mesh.triangles.get(f).is_some_and(|t| t.iter().any(|&v| vertex_material.get(v as usize) == Some(&MIXED)))
+        })
+        .collect()
+}
+
+/// A mesh's faces as a budget allocation sees them: materials, where each face's shared
+/// samples are baked, the texture pyramids, and the largest `R` given.
+struct Faces<'a> {
+    mesh: &'a WeldedMesh,
+    materials: &'a [FaceMaterial],
+    shared: &'a [SharedUvs],
+    pyramids: &'a [Option<crate::convert::bake::TexturePyramid>],
+    max: Resolution,
+}
+
+impl<'a> Faces<'a> {
+    /// Face `face`'s test points and texture; `None` for a face without a texture.
+    fn fit(&self, face: usize) -> Option<FaceFit<'a>> {
+        self.materials.get(face)?.texture?;
+        let uvs = self.mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
+        Some(FaceFit::new(self.materials, face, *self.shared.get(face)?, self.pyramids, uvs, self.max))
+    }
+
+    /// The distortion the allocation weighs: error² × the face's world area (zero at or
+    /// below [`ROUNDING`]).
+    fn distortion(&self, face: usize, error: f32) -> f64 {
+        if error <= ROUNDING { 0.0 } else { f64::from(error).powi(2) * world_area(self.mesh, face) }
+    }
+
+    /// Each face's predicted distortion at each level `R = 2^l` up to `max` (module docs).
+    fn predicted_distortions(&self, calibration: &[Option<ColorStore>]) -> Vec<Vec<f64>> {
+        let levels = self.max.log2() as usize + 1;
+        (0..self.materials.len())
+            .into_par_iter()
+            .map(|face| match self.fit(face) {
+                None => vec![0.0; levels],
+                Some(fit) => fit
+                    .predicted_errors(face as u32, self.max, calibration)
+                    .into_iter()
+                    .map(|error| self.distortion(face, error))
+                    .collect(),
+            })
+            .collect()
+    }
+
+    /// The error (module docs) of face `face` as `store` shows it, at the face's own `R`
+    /// there; `None` for a face without a texture.
+    fn shown_error(&self, store: &ColorStore, face: usize) -> Option<f32> {
+        let (fit, r) = (self.fit(face)?, store.face_resolution(face as u32)?);
+        Some(fit.error_of(r, |bary| sample(store, face as u32, bary, Filter::Linear, 0).unwrap_or([0.0; 4])))
+    }
+
+    /// Each face's distortion as `store` shows it ([`Faces::shown_error`]).
+    fn shown_distortions(&self, store: &ColorStore) -> Vec<f64> {
+        (0..self.materials.len())
+            .into_par_iter()
+            .map(|face| self.shown_error(store, face).map_or(0.0, |error| self.distortion(face, error)))
+            .collect()
+    }
+}
+
+/// Rounds of [`refine_allocation`] after the first allocation.
+pub const REFINEMENT_ROUNDS: usize = 2;
+
+/// Measures an allocation on the store the conversion makes of it and corrects the
+/// predictions (module docs): the predictions come from uniform stores, where every face's
+/// neighbours share its `R`; in the allocated store a coarse face fans towards finer edges
+/// and the least-squares fit balances shared samples between faces of different `R`, so a
+/// face can show more or less error than predicted. Each round bakes and fits the allocated
+/// store (counted first: it holds at most `budget` samples), measures each face's error as
+/// shown, scales that face's predicted distortions at every level by measured / predicted at
+/// its level, and allocates again. Returns the allocation whose store showed the least
+/// area-weighted squared error, the first one included, so a round never makes it worse by
+/// that measure. The point bake's predictions are its own errors: nothing to correct.
+fn refine_allocation(
+    faces: &Faces,
+    scene: &Scene,
+    distortion: &mut [Vec<f64>],
+    first: Vec<Resolution>,
+    budget: u64,
+    fit: BakeFit,
+) -> Vec<Resolution> {
+    let mesh = faces.mesh;
+    let topology = Topology::build(mesh.positions_world.len() as u32, &mesh.triangles).ok();
+    let (Some(topology), BakeFit::LeastSquares) = (topology, fit) else {
+        return first;
+    };
+    let measure = |resolutions: &[Resolution]| -> Option<Vec<f64>> {
+        let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);
+        if counts.samples > budget.min(least_squares::MAX_SAMPLES) {
+            return None;
+        }
+        let mut store = ColorStore::with_resolutions(topology.clone(), resolutions.to_vec(), [1.0; 4]).ok()?;
+        bake_texture(&mut store, mesh, scene);
+        least_squares::refine(&mut store, mesh, scene)?;
+        Some(faces.shown_distortions(&store))
+    };
+    let mut current = first;
+    let Some(mut shown) = measure(&current) else { return current };
+    let mut best = (shown.iter().sum::<f64>(), current.clone());
+    for _ in 0..REFINEMENT_ROUNDS {
+        for (face, row) in distortion.iter_mut().enumerate() {
+            let level = current[face].log2() as usize;
+            let predicted = row.get(level).copied().unwrap_or(0.0);
+            if predicted > 0.0 && shown[face] > 0.0 {
+                let scale = shown[face] / predicted;
+                row.iter_mut().for_each(|d| *d *= scale);
+            }
+        }
+        current = allocate_budget(mesh, distortion, budget, faces.max);
+        let Some(measured) = measure(&current) else { break };
+        shown = measured;
+        let total = shown.iter().sum::<f64>();
+        if total < best.0 {
+            best = (total, current.clone());
+        }
+    }
+    best.1
+}
+
+/// Rate–distortion allocation (module docs): every face starts at `R = 1`; raises are taken
+/// in order of distortion removed per sample added, each face's best raise among those that
+/// still fit `budget`, until none fits. `distortion[face][l]` is the face's predicted
+/// distortion at `R = 2^l`.
+/// Sample counts are exact as the store counts them (an edge holds the larger `R` of its
+/// faces), so the result never exceeds the budget (nor goes below the `R = 1` count, the
+/// least any mesh needs).
+fn allocate_budget(mesh: &WeldedMesh, distortion: &[Vec<f64>], budget: u64, max: Resolution) -> Vec<Resolution> {
+    let face_count = distortion.len();
+    let levels = max.log2() as usize + 1;
+    // Topology: the three edges of each face, as vertex pairs.
+    let mut edge_ids = std::collections::HashMap::new();
+    let face_edges: Vec<[usize; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            [0, 1, 2].map(|k| {
+                let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+                let next = edge_ids.len();
+                *edge_ids.entry((a, b)).or_insert(next)
+            })
+        })
+        .collect();
+    let mut edge_faces: Vec<Vec<usize>> = vec![Vec::new(); edge_ids.len()];
+    for (face, edges) in face_edges.iter().enumerate() {
+        for &e in edges {
+            edge_faces[e].push(face);
+        }
+    }
+    let mut level = vec![0usize; face_count];
+    let edge_level = |level: &[usize], e: usize| edge_faces[e].iter().map(|&f| level[f]).max().unwrap_or(0);
+    // Samples added by raising `face` from its level to `to`.
+    let added = |level: &[usize], face: usize, to: usize| -> u64 {
+        let interior = |l: usize| {
+            let r = 1u64 << l;
+            (r.saturating_sub(1)) * (r.saturating_sub(2)) / 2
+        };
+        let mut added = interior(to) - interior(level[face]);
+        for &e in &face_edges[face] {
+            let current = edge_level(level, e);
+            if to > current {
+                added += (1u64 << to) - (1u64 << current);
+            }
+        }
+        added
+    };
+    let mut used: u64 = mesh.positions_world.len() as u64;
+    // The best raise of a face that adds at most `limit` samples: the level with the most
+    // distortion removed per sample. (A face whose best raise no longer fits the budget
+    // still takes a smaller one that does.)
+    let best = |level: &[usize], face: usize, limit: u64| -> Option<(f64, usize)> {
+        ((level[face] + 1)..levels)
+            .filter_map(|to| {
+                let gain = distortion[face][level[face]] - distortion[face][to];
+                let cost = added(level, face, to);
+                (gain > 0.0 && cost <= limit).then_some((gain / cost.max(1) as f64, to))
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+    };
+    let mut heap: std::collections::BinaryHeap<(OrderedRatio, usize, usize)> = (0..face_count)
+        .filter_map(|face| {
+            best(&level, face, budget.saturating_sub(used)).map(|(ratio, to)| (OrderedRatio(ratio), face, to))
+        })
+        .collect();
+    while let Some((_, face, to)) = heap.pop() {
+        // Stale entries (the face or a neighbour moved, or the budget left shrank): recompute.
+        let Some((ratio, now_to)) = best(&level, face, budget.saturating_sub(used)) else { continue };
+        if now_to != to {
+            heap.push((OrderedRatio(ratio), face, now_to));
+            continue;
+        }
+        used += added(&level, face, to);
+        level[face] = to;
+        if let Some((ratio, to)) = best(&level, face, budget.saturating_sub(used)) {
+            heap.push((OrderedRatio(ratio), face, to));
+        }
+    }
+    level.iter().map(|&l| Resolution::from_log2(l as u32).unwrap_or(max)).collect()
+}
+
+/// Level-0 samples a calibration store may hold, as a multiple of the budget (module docs).
+pub const CALIBRATION_FACTOR: u64 = 4;
+
+/// The least-squares bake of the whole mesh at each uniform `R = 2^l` (`l` up to
+/// `log2 max`) whose sample count is at most [`CALIBRATION_FACTOR`] × `budget` (and at most
+/// what [`least_squares::refine`] fits), for a budget allocation to measure each face's
+/// fitted error on; `None` at the other levels and for the point bake (module docs).
+fn calibration_stores(
+    mesh: &WeldedMesh,
+    scene: &Scene,
+    budget: u64,
+    max: Resolution,
+    bake: BakeFit,
+) -> Vec<Option<ColorStore>> {
+    let levels = max.log2() + 1;
+    let topology = Topology::build(mesh.positions_world.len() as u32, &mesh.triangles).ok();
+    let (Some(topology), BakeFit::LeastSquares) = (topology, bake) else {
+        return (0..levels).map(|_| None).collect();
+    };
+    let limit = budget.saturating_mul(CALIBRATION_FACTOR).min(least_squares::MAX_SAMPLES);
+    (0..levels)
+        .map(|l| {
+            let r = Resolution::from_log2(l).ok()?;
+            if r.get() > least_squares::MAX_RESOLUTION || SampleCounts::uniform_on(&topology, r).samples > limit {
+                return None;
+            }
+            // Counted above, before the store is allocated.
+            let mut store = ColorStore::uniform(topology.clone(), r, [1.0; 4]);
+            bake_texture(&mut store, mesh, scene);
+            least_squares::refine(&mut store, mesh, scene)?;
+            Some(store)
+        })
+        .collect()
+}
+
+/// A ratio ordered by `f64::total_cmp` (for the allocation's heap).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct OrderedRatio(f64);
+
+impl Eq for OrderedRatio {}
+
+impl PartialOrd for OrderedRatio {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for OrderedRatio {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+/// Bakes `store` (the store of `mesh`, at the resolutions [`face_resolutions`] chose for
+/// `rule`) with `fit` and, for an error bound, checks every face as the mesh shows it —
+/// shared vertices and edges baked from their owner face (or, fitted, balanced between the
+/// faces that show them), and coarse faces fanned towards finer edges — raising `R` (up to
+/// `max`) of every face still over the bound and baking again, until none is. Returns the
+/// rounds.
+pub fn bake_and_verify(
+    store: &mut ColorStore,
+    mesh: &WeldedMesh,
+    scene: &Scene,
+    rule: ResolutionRule,
+    fit: BakeFit,
+) -> u32 {
+    let bake = |store: &mut ColorStore| {
+        bake_texture(store, mesh, scene);
+        if fit == BakeFit::LeastSquares {
+            least_squares::refine(store, mesh, scene);
+        }
+    };
+    bake(store);
+    let ResolutionRule::ErrorBound { bound, max } = rule else {
+        return 0;
+    };
+    let face_count = store.topology().face_count() as usize;
+    let (materials, pyramids) = face_materials(mesh, scene, face_count);
+    let shared = shared_uvs(mesh);
+    if shared.len() != face_count {
+        return 0;
+    }
+    let faces = Faces { mesh, materials: &materials, shared: &shared, pyramids: &pyramids, max };
+    let mut rounds = 0;
+    loop {
+        rounds += 1;
+        let shown: &ColorStore = store;
+        let over: Vec<u32> = (0..face_count)
+            .into_par_iter()
+            .filter(|&face| {
+                let r = shown.face_resolution(face as u32).unwrap_or(max);
+                r < max && faces.shown_error(shown, face).is_some_and(|error| error > bound.max(ROUNDING))
+            })
+            .map(|face| face as u32)
+            .collect();
+        if over.is_empty() {
+            return rounds;
+        }
+        for face in over {
+            let r = store.face_resolution(face).unwrap_or(max);
+            let raised = Resolution::from_log2(r.log2() + 1).unwrap_or(max).min(max);
+            // The face exists and `raised` is a valid resolution, so this cannot fail.
+            let _ = store.set_face_resolution(face, raised);
+        }
+        bake(store);
+    }
+}
+
+/// The smallest power of two `≥ x` (at least 1), capped at `max`.
+fn power_of_two_at_least(x: f32, max: Resolution) -> Resolution {
+    let wanted = if x.is_finite() && x > 1.0 { x.ceil() as u64 } else { 1 };
+    let log2 = wanted.next_power_of_two().trailing_zeros().min(max.log2());
+    Resolution::from_log2(log2).unwrap_or(max)
+}
+
+/// Where a face's shared samples are baked: the UVs and material of each element's owner
+/// face (the lowest face id containing it, as [`bake_texture`] bakes), in this face's
+/// orientation — across a UV seam the owner maps the element to other texels.
+#[derive(Debug, Clone, Copy)]
+struct SharedUvs {
+    /// Per corner: the owner's UV at that vertex and the owner face.
+    corners: [([f32; 2], usize); 3],
+    /// Per face edge k (corner k → k + 1): the owner's UVs at both ends and the owner face.
+    edges: [([f32; 2], [f32; 2], usize); 3],
+}
+
+/// The [`SharedUvs`] of every face of `mesh`.
+fn shared_uvs(mesh: &WeldedMesh) -> Vec<SharedUvs> {
+    let mut vertex_owner = vec![usize::MAX; mesh.positions_world.len()];
+    let mut edge_owner = std::collections::HashMap::new();
+    for (face, t) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            if let Some(owner) = vertex_owner.get_mut(t[k] as usize) {
+                *owner = (*owner).min(face);
+            }
+            let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+            edge_owner.entry((a, b)).or_insert(face);
+        }
+    }
+    let uv_of = |face: usize, vertex: u32| -> [f32; 2] {
+        let (Some(t), Some(uvs)) = (mesh.triangles.get(face), mesh.corner_uvs.get(face)) else { return [0.0; 2] };
+        t.iter().position(|&v| v == vertex).map_or([0.0; 2], |k| uvs[k])
+    };
+    mesh.triangles
+        .iter()
+        .enumerate()
+        .map(|(face, t)| {
+            let corners = [0, 1, 2].map(|k| {
+                let owner = vertex_owner.get(t[k] as usize).copied().filter(|&o| o != usize::MAX).unwrap_or(face);
+                (uv_of(owner, t[k]), owner)
+            });
+            let edges = [0, 1, 2].map(|k| {
+                let (start, end) = (t[k], t[(k + 1) % 3]);
+                let owner = edge_owner.get(&(start.min(end), start.max(end))).copied().unwrap_or(face);
+                (uv_of(owner, start), uv_of(owner, end), owner)
+            });
+            SharedUvs { corners, edges }
+        })
+        .collect()
+}
+
+/// One face's texture and test points, for [`FaceFit::error`].
+struct FaceFit<'a> {
+    /// Every face's material (shared samples use their owner's).
+    materials: &'a [FaceMaterial],
+    shared: SharedUvs,
+    material: &'a FaceMaterial,
+    pyramids: &'a [Option<crate::convert::bake::TexturePyramid>],
+    uvs: [[f32; 2]; 3],
+    /// The test lattice from the texture alone: twice the face's longest UV edge in
+    /// texels (a power of two), at least 8, at most `2·max`.
+    dense: u32,
+    /// Barycentrics of the test points of `dense` and the truth there.
+    points: Vec<([f32; 3], Rgba)>,
+}
+
+impl<'a> FaceFit<'a> {
+    fn new(
+        materials: &'a [FaceMaterial],
+        face: usize,
+        shared: SharedUvs,
+        pyramids: &'a [Option<crate::convert::bake::TexturePyramid>],
+        uvs: [[f32; 2]; 3],
+        max: Resolution,
+    ) -> Self {
+        let material = &materials[face];
+        let texels = power_of_two_at_least(material.longest_uv_edge_texels, Resolution::MAX).get();
+        let dense = (2 * texels).clamp(8, 2 * max.get());
+        let mut fit = FaceFit { materials, shared, material, pyramids, uvs, dense, points: Vec::new() };
+        fit.points = fit.test_points(dense);
+        fit
+    }
+
+    /// The test points for a face shown at `r`: those of `dense`, or of `2·r` when that is
+    /// finer, so that every strip of one sample spacing along an edge holds test points.
+    /// (With the texture's lattice alone, a face under one texel gets `D = 8`, whose
+    /// centroids lie at least 1/24 of the face from each edge, and at `R ≥ 32` the strip
+    /// where a UV seam's foreign edge colours fade out — 1/R wide — held none: the fit
+    /// saw no error there, random points did, docs/ADAPTIVE.md.)
+    fn points_for(&self, r: Resolution) -> std::borrow::Cow<'_, [([f32; 3], Rgba)]> {
+        let wanted = 2 * r.get();
+        if wanted <= self.dense {
+            std::borrow::Cow::Borrowed(&self.points)
+        } else {
+            std::borrow::Cow::Owned(self.test_points(wanted))
+        }
+    }
+
+    /// The centroids of the `dense²` sub-triangles of a lattice `dense` and the truth there
+    /// (the texture's level 0 read bilinearly, times the factor).
+    fn test_points(&self, dense: u32) -> Vec<([f32; 3], Rgba)> {
+        let material = self.material;
+        let level0 = material
+            .texture
+            .and_then(|t| self.pyramids.get(t))
+            .and_then(Option::as_ref)
+            .and_then(|p| p.levels().first());
+        layout::sub_triangle_centroids(dense)
+            .map(|bary| {
+                let uv = interpolate_uv(self.uvs, bary);
+                let texel = level0.map_or([1.0; 4], |level| level.sample_bilinear(uv));
+                (bary, std::array::from_fn(|c| material.factor[c] * texel[c]))
+            })
+            .collect()
+    }
+
+    /// The error (module docs) of the colours `shown` returns at the test points of a face
+    /// shown at `r`.
+    fn error_of(&self, r: Resolution, shown: impl Fn([f32; 3]) -> Rgba) -> f32 {
+        let points = self.points_for(r);
+        let mut sum = 0.0f64;
+        for (bary, truth) in points.iter() {
+            sum += difference(shown(*bary), *truth);
+        }
+        (sum / (4 * points.len().max(1)) as f64).sqrt() as f32
+    }
+
+    /// The colour baked at lattice point `(i, j)` of resolution `res`: corners and edge
+    /// points from their owner's UVs and material, interior points from the face's own.
+    fn lattice_color(&self, i: u32, j: u32, res: u32) -> Rgba {
+        let n = res as f32;
+        let owner = |face: usize| self.materials.get(face).unwrap_or(self.material);
+        let lerp = |a: [f32; 2], b: [f32; 2], t: f32| [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
+        let corner = match (i, j) {
+            (0, 0) => Some(0),
+            (i, 0) if i == res => Some(1),
+            (0, j) if j == res => Some(2),
+            _ => None,
+        };
+        if let Some(k) = corner {
+            let (uv, face) = self.shared.corners[k];
+            return material_color(owner(face), self.pyramids, uv, res);
+        }
+        let edge = if j == 0 {
+            Some((0, i as f32 / n))
+        } else if i + j == res {
+            Some((1, j as f32 / n))
+        } else if i == 0 {
+            Some((2, (res - j) as f32 / n))
+        } else {
+            None
+        };
+        if let Some((k, t)) = edge {
+            let (start, end, face) = self.shared.edges[k];
+            return material_color(owner(face), self.pyramids, lerp(start, end, t), res);
+        }
+        let bary = [(n - i as f32 - j as f32) / n, i as f32 / n, j as f32 / n];
+        material_color(self.material, self.pyramids, interpolate_uv(self.uvs, bary), res)
+    }
+
+    /// The error (module docs) of face `face` at each `R = 2^l` up to `max` that a budget
+    /// allocation predicts: measured on the calibration store of that level where there is
+    /// one; above the finest calibrated level, the point bake's error scaled by the gain the
+    /// fit made there; the point bake's error where nothing is calibrated.
+    fn predicted_errors(&self, face: u32, max: Resolution, calibration: &[Option<ColorStore>]) -> Vec<f32> {
+        let resolutions: Vec<Resolution> = (0..=max.log2()).map(|l| Resolution::from_log2(l).unwrap_or(max)).collect();
+        let measured = |l: usize| {
+            let store = calibration.get(l)?.as_ref()?;
+            Some(self.error_of(resolutions[l], |bary| sample(store, face, bary, Filter::Linear, 0).unwrap_or([0.0; 4])))
+        };
+        let mut gain = 1.0;
+        let mut errors = Vec::with_capacity(resolutions.len());
+        for (l, &r) in resolutions.iter().enumerate() {
+            match measured(l) {
+                Some(error) => {
+                    let point = self.error(r);
+                    gain = if point > ROUNDING { error / point } else { 1.0 };
+                    errors.push(error);
+                }
+                None => errors.push(gain * self.error(r)),
+            }
+        }
+        errors
+    }
+
+    /// The error (module docs) of the face alone, baked and reconstructed at `r`.
+    fn error(&self, r: Resolution) -> f32 {
+        let res = r.get();
+        let row = |j: u32| (j * (2 * res + 3 - j) / 2) as usize;
+        let mut lattice = Vec::with_capacity(((res + 1) * (res + 2) / 2) as usize);
+        for j in 0..=res {
+            for i in 0..=res - j {
+                lattice.push(self.lattice_color(i, j, res));
+            }
+        }
+        let points = self.points_for(r);
+        let mut sum = 0.0f64;
+        for (bary, truth) in points.iter() {
+            let mut shown = [0.0f32; 4];
+            for s in layout::linear_samples(r, *bary) {
+                let color = lattice[row(s.j) + s.i as usize];
+                for c in 0..4 {
+                    shown[c] += s.weight * color[c];
+                }
+            }
+            sum += difference(shown, *truth);
+        }
+        (sum / (4 * points.len().max(1)) as f64).sqrt() as f32
+    }
+}
+
+/// Squared differences summed over the channels: RGB of the sRGB-encoded colours (module
+/// docs), alpha as is.
+fn difference(shown: Rgba, truth: Rgba) -> f64 {
+    (0..4)
+        .map(|c| {
+            let (a, b) =
+                if c < 3 { (linear_to_srgb(shown[c]), linear_to_srgb(truth[c])) } else { (shown[c], truth[c]) };
+            f64::from(a - b).powi(2)
+        })
+        .sum()
+}

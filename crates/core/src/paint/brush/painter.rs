@@ -1,0 +1,538 @@
+//! The stroke driver: [`PaintView`] (what the pointer is over), [`Painter`] (brush state,
+//! stroke spacing in screen space, one dab's footprint and culling), and what a stroke
+//! reports ([`Dab`], [`StrokeUpdate`]).
+
+use glam::DVec3;
+
+use crate::camera::OrbitCamera;
+use crate::colors::budget::{Budget, SampleTracker};
+use crate::colors::format::ColorFormat;
+use crate::colors::store::ColorStore;
+use crate::paint::picking::{MeshBvh, RayHit};
+use crate::paint::undo::{StepSummary, StoreWriter, UndoHistory};
+
+use super::blur::blur_faces;
+use super::error::BrushError;
+use super::footprint::{Footprint, Occlusion};
+use super::kernels::{DabStats, PaintOp, paint_faces};
+use super::scratch::{Scratch, position};
+use super::settings::{BlendMode, BrushRadius, BrushSettings, ResolutionOp, Tool, resolution_for_brush};
+use crate::colors::layout::Resolution;
+use crate::paint::occlusion::DepthMap;
+
+/// Smallest distance between dabs along a stroke, pixels.
+pub const MIN_SPACING_PX: f64 = 0.25;
+/// Most dabs one [`Painter::stroke_to`] call places (a guard against absurd spacing).
+pub const MAX_DABS_PER_SEGMENT: usize = 100_000;
+
+/// What the pointer paints on: the mesh, its BVH, the camera and the viewport.
+#[derive(Debug, Clone, Copy)]
+pub struct PaintView<'a> {
+    /// Vertex positions (world space), one per store vertex.
+    pub positions: &'a [[f32; 3]],
+    /// The picking BVH built over `positions` and the store's triangles.
+    pub bvh: &'a MeshBvh,
+    /// The camera.
+    pub camera: &'a OrbitCamera,
+    /// Viewport width and height, pixels.
+    pub viewport_px: [u32; 2],
+    /// The colours when painting started (for Erase to base); may have other resolutions.
+    pub base: Option<&'a ColorStore>,
+}
+
+impl PaintView<'_> {
+    /// The ray through pixel `cursor_px` and its nearest hit.
+    pub fn pick(&self, cursor_px: [f64; 2]) -> Option<RayHit> {
+        let [width, height] = self.viewport_px;
+        let (origin, direction) = self.camera.ray_through_pixel(cursor_px[0], cursor_px[1], width, height);
+        self.bvh.cast(origin, direction, f64::INFINITY)
+    }
+
+    /// World units per pixel at the depth of `point` (perspective).
+    pub fn world_per_px_at(&self, point: DVec3) -> f64 {
+        let forward = -self.camera.eye_direction();
+        let depth = (point - self.camera.eye()).dot(forward).max(0.0);
+        2.0 * depth * (self.camera.fov_y_degrees.to_radians() * 0.5).tan() / f64::from(self.viewport_px[1].max(1))
+    }
+}
+
+/// One dab placed by a stroke.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dab {
+    /// The cursor position it was placed at, pixels.
+    pub cursor_px: [f64; 2],
+    /// Brush centre: the ray's hit, world space.
+    pub center_world: [f64; 3],
+    /// Brush radius, world units.
+    pub radius_world: f64,
+    /// The face hit.
+    pub face: u32,
+}
+
+/// What one stroke call did.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct StrokeUpdate {
+    /// Dabs placed (cursor positions over the mesh).
+    pub dabs: Vec<Dab>,
+    /// Totals over the dabs.
+    pub stats: DabStats,
+}
+
+/// The state of a stroke in progress.
+#[derive(Debug, Clone, Copy)]
+struct StrokeState {
+    settings: BrushSettings,
+    last_cursor_px: [f64; 2],
+    /// Screen distance travelled since the last dab position.
+    since_dab_px: f64,
+    /// World units per pixel at the last hit.
+    world_per_px: Option<f64>,
+}
+
+/// Paints strokes on a store: the brush state and per-mesh scratch. See the module
+/// documentation for the call sequence.
+#[derive(Debug, Clone)]
+pub struct Painter {
+    settings: BrushSettings,
+    mirror_plane_x: f64,
+    stroke: Option<StrokeState>,
+    scratch: Scratch,
+    /// The budget resolution changes are checked against, with the document's format.
+    budget: Option<(Budget, ColorFormat)>,
+    /// The sample counts during a resolution stroke (built at its first resize).
+    tracker: Option<SampleTracker>,
+    /// Occlusion depth maps of the view and of its mirror (built on the first dab that needs
+    /// them after the view changed, see [`crate::paint::occlusion`]).
+    depth_maps: [Option<DepthMap>; 2],
+    /// Whether the last colour or blur dab ran on the thread pool (`None` before the
+    /// first): a stroke keeps its radius, so the next one likely does too.
+    last_dab_parallel: Option<bool>,
+}
+
+impl Painter {
+    /// A painter for the mesh with `positions` (the X-mirror plane is the centre of their
+    /// bounds), with default settings.
+    pub fn new(positions: &[[f32; 3]]) -> Self {
+        let (min, max) = positions
+            .iter()
+            .map(|p| f64::from(p[0]))
+            .filter(|x| x.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+        let mirror_plane_x = if min <= max { 0.5 * (min + max) } else { 0.0 };
+        Painter {
+            settings: BrushSettings::default(),
+            mirror_plane_x,
+            stroke: None,
+            scratch: Scratch::default(),
+            budget: None,
+            tracker: None,
+            last_dab_parallel: None,
+            depth_maps: [None, None],
+        }
+    }
+
+    /// Makes sure the occlusion depth maps for `view` exist (the view's, and the mirrored
+    /// view's when `mirror` is on), building those missing or built for another view.
+    /// Returns how many were built. Dabs with occlusion call this themselves; it is public so
+    /// a caller can build the maps ahead (e.g. when the view stops moving) and so the
+    /// benchmark can time the build apart from the dabs.
+    pub fn prepare_occlusion(&mut self, view: &PaintView, store: &ColorStore, mirror: bool) -> usize {
+        let triangles = &store.topology().face_vertices;
+        let eye = view.camera.eye();
+        let target = DVec3::from_array(view.camera.target);
+        let plane = self.mirror_plane_x;
+        let mirrored = |p: DVec3| DVec3::new(2.0 * plane - p.x, p.y, p.z);
+        let eyes = [(eye, target), (mirrored(eye), mirrored(target))];
+        let mut built = 0;
+        for (k, &(eye, target)) in eyes.iter().enumerate().take(if mirror { 2 } else { 1 }) {
+            let current = self.depth_maps[k]
+                .as_ref()
+                .is_some_and(|map| map.is_for(view.positions, triangles, view.camera, eye, target, view.viewport_px));
+            if !current {
+                self.depth_maps[k] =
+                    DepthMap::build(view.positions, triangles, view.camera, eye, target, view.viewport_px);
+                built += 1;
+            }
+        }
+        built
+    }
+
+    /// The budget the resolution brush checks each face's change against before making it
+    /// (`None`: no check), with the colour format of the document.
+    pub fn set_budget(&mut self, budget: Option<(Budget, ColorFormat)>) {
+        self.budget = budget;
+        self.tracker = None;
+    }
+
+    /// The settings the next stroke uses.
+    pub fn settings(&self) -> &BrushSettings {
+        &self.settings
+    }
+
+    /// Changes the settings; a stroke in progress keeps the ones it began with.
+    pub fn set_settings(&mut self, settings: BrushSettings) {
+        self.settings = settings;
+    }
+
+    /// The X-mirror plane, `x =` this (world units).
+    pub fn mirror_plane_x(&self) -> f64 {
+        self.mirror_plane_x
+    }
+
+    /// Whether a stroke is in progress.
+    pub fn is_stroking(&self) -> bool {
+        self.stroke.is_some()
+    }
+
+    /// Starts a stroke at `cursor_px` with the current settings: opens an undo step and
+    /// places the first dab (none when the cursor is off the mesh). A stroke in progress is
+    /// ended first.
+    pub fn begin_stroke(
+        &mut self,
+        view: &PaintView,
+        store: &mut ColorStore,
+        history: &mut UndoHistory,
+        cursor_px: [f64; 2],
+    ) -> Result<StrokeUpdate, BrushError> {
+        self.end_stroke(history);
+        let settings = self.settings;
+        settings.validate()?;
+        check_view(view, store, &settings)?;
+        history.begin_step(store, settings.label())?;
+        self.scratch.fit(store);
+        self.scratch.next_stroke();
+        self.tracker = None;
+        self.stroke = Some(StrokeState { settings, last_cursor_px: cursor_px, since_dab_px: 0.0, world_per_px: None });
+        let mut update = StrokeUpdate::default();
+        if let Err(error) = self.dab_at_cursor(view, store, history, cursor_px, &mut update) {
+            self.end_stroke(history);
+            return Err(error);
+        }
+        Ok(update)
+    }
+
+    /// Extends the stroke to `cursor_px`, placing dabs every spacing along the screen
+    /// segment from the previous position. Does nothing without a stroke.
+    pub fn stroke_to(
+        &mut self,
+        view: &PaintView,
+        store: &mut ColorStore,
+        history: &mut UndoHistory,
+        cursor_px: [f64; 2],
+    ) -> Result<StrokeUpdate, BrushError> {
+        let mut update = StrokeUpdate::default();
+        let Some(state) = self.stroke else {
+            return Ok(update);
+        };
+        let [x0, y0] = state.last_cursor_px;
+        let (dx, dy) = (cursor_px[0] - x0, cursor_px[1] - y0);
+        let length = dx.hypot(dy);
+        if !length.is_finite() {
+            return Ok(update);
+        }
+        let radius_px = match state.settings.radius {
+            BrushRadius::Pixels { radius_px } => radius_px,
+            BrushRadius::World { radius_world } => {
+                let world_per_px =
+                    state.world_per_px.unwrap_or_else(|| view.camera.world_per_pixel(f64::from(view.viewport_px[1])));
+                radius_world / world_per_px.max(f64::MIN_POSITIVE)
+            }
+        };
+        let spacing = (state.settings.spacing_percent / 100.0 * radius_px).max(MIN_SPACING_PX);
+        // Distance along this segment to the next dab.
+        let mut along = spacing - state.since_dab_px;
+        let mut placed = 0;
+        let mut last_along = -state.since_dab_px;
+        while along <= length && placed < MAX_DABS_PER_SEGMENT {
+            let t = along / length;
+            self.dab_at_cursor(view, store, history, [x0 + dx * t, y0 + dy * t], &mut update)?;
+            last_along = along;
+            along += spacing;
+            placed += 1;
+        }
+        if let Some(state) = self.stroke.as_mut() {
+            state.last_cursor_px = cursor_px;
+            state.since_dab_px = (length - last_along).max(0.0);
+        }
+        Ok(update)
+    }
+
+    /// Ends the stroke and closes its undo step. `None` when no stroke was in progress.
+    pub fn end_stroke(&mut self, history: &mut UndoHistory) -> Option<StepSummary> {
+        self.stroke.take()?;
+        self.tracker = None;
+        history.end_step()
+    }
+
+    /// One dab at the cursor (a stroke must be in progress).
+    fn dab_at_cursor(
+        &mut self,
+        view: &PaintView,
+        store: &mut ColorStore,
+        history: &mut UndoHistory,
+        cursor_px: [f64; 2],
+        update: &mut StrokeUpdate,
+    ) -> Result<(), BrushError> {
+        let Some(state) = self.stroke else {
+            return Ok(());
+        };
+        let Some(hit) = view.pick(cursor_px) else {
+            return Ok(());
+        };
+        let center = DVec3::from_array(hit.position_world);
+        let world_per_px = view.world_per_px_at(center);
+        let radius_world = match state.settings.radius {
+            BrushRadius::Pixels { radius_px } => radius_px * world_per_px,
+            BrushRadius::World { radius_world } => radius_world,
+        };
+        if let Some(state) = self.stroke.as_mut()
+            && world_per_px > 0.0
+        {
+            state.world_per_px = Some(world_per_px);
+        }
+        let stats =
+            self.dab_with(&state.settings, view, &mut StoreWriter::new(store, history), center, radius_world)?;
+        update.stats.add(stats);
+        update.dabs.push(Dab { cursor_px, center_world: hit.position_world, radius_world, face: hit.face });
+        Ok(())
+    }
+
+    /// One dab centred at `center_world` with radius `radius_world`, with the stroke's
+    /// settings (the current settings outside a stroke). Records into the history's open
+    /// step, if any. This is what every stroke dab runs; public for tests and benchmarks.
+    /// Outside a stroke, each call counts as its own stroke for the resolution brush's
+    /// "each face once per stroke" rule.
+    pub fn dab_at(
+        &mut self,
+        view: &PaintView,
+        store: &mut ColorStore,
+        history: &mut UndoHistory,
+        center_world: DVec3,
+        radius_world: f64,
+    ) -> Result<DabStats, BrushError> {
+        let settings = self.stroke.map_or(self.settings, |state| state.settings);
+        settings.validate()?;
+        check_view(view, store, &settings)?;
+        if self.stroke.is_none() {
+            self.scratch.fit(store);
+            self.scratch.next_stroke();
+            self.tracker = None;
+        }
+        self.dab_with(&settings, view, &mut StoreWriter::new(store, history), center_world, radius_world)
+    }
+
+    /// One dab with `settings`, written through `writer`.
+    fn dab_with(
+        &mut self,
+        settings: &BrushSettings,
+        view: &PaintView,
+        writer: &mut StoreWriter,
+        center: DVec3,
+        radius_world: f64,
+    ) -> Result<DabStats, BrushError> {
+        if !(radius_world.is_finite() && radius_world > 0.0 && center.is_finite()) {
+            return Ok(DabStats::default());
+        }
+        let brush = matches!(settings.tool, Tool::Paint | Tool::Blur);
+        if brush && self.last_dab_parallel.is_none_or(|parallel| parallel) {
+            // Wake the pool now, so that its threads are up by the time the kernels' parallel
+            // section starts, after the sphere query and the masks: between a stroke's dabs
+            // (one a frame) they sleep, and a sleeping thread takes a while to wake on a
+            // virtual machine. It raised `bench paint`'s `occlusion_frame_paced` row (2.3M
+            // triangles, 100k-sample dabs) in both of two interleaved runs. Only when the last
+            // dab ran in parallel (a stroke keeps its radius): a small dab runs on this thread,
+            // and the woken threads spin for work on the cores it needs (`perf` of 10k-sample
+            // blur dabs: about a third of the time in the scheduler and `sched_yield`).
+            rayon::spawn(|| {});
+        }
+        let occlusion = settings.occlusion && matches!(settings.tool, Tool::Paint | Tool::Blur);
+        if occlusion {
+            self.prepare_occlusion(view, writer.store(), settings.mirror_x);
+        }
+        // The maps are lent to the dab (which needs `&mut self`) and put back after it.
+        let maps = std::mem::take(&mut self.depth_maps);
+        let result = self.dab_with_maps(settings, view, writer, center, radius_world, occlusion.then_some(&maps));
+        self.depth_maps = maps;
+        result
+    }
+
+    /// [`Painter::dab_with`] with the occlusion depth maps (`None`: no occlusion).
+    fn dab_with_maps(
+        &mut self,
+        settings: &BrushSettings,
+        view: &PaintView,
+        writer: &mut StoreWriter,
+        center: DVec3,
+        radius_world: f64,
+        maps: Option<&[Option<DepthMap>; 2]>,
+    ) -> Result<DabStats, BrushError> {
+        let store = writer.store();
+        self.scratch.fit(store);
+        let eye = view.camera.eye();
+        let mirror = |p: DVec3| DVec3::new(2.0 * self.mirror_plane_x - p.x, p.y, p.z);
+        let count = if settings.mirror_x { 2 } else { 1 };
+        let footprint = Footprint::new(
+            [center, mirror(center)],
+            [eye, mirror(eye)],
+            count,
+            radius_world,
+            settings.strength,
+            settings.falloff,
+            maps.map(|maps| Occlusion {
+                bvh: view.bvh,
+                maps: [maps[0].as_ref(), maps[1].as_ref().filter(|_| count == 2)],
+            }),
+        );
+        // The faces of both spheres, sorted and unique.
+        let mut faces = view.bvh.faces_in_sphere(center, radius_world);
+        if count == 2 {
+            faces.extend(view.bvh.faces_in_sphere(footprint.centers[1], radius_world));
+            faces.sort_unstable();
+            faces.dedup();
+        }
+        let all_mask = (1u8 << count) - 1;
+        let mut masks = std::mem::take(&mut self.scratch.face_masks);
+        masks.clear();
+        if settings.backface_culling {
+            // The side the ray hits is the front: faces are oriented consistently with their
+            // component, then the hit face's side towards the eye decides (inside-out and
+            // mixed-winding meshes paint what the cursor shows).
+            let flips = self.scratch.face_flips(store);
+            let hit = view.bvh.cast(eye, center - eye, f64::INFINITY);
+            let hit_side = hit.map_or(1.0, |hit| {
+                let flipped = flips.get(hit.face as usize).copied().unwrap_or(false);
+                if hit.front_facing != flipped { 1.0 } else { -1.0 }
+            });
+            for &face in &faces {
+                let corners = store.topology().face_vertices.get(face as usize).copied().unwrap_or_default();
+                let [p0, p1, p2] = corners.map(|v| position(view.positions, v));
+                let side = if flips.get(face as usize).copied().unwrap_or(false) { -hit_side } else { hit_side };
+                let normal = (p1 - p0).cross(p2 - p0) * side;
+                masks.push(
+                    (0..count).filter(|&k| normal.dot(footprint.eyes[k] - p0) > 0.0).fold(0u8, |m, k| m | 1 << k),
+                );
+            }
+        } else {
+            masks.resize(faces.len(), all_mask);
+        }
+        self.scratch.face_masks = masks;
+        self.scratch.faces = faces;
+        if let (Some(max), Tool::Paint | Tool::Blur) = (settings.follow_resolution, settings.tool) {
+            self.follow_brush(max, radius_world, view, writer)?;
+        }
+        let stats = match settings.tool {
+            Tool::Paint => {
+                let op = PaintOp { blend: settings.blend, color: settings.color, base: view.base };
+                paint_faces(&footprint, &op, view.positions, writer, &mut self.scratch)
+            }
+            Tool::Blur => blur_faces(&footprint, view.positions, writer, &mut self.scratch),
+            Tool::Resolution(op) => {
+                let budget = match &self.budget {
+                    Some((budget, format)) => {
+                        let tracker = self.tracker.get_or_insert_with(|| SampleTracker::new(writer.store()));
+                        Some((budget, *format, tracker))
+                    }
+                    None => None,
+                };
+                resize_faces(op, writer, &mut self.scratch, budget)?
+            }
+        };
+        if matches!(settings.tool, Tool::Paint | Tool::Blur) {
+            self.last_dab_parallel = Some(stats.parallel);
+        }
+        Ok(stats)
+    }
+}
+
+impl Painter {
+    /// Resolution follows the brush ([`BrushSettings::follow_resolution`]): raises the faces
+    /// of the dab (those facing the eye, `scratch.face_masks` ≠ 0) that cannot resolve
+    /// `radius_world`, each checked against the budget first.
+    fn follow_brush(
+        &mut self,
+        max: Resolution,
+        radius_world: f64,
+        view: &PaintView,
+        writer: &mut StoreWriter,
+    ) -> Result<(), BrushError> {
+        for (k, &face) in self.scratch.faces.iter().enumerate() {
+            if self.scratch.face_masks.get(k).copied().unwrap_or(0) == 0 {
+                continue;
+            }
+            let store = writer.store();
+            let Some(current) = store.face_resolution(face) else { continue };
+            let corners = store.topology().face_vertices.get(face as usize).copied().unwrap_or_default();
+            let [p0, p1, p2] = corners.map(|v| position(view.positions, v));
+            let longest = (p1 - p0).length().max((p2 - p1).length()).max((p0 - p2).length());
+            let target = resolution_for_brush(longest, radius_world, max);
+            if target <= current {
+                continue;
+            }
+            if let Some((budget, format)) = &self.budget {
+                let tracker = self.tracker.get_or_insert_with(|| SampleTracker::new(writer.store()));
+                tracker.admit(writer.store(), face, target, budget, *format)?;
+            }
+            writer.set_face_resolution(face, target)?;
+        }
+        // The sample scratch follows the resized store.
+        self.scratch.fit(writer.store());
+        Ok(())
+    }
+}
+
+/// The resolution dab: applies `op` to every face in `scratch.faces` not yet changed in this
+/// stroke; with a budget, each change is checked first (O(the face's edges)) and the first
+/// one past it stops the dab with [`BrushError::Budget`].
+fn resize_faces(
+    op: ResolutionOp,
+    writer: &mut StoreWriter,
+    scratch: &mut Scratch,
+    mut budget: Option<(&Budget, ColorFormat, &mut SampleTracker)>,
+) -> Result<DabStats, BrushError> {
+    let stroke = scratch.stroke;
+    let mut stats = DabStats { faces: scratch.faces.len() as u32, ..DabStats::default() };
+    for &face in &scratch.faces {
+        let (Some(slot), Some(current)) =
+            (scratch.face_stroke.get_mut(face as usize), writer.store().face_resolution(face))
+        else {
+            continue;
+        };
+        if *slot == stroke {
+            continue;
+        }
+        if let Some(target) = op.apply(current) {
+            if let Some((budget, format, tracker)) = budget.as_mut() {
+                tracker.admit(writer.store(), face, target, budget, *format)?;
+            }
+            *slot = stroke;
+            if writer.set_face_resolution(face, target)? {
+                stats.faces_resized += 1;
+            }
+        }
+    }
+    Ok(stats)
+}
+
+/// Checks the view matches the store (and the base, when the blend mode needs it).
+fn check_view(view: &PaintView, store: &ColorStore, settings: &BrushSettings) -> Result<(), BrushError> {
+    let vertices = store.topology().vertex_count;
+    if view.positions.len() != vertices as usize {
+        return Err(BrushError::PositionCount { positions: view.positions.len(), vertices });
+    }
+    if settings.tool == Tool::Paint && settings.blend == BlendMode::EraseToBase {
+        check_base(view.base, store)?;
+    }
+    Ok(())
+}
+
+/// Checks `base` exists and belongs to the mesh of `store`.
+pub(super) fn check_base(base: Option<&ColorStore>, store: &ColorStore) -> Result<(), BrushError> {
+    let base = base.ok_or(BrushError::NoBase)?;
+    if base.topology().face_vertices != store.topology().face_vertices {
+        return Err(BrushError::BaseMismatch {
+            base_faces: base.topology().face_count(),
+            faces: store.topology().face_count(),
+        });
+    }
+    Ok(())
+}

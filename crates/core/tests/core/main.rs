@@ -1,0 +1,24 @@
+//! The core's tests in one binary (one link, no GPU or UI crate): each module is one
+//! concern's tests against an independent truth.
+
+mod common;
+
+mod adaptive_extremes;
+mod bake;
+mod examples;
+mod follow_brush;
+mod fuzz;
+mod import;
+mod layout;
+mod least_squares;
+mod occlusion;
+mod optimize;
+mod packed_file;
+mod packer;
+mod paint_layout;
+mod picking;
+mod repack;
+mod seams;
+mod store;
+mod topology;
+mod undo;

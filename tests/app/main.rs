@@ -1,0 +1,23 @@
+//! The application's tests in one binary: the `meshpaint` command line end to end, the
+//! benchmarks, GPU renders through the binary, and the workspace's layout rules.
+
+mod common;
+
+mod adaptive;
+mod architecture;
+mod autosave;
+mod bake_uv;
+mod bench_cli;
+mod brush;
+mod budget;
+mod cli;
+mod durability;
+mod examples;
+mod export_fit;
+mod export_gltf;
+mod extremes;
+mod formats;
+mod gpu_render;
+mod trade;
+mod validator;
+mod winding;

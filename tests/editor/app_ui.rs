@@ -1,0 +1,832 @@
+//! UI logic of the editor without a window: egui_kittest drives `Editor::ui` (panels,
+//! shortcuts, help window, file dialog, status line) and the editor's open/save/export
+//! paths, with no GPU (the 3D view is covered by tests/app_window.rs under Xvfb).
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Duration;
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use meshpaint::app::{Action, Editor, Mode, Severity};
+use meshpaint_core::io::document::Source;
+use meshpaint_render::{FilterMode, Shading};
+
+use crate::common;
+use common::workspace_path;
+
+const JOB_TIMEOUT: Duration = Duration::from_secs(60);
+
+fn new_editor() -> Editor {
+    Editor::new(None, Arc::new(|| {}))
+}
+
+/// An editor with the built-in Duck open (no GPU).
+fn editor_with_duck() -> Editor {
+    let mut editor = new_editor();
+    editor.open(Source::BuiltIn);
+    assert!(editor.wait_for_job(JOB_TIMEOUT), "opening the Duck timed out");
+    assert!(editor.document.is_some(), "the Duck did not open: {:?}", editor.status);
+    editor
+}
+
+fn harness(editor: Editor) -> Harness<'static, Editor> {
+    Harness::builder().with_size([1280.0, 800.0]).build_ui_state(|ui, editor: &mut Editor| editor.ui(ui), editor)
+}
+
+#[test]
+fn view_panel_changes_the_render_settings() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    assert!(!harness.state().view.overlays.wireframe);
+    harness.get_by_label("Wireframe").click();
+    harness.run_steps(2);
+    assert!(harness.state().view.overlays.wireframe);
+    assert!(harness.state().render_settings().overlays.wireframe);
+
+    harness.get_by_label("Resolution heat map").click();
+    harness.run_steps(2);
+    assert!(harness.state().render_settings().overlays.heatmap);
+
+    harness.get_by_label("Unlit").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().render_settings().shading, Shading::Unlit);
+    harness.get_by_label("Flat").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().view.shading, Shading::Lit);
+    harness.get_by_label("Smooth").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().render_settings().shading, Shading::Smooth);
+}
+
+#[test]
+fn filter_combo_box_selects_the_filter() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    assert_eq!(harness.state().view.filter, FilterMode::Trilinear);
+    harness.get_by_value("Trilinear (auto MIP)").click();
+    harness.run_steps(2);
+    harness.get_by_label("Nearest").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().render_settings().filter, FilterMode::Nearest);
+}
+
+#[test]
+fn shortcuts_toggle_overlays_shading_and_filter() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press(egui::Key::W);
+    harness.run_steps(2);
+    assert!(harness.state().view.overlays.wireframe);
+    harness.key_press(egui::Key::H);
+    harness.run_steps(2);
+    assert!(harness.state().view.overlays.heatmap);
+    harness.key_press(egui::Key::L);
+    harness.run_steps(2);
+    assert_eq!(harness.state().view.shading, Shading::Unlit);
+    harness.key_press(egui::Key::M);
+    harness.run_steps(2);
+    assert_eq!(harness.state().view.filter, FilterMode::Nearest);
+    // The checkbox shows the state the shortcut set.
+    harness.get_by_label("Wireframe").click();
+    harness.run_steps(2);
+    assert!(!harness.state().view.overlays.wireframe);
+}
+
+#[test]
+fn f1_opens_the_help_window_listing_every_shortcut() {
+    let mut harness = harness(new_editor());
+    harness.run_steps(2);
+    assert!(harness.query_by_label("Keyboard and mouse").is_none());
+    harness.key_press(egui::Key::F1);
+    harness.run_steps(3);
+    assert!(harness.state().show_help);
+    assert!(harness.query_by_label("Keyboard and mouse").is_some(), "no help window");
+    for shortcut in meshpaint::app::input::SHORTCUTS {
+        // F is listed twice: once per mode.
+        assert!(harness.query_all_by_label(shortcut.keys).next().is_some(), "help lacks {}", shortcut.keys);
+        assert!(harness.query_by_label(shortcut.description).is_some(), "help lacks {}", shortcut.description);
+    }
+    for (gesture, _) in meshpaint::app::input::POINTER_HELP {
+        assert!(harness.query_by_label(gesture).is_some(), "help lacks {gesture}");
+    }
+    harness.key_press(egui::Key::F1);
+    harness.run_steps(3);
+    assert!(harness.query_by_label("Keyboard and mouse").is_none());
+}
+
+#[test]
+fn every_shortcut_performs_a_distinct_action() {
+    let shortcuts = meshpaint::app::input::SHORTCUTS;
+    let mut actions: Vec<Action> = shortcuts.iter().map(|s| s.action).collect();
+    actions.sort_by_key(|a| format!("{a:?}"));
+    actions.dedup();
+    assert_eq!(actions.len(), shortcuts.len(), "two shortcuts share an action");
+    for (i, a) in shortcuts.iter().enumerate() {
+        for b in &shortcuts[i + 1..] {
+            let same_mode = [Mode::View, Mode::Paint].iter().any(|&m| a.scope.includes(m) && b.scope.includes(m));
+            assert!(!(a.key == b.key && a.modifiers == b.modifiers && same_mode), "{} is bound twice", a.keys);
+        }
+    }
+}
+
+#[test]
+fn middle_drag_orbits_shift_pans_and_the_wheel_zooms() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    let center = harness.state().viewport.rect.center();
+    let start = harness.state().camera;
+    let drag = |harness: &mut Harness<'_, Editor>, modifiers: egui::Modifiers| {
+        harness.event(egui::Event::PointerMoved(center));
+        harness.run_steps(1);
+        harness.event(egui::Event::PointerButton {
+            pos: center,
+            button: egui::PointerButton::Middle,
+            pressed: true,
+            modifiers,
+        });
+        harness.run_steps(1);
+        for step in 1..=5 {
+            harness.event(egui::Event::PointerMoved(center + egui::vec2(10.0 * step as f32, 4.0 * step as f32)));
+            harness.run_steps(1);
+        }
+        let end = center + egui::vec2(50.0, 20.0);
+        harness.event(egui::Event::PointerButton {
+            pos: end,
+            button: egui::PointerButton::Middle,
+            pressed: false,
+            modifiers,
+        });
+        harness.run_steps(2);
+    };
+    drag(&mut harness, egui::Modifiers::NONE);
+    let orbited = harness.state().camera;
+    assert!(orbited.yaw_degrees < start.yaw_degrees - 5.0, "{} → {}", start.yaw_degrees, orbited.yaw_degrees);
+    assert!(orbited.pitch_degrees > start.pitch_degrees + 2.0);
+    assert_eq!(orbited.target, start.target);
+
+    harness.event(egui::Event::ModifiersChanged(egui::Modifiers::SHIFT));
+    drag(&mut harness, egui::Modifiers::SHIFT);
+    harness.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    let panned = harness.state().camera;
+    assert_ne!(panned.target, orbited.target, "shift + middle drag did not pan");
+    assert_eq!(panned.yaw_degrees, orbited.yaw_degrees);
+
+    harness.event(egui::Event::PointerMoved(center));
+    harness.event(egui::Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Line,
+        delta: egui::vec2(0.0, 2.0),
+        phase: egui::TouchPhase::Move,
+        source: egui::MouseWheelSource::Wheel,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run_steps(2);
+    assert!(harness.state().camera.distance < panned.distance * 0.8, "the wheel did not zoom in");
+
+    harness.key_press(egui::Key::Home);
+    harness.run_steps(2);
+    let framed = harness.state().camera;
+    let bounds = harness.state().document.as_ref().unwrap().bounds;
+    assert_eq!(framed.target, bounds.center, "Home did not frame the mesh");
+}
+
+#[test]
+fn frame_under_cursor_centres_on_the_surface() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    let center = harness.state().viewport.rect.center();
+    let before = harness.state().camera;
+    harness.event(egui::Event::PointerMoved(center + egui::vec2(20.0, 10.0)));
+    harness.run_steps(1);
+    harness.key_press(egui::Key::F);
+    harness.run_steps(2);
+    let after = harness.state().camera;
+    assert_ne!(after.target, before.target, "F did not move the target: {:?}", harness.state().status);
+    assert!(after.distance < before.distance);
+    // Over empty background nothing moves and the status line says so.
+    harness.event(egui::Event::PointerMoved(harness.state().viewport.rect.left_top() + egui::vec2(5.0, 5.0)));
+    harness.run_steps(1);
+    harness.key_press(egui::Key::F);
+    harness.run_steps(2);
+    assert_eq!(harness.state().camera, after);
+    assert!(harness.state().status.text.contains("Nothing under the cursor"));
+}
+
+#[test]
+fn file_dialog_opens_and_escape_cancels() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::O);
+    harness.run_steps(3);
+    assert!(harness.state().dialog.is_some());
+    assert!(harness.query_by_label("Up").is_some(), "no file list");
+    // Shortcuts are off while the dialog is open (its field has the keyboard).
+    harness.key_press(egui::Key::W);
+    harness.run_steps(2);
+    assert!(!harness.state().view.overlays.wireframe);
+    harness.key_press(egui::Key::Escape);
+    harness.run_steps(2);
+    assert!(harness.state().dialog.is_none());
+}
+
+#[test]
+fn export_gltf_through_the_dialog_writes_a_glb() {
+    let dir = std::env::temp_dir().join(format!("meshpaint_app_ui_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("duck_export.glb");
+    let _ = std::fs::remove_file(&out);
+
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.get_by_label("Export glTF…").click();
+    harness.run_steps(3);
+    assert!(harness.state().dialog.is_some(), "no export dialog");
+    harness.state_mut().dialog.as_mut().unwrap().file_name = out.display().to_string();
+    harness.run_steps(1);
+    harness.get_by_label("Export").click();
+    harness.run_steps(2);
+    assert!(harness.state().dialog.is_none());
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "export timed out");
+    harness.run_steps(2);
+    let bytes = std::fs::read(&out).expect("no exported file");
+    assert_eq!(&bytes[..4], b"glTF");
+    assert!(bytes.len() > 100_000, "{} bytes", bytes.len());
+    assert_eq!(harness.state().status.severity, Severity::Info, "{:?}", harness.state().status);
+    assert!(harness.query_by_label_contains("Exported").is_some(), "status line does not report the export");
+
+    // Save as a packed file, then open it again: same triangles, Save now writes there.
+    let project = dir.join("duck.mpk");
+    let _ = std::fs::remove_file(&project);
+    harness.state_mut().save_to(project.clone(), meshpaint_core::colors::format::ColorFormat::Rgba16F);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    assert_eq!(harness.state().document.as_ref().unwrap().project_path.as_deref(), Some(project.as_path()));
+    harness.state_mut().open(Source::File(project.clone()));
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    let open = harness.state().document.as_ref().unwrap();
+    assert_eq!(open.triangles(), 4212);
+    assert_eq!(open.format, meshpaint_core::colors::format::ColorFormat::Rgba16F);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every file below `dir`, sorted.
+fn files_below(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            files_below(&path, out);
+        } else {
+            out.push(path);
+        }
+    }
+    out.sort();
+}
+
+#[test]
+fn opening_every_invalid_fixture_keeps_the_document_and_shows_the_error() {
+    let mut files = Vec::new();
+    files_below(&workspace_path("tests/fixtures/invalid"), &mut files);
+    assert!(files.len() > 100, "expected the invalid fixtures, found {}", files.len());
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    let mut refused = 0;
+    for file in &files {
+        let before = harness.state().document.as_ref().map(|d| Arc::clone(&d.document));
+        harness.state_mut().open(Source::File(file.clone()));
+        harness.run_steps(1);
+        assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "{}: opening timed out", file.display());
+        harness.run_steps(2);
+        let editor = harness.state();
+        let now = editor.document.as_ref().map(|d| Arc::clone(&d.document));
+        match editor.status.severity {
+            Severity::Error => {
+                refused += 1;
+                // The document shown before is still there, untouched.
+                let (Some(before), Some(now)) = (before, now) else {
+                    panic!("{}: the document was lost", file.display());
+                };
+                assert!(Arc::ptr_eq(&before, &now), "{}: the document changed on error", file.display());
+                let name = file.file_name().unwrap().to_string_lossy().to_string();
+                assert!(editor.status.text.contains(&name), "error does not name the file: {}", editor.status.text);
+                assert!(
+                    harness.query_by_label_contains("Could not open").is_some(),
+                    "{}: the error is not on screen",
+                    file.display()
+                );
+            }
+            // Some fixtures are valid files with odd features: they open like any file.
+            Severity::Info | Severity::Warning => {
+                let open = editor.document.as_ref().expect("opened without a document");
+                assert!(open.triangles() > 0);
+                assert_eq!(open.path.as_deref(), Some(file.as_path()));
+            }
+        }
+    }
+    assert!(refused > files.len() / 2, "only {refused} of {} refused", files.len());
+}
+
+#[test]
+fn a_bad_start_up_file_falls_back_to_the_duck_with_the_error_shown() {
+    let mut editor = new_editor();
+    editor.open(Source::File(workspace_path("tests/fixtures/invalid/gltf-validator/glb/invalid_magic.glb")));
+    assert!(editor.wait_for_job(JOB_TIMEOUT));
+    // The failure started the built-in scene.
+    assert!(editor.wait_for_job(JOB_TIMEOUT));
+    assert_eq!(editor.document.as_ref().map(|d| d.title.as_str()), Some("Duck (built-in)"));
+    assert_eq!(editor.status.severity, Severity::Error);
+    assert!(editor.status.text.contains("invalid_magic.glb"), "{}", editor.status.text);
+    let mut harness = harness(editor);
+    harness.run_steps(2);
+    assert!(harness.query_by_label_contains("invalid_magic.glb").is_some());
+}
+
+#[test]
+fn save_without_a_project_file_asks_for_a_name() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    harness.run_steps(3);
+    let dialog = harness.state().dialog.as_ref().expect("Save did not ask for a name");
+    assert_eq!(dialog.purpose, meshpaint::app::file_dialog::DialogPurpose::SaveAs);
+    assert!(dialog.file_name.ends_with(".mpk"));
+}
+
+/// A file dropped on the window, as egui-winit hands it over.
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn dropping_a_file_on_the_window_opens_it() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    let box_glb = workspace_path("assets/models/BoxTextured/BoxTextured.glb");
+    harness.input_mut().dropped_files.push(Arc::new(Dropped(box_glb.clone())));
+    harness.run_steps(1);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.run_steps(2);
+    let open = harness.state().document.as_ref().expect("no document");
+    assert_eq!(open.path.as_deref(), Some(box_glb.as_path()));
+    assert_eq!(open.triangles(), 12);
+    assert!(harness.query_by_label_contains("Opened BoxTextured.glb").is_some());
+}
+
+/// The Duck's colours, sample by sample (interiors, edges, vertices).
+fn colors_of(editor: &Editor) -> Vec<[f32; 4]> {
+    let store = &editor.document.as_ref().unwrap().document.store;
+    let mut out = Vec::new();
+    store.for_each_site(|site| out.push(store.get(site.sample).unwrap()));
+    out
+}
+
+/// Drags with the left button from `from` to `to` over the 3D view, in a few steps.
+fn left_drag(harness: &mut Harness<'static, Editor>, from: egui::Pos2, to: egui::Pos2) {
+    harness.event(egui::Event::PointerMoved(from));
+    harness.run_steps(1);
+    let button = |pos, pressed| egui::Event::PointerButton {
+        pos,
+        button: egui::PointerButton::Primary,
+        pressed,
+        modifiers: egui::Modifiers::NONE,
+    };
+    harness.event(button(from, true));
+    harness.run_steps(1);
+    for step in 1..=5 {
+        harness.event(egui::Event::PointerMoved(from + (to - from) * (step as f32 / 5.0)));
+        harness.run_steps(1);
+    }
+    harness.event(button(to, false));
+    harness.run_steps(2);
+}
+
+#[test]
+fn tab_toggles_paint_mode_and_leaving_repacks() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode, Mode::View);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode, Mode::Paint, "{:?}", harness.state().status);
+    assert!(harness.state().paint.is_some());
+    assert!(harness.query_by_label("Paint mode").is_some(), "the mode is not shown");
+    // The paint layout has level 0 only: trilinear becomes linear.
+    assert_eq!(harness.state().view.filter, FilterMode::Trilinear);
+    assert_eq!(harness.state().render_settings().filter, FilterMode::Linear);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode, Mode::View);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.run_steps(2);
+    assert!(harness.state().status.text.contains("Repacked"), "{:?}", harness.state().status);
+    assert_eq!(harness.state().render_settings().filter, FilterMode::Trilinear);
+    assert!(harness.query_by_label("View mode").is_some());
+}
+
+#[test]
+fn paint_panel_changes_the_brush_settings() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    assert!(!harness.state().brush.mirror_x);
+    harness.get_by_label("X mirror").click();
+    harness.run_steps(2);
+    assert!(harness.state().brush.mirror_x);
+    harness.get_by_label("Occlusion").click();
+    harness.run_steps(2);
+    assert!(!harness.state().brush.occlusion);
+    harness.get_by_label("Blur").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().brush.tool, meshpaint_core::paint::brush::Tool::Blur);
+    harness.get_by_label("Colour").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().brush.tool, meshpaint_core::paint::brush::Tool::Paint);
+    harness.get_by_value("Mix").click();
+    harness.run_steps(2);
+    harness.get_by_label("Erase to base").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().brush.blend, meshpaint_core::paint::brush::BlendMode::EraseToBase);
+    harness.get_by_label("world").click();
+    harness.run_steps(2);
+    assert!(matches!(harness.state().brush.radius, meshpaint_core::paint::brush::BrushRadius::World { .. }));
+}
+
+#[test]
+fn a_stroke_paints_and_undo_redo_buttons_and_keys_revert_it() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    let original = colors_of(harness.state());
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    let center = harness.state().viewport.rect.center();
+    left_drag(&mut harness, center - egui::vec2(60.0, 0.0), center + egui::vec2(60.0, 0.0));
+    let painted = colors_of(harness.state());
+    let changed = original.iter().zip(&painted).filter(|(a, b)| a != b).count();
+    assert!(changed > 100, "the stroke changed {changed} samples: {:?}", harness.state().status);
+    assert_eq!(harness.state().history.undo_len(), 1);
+    assert!(harness.state().history.bytes_used() > 0);
+    assert!(harness.query_by_label_contains("Undo: 1 steps").is_some(), "undo memory is not shown");
+
+    harness.get_by_label("Undo").click();
+    harness.run_steps(2);
+    assert_eq!(colors_of(harness.state()), original, "undo did not restore the colours");
+    harness.get_by_label("Redo").click();
+    harness.run_steps(2);
+    assert_eq!(colors_of(harness.state()), painted, "redo did not repaint");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(colors_of(harness.state()), original, "Ctrl+Z did not undo");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(colors_of(harness.state()), painted, "Ctrl+Shift+Z did not redo");
+}
+
+#[test]
+fn f_and_shift_f_set_radius_and_strength_interactively() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    let center = harness.state().viewport.rect.center();
+    harness.event(egui::Event::PointerMoved(center));
+    harness.run_steps(1);
+    let before = harness.state().brush;
+    // F: the radius follows the pointer; Enter confirms.
+    harness.key_press(egui::Key::F);
+    harness.run_steps(1);
+    harness.event(egui::Event::PointerMoved(center + egui::vec2(50.0, 0.0)));
+    harness.run_steps(1);
+    harness.key_press(egui::Key::Enter);
+    harness.run_steps(2);
+    let meshpaint_core::paint::brush::BrushRadius::Pixels { radius_px } = harness.state().brush.radius else {
+        panic!("the radius is not in pixels");
+    };
+    assert!((radius_px - 80.0).abs() < 1.0, "radius {radius_px} px after moving 50 px out from 30 px");
+    assert_eq!(harness.state().camera, {
+        let editor = harness.state();
+        editor.camera
+    });
+    // Shift+F then Esc: the strength comes back.
+    harness.key_press_modifiers(egui::Modifiers::SHIFT, egui::Key::F);
+    harness.run_steps(1);
+    harness.event(egui::Event::PointerMoved(center - egui::vec2(100.0, 0.0)));
+    harness.run_steps(1);
+    assert!(harness.state().brush.strength < before.strength);
+    harness.key_press(egui::Key::Escape);
+    harness.run_steps(2);
+    assert_eq!(harness.state().brush.strength, before.strength);
+    assert!(harness.state().paint.as_ref().unwrap().gesture.is_none());
+}
+
+/// The Duck in paint mode after one stroke of the resolution brush across the view's middle.
+fn duck_after_a_resolution_stroke() -> Harness<'static, Editor> {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    harness.get_by_label("Resolution").click();
+    harness.run_steps(2);
+    assert!(matches!(harness.state().brush.tool, meshpaint_core::paint::brush::Tool::Resolution(_)));
+    let center = harness.state().viewport.rect.center();
+    left_drag(&mut harness, center - egui::vec2(30.0, 0.0), center + egui::vec2(30.0, 0.0));
+    harness
+}
+
+#[test]
+fn resolution_brush_and_set_r_for_all_change_face_resolutions() {
+    let mut harness = duck_after_a_resolution_stroke();
+    let resolutions = |editor: &Editor| editor.document.as_ref().unwrap().document.store.face_resolutions().to_vec();
+    let raised = resolutions(harness.state()).iter().filter(|r| r.get() == 16).count();
+    assert!(raised > 0, "the resolution brush raised no face: {:?}", harness.state().status);
+    harness.get_by_label("Set R for all").click();
+    harness.run_steps(2);
+    assert!(resolutions(harness.state()).iter().all(|r| r.get() == 8), "{:?}", harness.state().status);
+    harness.get_by_label("Undo").click();
+    harness.run_steps(2);
+    assert_eq!(resolutions(harness.state()).iter().filter(|r| r.get() == 16).count(), raised);
+}
+
+/// Leaving paint mode after a resolution stroke lays the packing out anew (moving the
+/// chains the stroke did not reach): the packing the view's buffers are uploaded from is a
+/// full pack's.
+#[test]
+fn leaving_paint_mode_after_a_resolution_stroke_gives_the_full_pack() {
+    let mut harness = duck_after_a_resolution_stroke();
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.run_steps(2);
+    // The relayout ran (not a full repack after all), and gave a full pack's buffers.
+    let status = &harness.state().status.text;
+    assert!(status.contains("Repacked (new layout, unchanged chains moved)"), "{status}");
+    let open = harness.state().document.as_ref().unwrap();
+    let store = &open.document.store;
+    assert!(store.face_resolutions().iter().any(|r| r.get() == 16), "the stroke raised no face");
+    let full = meshpaint_core::packing::pack(store, &open.document.positions, open.format).unwrap();
+    assert!(*open.pack_cache.as_ref().unwrap().packed() == full, "the repacked buffers differ from a full pack");
+}
+
+/// The Optimize button (E = 0): fewer samples, every shown colour kept (CPU reference
+/// sampler at random points), the memory in the status line, one undo step back.
+#[test]
+fn optimize_button_lowers_resolutions_losslessly_and_undoes() {
+    use meshpaint_core::packing::sampler::{Filter, sample};
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    let store = |editor: &Editor| editor.document.as_ref().unwrap().document.store.clone();
+    let before = store(harness.state());
+    harness.get_by_label("Optimize").click();
+    harness.run_steps(2);
+    // Optimize plans on a worker thread; its result is applied when the job is noticed.
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "Optimize timed out");
+    harness.run_steps(2);
+    let after = store(harness.state());
+    let status = format!("{:?}", harness.state().status);
+    assert!(after.sample_count() * 2 < before.sample_count(), "{status}");
+    assert!(status.contains("Optimize") && status.contains("samples") && status.contains("B"), "{status}");
+    let mut seed = 0x5eedu64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 40) as f32 / (1u64 << 24) as f32
+    };
+    for face in 0..before.topology().face_count() {
+        let (mut u, mut v) = (next(), next());
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
+        }
+        let bary = [1.0 - u - v, u, v];
+        let (a, b) = (
+            sample(&before, face, bary, Filter::Linear, 0).unwrap(),
+            sample(&after, face, bary, Filter::Linear, 0).unwrap(),
+        );
+        assert!((0..4).all(|c| (a[c] - b[c]).abs() <= 2e-6), "face {face}: {a:?} → {b:?}");
+    }
+    harness.get_by_label("Undo").click();
+    harness.run_steps(2);
+    assert_eq!(store(harness.state()).face_resolutions(), before.face_resolutions());
+    assert_eq!(store(harness.state()).sample_count(), before.sample_count());
+}
+
+/// The Duck opened within a memory budget of `bytes`, in paint mode.
+fn duck_painting_within(bytes: u64) -> Harness<'static, Editor> {
+    let mut editor = new_editor();
+    editor.budget_override = Some(meshpaint_core::colors::budget::Budget::with_memory(
+        bytes,
+        meshpaint_core::colors::budget::MemorySource::Set,
+    ));
+    editor.open(Source::BuiltIn);
+    assert!(editor.wait_for_job(JOB_TIMEOUT), "opening the Duck timed out");
+    assert!(editor.document.is_some(), "the Duck did not open: {:?}", editor.status);
+    let mut harness = harness(editor);
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    assert_eq!(harness.state().mode, Mode::Paint);
+    harness
+}
+
+#[test]
+fn set_r_for_all_past_the_budget_is_refused_and_the_document_stays_valid() {
+    // 100 MB holds the Duck at R = 8 and 16 (about 11 and 37 MB estimated), not at R = 64.
+    let mut harness = duck_painting_within(100_000_000);
+    let resolutions = |editor: &Editor| editor.document.as_ref().unwrap().document.store.face_resolutions().to_vec();
+    let before = resolutions(harness.state());
+    harness.state_mut().resolution_for_all = meshpaint_core::colors::layout::Resolution::new(64).unwrap();
+    harness.get_by_label("Set R for all").click();
+    harness.run_steps(2);
+    let status = harness.state().status.clone();
+    assert_eq!(status.severity, Severity::Error, "{status:?}");
+    assert!(status.text.contains("R = 64 on every face") && status.text.contains("of memory"), "{status:?}");
+    assert_eq!(resolutions(harness.state()), before, "nothing changed");
+    assert_eq!(harness.state().history.undo_len(), 0, "no step recorded");
+    // R = 16 fits; the document still saves and reopens.
+    harness.state_mut().resolution_for_all = meshpaint_core::colors::layout::Resolution::new(16).unwrap();
+    harness.get_by_label("Set R for all").click();
+    harness.run_steps(2);
+    assert!(resolutions(harness.state()).iter().all(|r| r.get() == 16), "{:?}", harness.state().status);
+    let file = common::TempFile::new("app_ui_budget", "duck16.mpk");
+    let document = harness.state().document.as_ref().unwrap().document.clone();
+    let packed = document.pack(meshpaint_core::colors::format::ColorFormat::Rgba8Srgb).unwrap();
+    meshpaint_core::packing::file::write_file(file.path(), &packed).unwrap();
+    let reopened =
+        meshpaint_core::io::document::Document::open(file.path(), meshpaint_core::colors::layout::Resolution::ONE)
+            .unwrap();
+    assert_eq!(reopened.store.face_resolutions(), document.store.face_resolutions());
+}
+
+#[test]
+fn the_resolution_brush_stops_at_the_budget_with_one_message() {
+    // Just above the Duck at R = 8 (about 11.1 MB estimated): room for a few raised faces.
+    let mut harness = duck_painting_within(11_136_784 + 100_000);
+    harness.get_by_label("Resolution").click();
+    harness.run_steps(2);
+    let center = harness.state().viewport.rect.center();
+    left_drag(&mut harness, center - egui::vec2(60.0, 0.0), center + egui::vec2(60.0, 0.0));
+    let editor = harness.state();
+    let raised =
+        editor.document.as_ref().unwrap().document.store.face_resolutions().iter().filter(|r| r.get() == 16).count();
+    assert!(raised > 0, "some faces fit: {:?}", editor.status);
+    assert_eq!(editor.status.severity, Severity::Error, "{:?}", editor.status);
+    assert!(
+        editor.status.text.contains("raising face") && editor.status.text.contains("of memory"),
+        "{:?}",
+        editor.status
+    );
+    let store = &editor.document.as_ref().unwrap().document.store;
+    let counts = meshpaint_core::colors::budget::SampleCounts::of_store(store);
+    assert!(counts.estimated_bytes(meshpaint_core::colors::format::ColorFormat::Rgba8Srgb) <= 11_136_784 + 100_000);
+}
+
+/// Opens `path` with the editor's current import settings and waits for it.
+fn open_and_wait(editor: &mut Editor, path: &Path) {
+    editor.open(Source::File(path.to_owned()));
+    assert!(editor.wait_for_job(JOB_TIMEOUT), "opening {} timed out", path.display());
+    assert!(editor.document.is_some(), "{} did not open: {:?}", path.display(), editor.status);
+}
+
+/// The open dialog's resolution choice reaches the document: "Automatic" keeps R on the
+/// textured Duck and starts an untextured STL at R = 1 with resolution following the brush;
+/// "Error ≤ E" gives the Duck exactly the per-face resolutions of the library's rule, and so
+/// do "Match texture" and "Samples ≤ N" (the budget, on BoxTextured).
+#[test]
+fn the_open_dialog_offers_uniform_match_texture_error_bound_and_budget_resolutions() {
+    use meshpaint::app::import_settings::ImportMode;
+    use meshpaint_core::colors::budget::Budget;
+    use meshpaint_core::convert::adaptive::ResolutionRule;
+    use meshpaint_core::io::document::Document;
+    let duck = workspace_path("assets/models/Duck/Duck.glb");
+    let stl = workspace_path("assets/models/AssimpTestModels/sphereWithHole.stl");
+    let mut harness = harness(new_editor());
+    harness.run_steps(2);
+    harness.state_mut().open_dialog(meshpaint::app::file_dialog::DialogPurpose::Open);
+    harness.run_steps(2);
+    // The dialog shows the choice; picking a mode there is what the editor opens with.
+    harness.get_by_label("Mesh resolution:").click();
+    harness.run_steps(2);
+    harness.get_by_label("Error ≤ E").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().import.mode, ImportMode::ErrorBound, "the dialog's choice is the editor's");
+    harness.state_mut().dialog = None;
+
+    let resolutions = |editor: &Editor| editor.document.as_ref().unwrap().document.store.face_resolutions().to_vec();
+    let editor = harness.state_mut();
+    editor.import.error_bound = 0.02;
+    open_and_wait(editor, &duck);
+    let rule = ResolutionRule::ErrorBound { bound: 0.02, max: editor.import.max_resolution };
+    let expected = Document::open_within(&duck, rule, &Budget::from_environment()).unwrap();
+    assert_eq!(resolutions(editor), expected.store.face_resolutions(), "the rule's resolutions, face by face");
+    assert!(resolutions(editor).iter().any(|r| r.get() != resolutions(editor)[0].get()), "not uniform");
+
+    editor.import.mode = ImportMode::Automatic;
+    open_and_wait(editor, &duck);
+    assert!(resolutions(editor).iter().all(|r| r.get() == 8), "the textured Duck keeps R = 8");
+    assert_eq!(editor.brush.follow_resolution, None, "textured: resolution does not follow the brush");
+    open_and_wait(editor, &stl);
+    assert!(resolutions(editor).iter().all(|r| r.get() == 1), "untextured: the lowest R");
+    assert!(editor.brush.follow_resolution.is_some(), "untextured: resolution follows the brush");
+
+    editor.import.mode = ImportMode::Uniform;
+    editor.import.resolution = meshpaint_core::colors::layout::Resolution::new(4).unwrap();
+    open_and_wait(editor, &stl);
+    assert!(resolutions(editor).iter().all(|r| r.get() == 4), "uniform R is uniform, textured or not");
+
+    editor.import.mode = ImportMode::MatchTexture;
+    open_and_wait(editor, &duck);
+    let rule = ResolutionRule::TexelDensity { max: editor.import.max_resolution };
+    let expected = Document::open_within(&duck, rule, &Budget::from_environment()).unwrap();
+    assert_eq!(resolutions(editor), expected.store.face_resolutions());
+
+    // "Samples ≤ N": the budget rule's resolutions, within N (BoxTextured: 12 faces, fast).
+    let box_textured = workspace_path("assets/models/BoxTextured/BoxTextured.glb");
+    editor.import.mode = ImportMode::Budget;
+    editor.import.sample_budget = 600;
+    open_and_wait(editor, &box_textured);
+    let rule = ResolutionRule::Budget { samples: 600, max: editor.import.max_resolution };
+    let expected = Document::open_within(&box_textured, rule, &Budget::from_environment()).unwrap();
+    assert_eq!(resolutions(editor), expected.store.face_resolutions());
+    let samples = editor.document.as_ref().unwrap().document.store.sample_count();
+    assert!(samples <= 600 && samples > 386, "{samples} samples: within N, more than uniform R = 8's 386");
+}
+
+/// An editor with a headless GPU (lavapipe) and the built-in Duck.
+fn editor_with_gpu_and_duck() -> Editor {
+    let gpu = meshpaint_render::Gpu::new_headless().expect("GPU tests need an adapter (lavapipe)");
+    let mut editor = Editor::new(Some(Arc::new(gpu)), Arc::new(|| {}));
+    editor.open(Source::BuiltIn);
+    assert!(editor.wait_for_job(JOB_TIMEOUT), "opening the Duck timed out");
+    assert!(editor.document.is_some(), "the Duck did not open: {:?}", editor.status);
+    editor
+}
+
+/// "Show: Source texture" draws the UV-textured source and reports the PSNR of this view
+/// (the Duck at R = 8 looks like its texture: tests/gpu_render.rs measures a mean below 1
+/// step at R = 16); "Position colours" draws a colour field, never the document's colours.
+#[test]
+fn the_view_compares_mesh_colors_with_the_source_texture_and_shows_the_psnr() {
+    use meshpaint_render::DrawItem;
+    let mut harness = harness(editor_with_gpu_and_duck());
+    harness.run_steps(2);
+    assert!(matches!(harness.state().shown_item(), Some(DrawItem::MeshColors(_))));
+    harness.get_by_label("Show:").click();
+    harness.run_steps(2);
+    harness.get_by_label("Source texture").click();
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "building the source texture timed out");
+    harness.run_steps(3);
+    assert!(matches!(harness.state().shown_item(), Some(DrawItem::Baseline(_))), "{:?}", harness.state().status);
+    let psnr = match &harness.state().source_psnr {
+        Some((_, Ok(db))) => *db,
+        other => panic!("no PSNR measured: {other:?}"),
+    };
+    assert!(psnr > 25.0 && psnr.is_finite(), "Duck R = 8 vs its texture: {psnr} dB");
+    harness.get_by_label_contains("PSNR");
+    let colors_before = harness.state().document.as_ref().unwrap().document.store.clone();
+    harness.get_by_label("Show:").click();
+    harness.run_steps(2);
+    harness.get_by_label("Position colours").click();
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "building the position colours timed out");
+    harness.run_steps(2);
+    let editor = harness.state();
+    let open = editor.document.as_ref().unwrap();
+    match (editor.shown_item(), open.gpu_mesh.as_ref()) {
+        (Some(DrawItem::MeshColors(shown)), Some(own)) => assert!(!std::ptr::eq(shown, own), "a separate mesh"),
+        _ => panic!("position colours are not shown"),
+    }
+    let colors_after = &open.document.store;
+    assert_eq!(colors_after.sample_count(), colors_before.sample_count());
+    assert!(
+        (0..colors_after.topology().face_count())
+            .all(|f| colors_after.interior_samples(f) == colors_before.interior_samples(f)),
+        "a view option never changes the document's colours"
+    );
+}
+
+/// A file without a texture cannot be compared: the view says why and keeps the mesh colors.
+#[test]
+fn comparing_an_untextured_mesh_says_why_and_shows_the_mesh_colors() {
+    use meshpaint_render::DrawItem;
+    let mut editor = editor_with_gpu_and_duck();
+    open_and_wait(&mut editor, &workspace_path("assets/models/AssimpTestModels/sphereWithHole.stl"));
+    let mut harness = harness(editor);
+    harness.run_steps(2);
+    harness.state_mut().view.shown = meshpaint::app::state::Shown::SourceTexture;
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.run_steps(2);
+    assert!(matches!(harness.state().shown_item(), Some(DrawItem::MeshColors(_))));
+    assert!(harness.get_all_by_label_contains("no base-colour texture").count() >= 1);
+}

@@ -1,0 +1,7 @@
+//! The editor's tests in one binary: its UI driven without a window (egui_kittest) and the
+//! real window under Xvfb.
+
+mod common;
+
+mod app_ui;
+mod app_window;
