@@ -1,6 +1,7 @@
 //! Autosave state of the editor, on top of [`meshpaint_core::io::autosave`]: the settings, the timer,
-//! the recovery file of the open document and the recovery offer. The editor's autosave
-//! tick, settings and recovery dialog are in [`super::autosave_ui`].
+//! the recovery file of the open document and the recovery offer, and when the next
+//! recovery write is due ([`AutosaveState::tick`]). The settings and the recovery dialog are
+//! the autosave panel (`panels::autosave`); the editor runs the write as a job.
 //!
 //! Recovery files of project files sit next to them ([`autosave::recovery_path`]); those of
 //! imported glTF files and the built-in scene go to `$XDG_STATE_HOME/meshpaint` (else
@@ -108,7 +109,35 @@ pub fn recovery_path_of(open: &OpenDocument) -> Option<PathBuf> {
     }
 }
 
+/// What autosave wants this frame.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum AutosaveTick {
+    /// Nothing now; the next write falls due after this long, if one is pending (the editor
+    /// draws no frame at rest, so the UI asks to be woken then).
+    Wait(Option<Duration>),
+    /// Write the recovery file here now.
+    Write(PathBuf),
+}
+
 impl AutosaveState {
+    /// Whether a recovery write of the open document is due at edit `generation`; `blocked`
+    /// (a job running, a stroke in progress) waits without a wake-up, as do autosave being
+    /// off and an open recovery offer.
+    pub fn tick(&mut self, generation: u64, blocked: bool) -> AutosaveTick {
+        if !self.enabled || blocked || self.offer.is_some() {
+            return AutosaveTick::Wait(None);
+        }
+        let Some(path) = self.recovery_path.clone() else {
+            return AutosaveTick::Wait(None);
+        };
+        self.autosaver.interval = Duration::from_secs(u64::from(self.interval_seconds.max(1)));
+        let now = Instant::now();
+        if !self.autosaver.is_due(now, generation) {
+            return AutosaveTick::Wait(self.autosaver.due_at(generation).map(|at| at.saturating_duration_since(now)));
+        }
+        AutosaveTick::Write(path)
+    }
+
     /// A document opened: patches a restored one, finds its recovery file, resets the timer.
     pub(crate) fn document_opened(&mut self, open: &mut OpenDocument, generation: u64) {
         if let Some(restoring) = self.restoring.take() {

@@ -1,9 +1,11 @@
 //! The open document as the editor holds it: the [`Document`] (its editable
 //! [`meshpaint_core::colors::store::ColorStore`]) side by side with its [`GpuMesh`] and picking BVH, and
-//! the work that makes one (open a file, the built-in scene) or writes one (save, export).
+//! the work that makes one (open a file, the built-in scene) or writes one (save, export),
+//! and which of its views the 3D view draws ([`OpenDocument::shown_item`]).
 //!
-//! Everything here runs on a job's worker thread ([`super::jobs`]); the GPU upload too
-//! (wgpu devices are shared across threads), so the UI never stalls on a large file.
+//! Loading, building views and writing run on a job's worker thread ([`super::jobs`]); the
+//! GPU upload too (wgpu devices are shared across threads), so the UI never stalls on a
+//! large file.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -15,10 +17,11 @@ use meshpaint_core::camera::BoundingSphere;
 use meshpaint_core::colors::budget::Budget;
 use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::convert::adaptive::ResolutionRule;
-use meshpaint_core::io::document::{Document, DocumentError, Source, SourceKind};
+use meshpaint_core::io::display::{Displayed, OpenOptions, open_for_display};
+use meshpaint_core::io::document::{Document, Source, SourceKind};
 use meshpaint_core::packing::packer::PackCache;
-use meshpaint_core::paint::picking::{BvhPreset, MeshBvh};
-use meshpaint_render::{BaselineMesh, Gpu, GpuMesh};
+use meshpaint_core::paint::picking::MeshBvh;
+use meshpaint_render::{BaselineMesh, DrawItem, Gpu, GpuMesh};
 
 use super::jobs::JobContext;
 use super::state::Shown;
@@ -125,9 +128,46 @@ impl OpenDocument {
     pub fn triangles(&self) -> u32 {
         self.document.store.topology().face_count()
     }
+
+    /// Whether the view `shown` still has to be built (never for the mesh colors).
+    pub fn is_missing(&self, shown: Shown) -> bool {
+        match shown {
+            Shown::MeshColors => false,
+            Shown::SourceTexture => self.alternates.source_texture.is_none(),
+            Shown::PositionColors => self.alternates.position_colors.is_none(),
+        }
+    }
+
+    /// Why the view `shown` cannot be shown, if building it failed.
+    pub fn failure(&self, shown: Shown) -> Option<&str> {
+        match shown {
+            Shown::MeshColors => None,
+            Shown::SourceTexture => self.alternates.source_texture.as_ref().and_then(|b| b.as_ref().err()),
+            Shown::PositionColors => self.alternates.position_colors.as_ref().and_then(|b| b.as_ref().err()),
+        }
+        .map(String::as_str)
+    }
+
+    /// What the 3D view draws for `shown`: that alternate view once it is built, else the
+    /// mesh colors (`None` without a GPU).
+    pub fn shown_item(&self, shown: Shown) -> Option<DrawItem<'_>> {
+        let alternate = match shown {
+            Shown::MeshColors => None,
+            Shown::SourceTexture => match &self.alternates.source_texture {
+                Some(Ok(mesh)) => Some(DrawItem::Baseline(mesh)),
+                _ => None,
+            },
+            Shown::PositionColors => match &self.alternates.position_colors {
+                Some(Ok(mesh)) => Some(DrawItem::MeshColors(mesh)),
+                _ => None,
+            },
+        };
+        alternate.or_else(|| self.gpu_mesh.as_ref().map(DrawItem::MeshColors))
+    }
 }
 
-/// Opens `source` for display (within `budget`: a mesh at the face
+/// Opens `source` for display through the one open path
+/// ([`meshpaint_core::io::display::open_for_display`], within `budget`: a mesh at the face
 /// resolutions of `rule`, or packed), uploads it when `gpu` is given and builds the picking BVH.
 pub fn load(
     source: &Source,
@@ -136,33 +176,10 @@ pub fn load(
     gpu: Option<&Gpu>,
     job: &JobContext,
 ) -> Result<OpenDocument> {
-    job.progress(0.05, "reading and importing");
-    let document = Document::open_source_within(source, rule, budget)?;
-    let name = source.name();
-    if document.store.topology().face_count() == 0 {
-        return Err(DocumentError::NoTriangles { path: PathBuf::from(&name) }.into());
-    }
-    job.progress(0.45, "packing colours with MIP chains, building the picking BVH");
-    // The BVH needs only the geometry: it is built while the colours are packed and uploaded.
-    let started = Instant::now();
-    let (packed, bvh) = rayon::join(
-        || -> Result<(PackCache, Duration, Option<GpuMesh>)> {
-            let cache = PackCache::build(&document.store, &document.positions, document.display_format())
-                .with_context(|| format!("packing {name}"))?;
-            let pack_time = started.elapsed();
-            let gpu_mesh = match gpu {
-                Some(gpu) => {
-                    job.progress(0.65, "uploading to the GPU");
-                    Some(gpu.upload(cache.packed()).with_context(|| format!("uploading {name} to the GPU"))?)
-                }
-                None => None,
-            };
-            Ok((cache, pack_time, gpu_mesh))
-        },
-        || MeshBvh::build(&document.positions, &document.store.topology().face_vertices, BvhPreset::FastBuild),
-    );
-    let (cache, pack_time, gpu_mesh) = packed?;
-    job.progress(1.0, "done");
+    let progress = |fraction: f32, stage: &str| job.progress(fraction, stage);
+    let upload = |packed: &_| gpu.map(|gpu| gpu.upload(packed)).transpose();
+    let displayed = open_for_display(source, &OpenOptions::new(rule, *budget), &progress, upload)?;
+    let Displayed { document, cache, bvh, upload: gpu_mesh, timings } = displayed;
     let packed = cache.packed();
     let document_is_packed = matches!(document.source, SourceKind::Packed(_));
     Ok(OpenDocument {
@@ -183,7 +200,7 @@ pub fn load(
             Source::File(path) => Some(path.clone()),
         },
         title: source.title(),
-        last_repack: pack_time,
+        last_repack: timings.pack,
         pack_cache: Some(cache),
         alternates: AlternateViews::default(),
     })

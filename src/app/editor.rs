@@ -1,140 +1,70 @@
-//! The editor's state and its per-frame UI: everything between the window shell
-//! ([`super::window`]) and the library.
+//! The editor: everything between the window shell ([`super::window`]) and the library.
 //!
-//! The editor holds the open document (the [`meshpaint_core::io::document::Document`] with its colour
-//! store side by side with its [`meshpaint_render::GpuMesh`]), the camera, the view settings,
-//! the mode, the job runner and the status line. [`Editor::ui`] draws one frame of panels
-//! and the 3D view's area; input is handled in one place, [`super::input`]. It needs no
-//! window, so `tests/app_ui.rs` drives it with egui_kittest.
+//! [`Editor`] keeps the document ([`DocumentState`]: the open
+//! [`meshpaint_core::io::document::Document`] with its colour store side by side with its
+//! [`meshpaint_render::GpuMesh`], paint mode, the undo history), the camera, the panels
+//! ([`Panels`]), the 3D view's state, the status line and the job runner. [`Editor::ui`]
+//! draws one frame: the panels draw themselves and return [`Command`]s, input returns
+//! [`Action`]s and commands, and [`Editor::apply`] carries every one out here. It needs no
+//! window, so `tests/editor/app_ui.rs` drives it with egui_kittest.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 
-use glam::DVec3;
-
-use meshpaint_core::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera};
+use meshpaint_core::camera::{BoundingSphere, DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera};
+use meshpaint_core::colors::budget::Budget;
 use meshpaint_core::colors::format::ColorFormat;
-use meshpaint_core::colors::layout::Resolution;
-use meshpaint_render::{DrawItem, FilterMode, RenderSettings};
-
+use meshpaint_core::io::autosave;
 use meshpaint_core::io::document::Source;
-use meshpaint_render::Gpu;
+use meshpaint_render::{DrawItem, FilterMode, Gpu, RenderSettings, Shading};
 
-use super::autosave::{AutosaveState, Autosaved};
-use super::document::{self, AlternateView, OpenDocument, Written};
-use super::file_dialog::{DialogOutcome, DialogPurpose, FileDialog};
-use super::import_settings::ImportSettings;
+use super::autosave::{AutosaveTick, Autosaved, Restoring};
+use super::command::Command;
+use super::document;
+use super::file_dialog::DialogPurpose;
+use super::input;
+use super::job_output::JobOutput;
 use super::jobs::{Finished, JobKind, Jobs, Waker, WriteKind};
-use super::paint_session::{PaintSession, Repacked};
-use super::state::{FrameStats, Mode, Severity, Shown, Status, ViewSettings, ViewportInfo};
-use super::text::{error_text, thousands};
-
-/// What a job produced.
-#[derive(Debug)]
-pub enum JobOutput {
-    /// A document was opened.
-    Loaded(Box<OpenDocument>),
-    /// A file was written.
-    Written(Written, WriteKind),
-    /// The store was repacked after paint mode.
-    Repacked(Box<Repacked>),
-    /// A recovery file was written.
-    Autosaved(Autosaved),
-    /// Optimize found its changes (applied if the document did not change meanwhile).
-    Optimized(Box<Optimized>),
-    /// An alternate view was built for the document opened from this path (`None`: built-in).
-    View(Option<PathBuf>, Box<AlternateView>),
-}
-
-/// The view a PSNR was measured in: render settings, 3D view size in pixels, scene generation.
-pub type PsnrKey = (RenderSettings, [u32; 2], u64);
-
-/// What an Optimize job found.
-#[derive(Debug)]
-pub struct Optimized {
-    /// The changes, planned on the store as it was at `generation`.
-    pub plan: meshpaint_core::paint::optimize::OptimizePlan,
-    /// [`Editor::edit_generation`] when the job started.
-    pub generation: u64,
-    /// The error bound used.
-    pub bound: f32,
-}
+use super::paint::{PaintContext, draw_brush_cursor};
+use super::paint_session::GestureKind;
+use super::panels::{
+    LastStroke, PaintPanelContext, Panels, SIDE_PANEL_WIDTH, SceneContext, ViewContext, ViewportContext,
+};
+use super::session::{DocumentState, opened_text};
+use super::state::{Action, Mode, Severity, Shown, Status, ViewportState};
+use super::text::error_text;
 
 /// The editor.
 pub struct Editor {
     /// GPU objects shared with jobs (`None` in UI tests without a GPU).
     pub gpu: Option<Arc<Gpu>>,
-    /// The open document, if any.
-    pub document: Option<OpenDocument>,
+    /// The open document, paint mode and the undo history.
+    pub document: DocumentState,
     /// The camera of the 3D view.
     pub camera: OrbitCamera,
-    /// Filter, shading, overlays.
-    pub view: ViewSettings,
-    /// The interaction mode.
-    pub mode: Mode,
+    /// Every panel, each with its own state (view settings, brush, file dialog, autosave …).
+    pub panels: Panels,
+    /// The 3D view's area, pointer, texture, frame timing and change counter.
+    pub viewport: ViewportState,
     /// The status line.
     pub status: Status,
     /// Background work.
     pub jobs: Jobs<JobOutput>,
-    /// The open file dialog, if any.
-    pub dialog: Option<FileDialog>,
-    /// Whether the shortcut help window is shown.
-    pub show_help: bool,
-    /// How meshes opened next get their face resolutions (the open dialog's choice).
-    pub import: ImportSettings,
-    /// The 3D view's area (set by [`Editor::ui`]).
-    pub viewport: ViewportInfo,
-    /// The egui texture showing the 3D view (registered by the window shell).
-    pub viewport_texture: Option<egui::TextureId>,
-    /// GPU memory of the 3D view's render targets (set by the window shell).
-    pub viewport_gpu_bytes: u64,
-    /// Frame timing (recorded by the window shell).
-    pub frame_stats: FrameStats,
-    /// Counts changes of what the GPU mesh shows (a new document; later, paint uploads):
-    /// the window shell redraws the 3D view only when this, the size or the settings change.
-    pub scene_generation: u64,
-    /// The pointer over the 3D view (points), if it is there.
-    pub viewport_pointer: Option<egui::Pos2>,
     /// Set when the user asked to quit.
     pub quit_requested: bool,
-    /// The brush settings (kept between paint sessions).
-    pub brush: meshpaint_core::paint::brush::BrushSettings,
-    /// Paint mode's state while it is on.
-    pub paint: Option<PaintSession>,
-    /// Undo / redo of paint mode, one step per stroke (cleared when another document opens).
-    pub history: meshpaint_core::paint::undo::UndoHistory,
-    /// The GPU mesh holds the paint layout (level 0 only): the filter is limited to level 0.
-    pub gpu_paint_layout: bool,
-    /// Bytes uploaded to the GPU during the previous frame.
-    pub upload_bytes_last_frame: u64,
-    /// Bytes uploaded to the GPU so far this frame.
-    pub upload_bytes_this_frame: u64,
-    /// Counts edits of the colours (autosave compares it).
-    pub edit_generation: u64,
-    /// The resolution of "Set R for all".
-    pub resolution_for_all: Resolution,
-    /// The error bound of "Optimize" (0 = lossless; colour units, 0..1).
-    pub optimize_bound: f32,
-    /// The last PSNR of the mesh colors against the source texture, with the view it was
-    /// measured in (render settings, view size, scene generation).
-    pub source_psnr: Option<(PsnrKey, Result<f64, String>)>,
     /// A memory budget that replaces the machine's (tests set a small one; `None`:
-    /// [`meshpaint_core::colors::budget::Budget::from_environment`]).
-    pub budget_override: Option<meshpaint_core::colors::budget::Budget>,
-    /// Autosave settings and state.
-    pub autosave: AutosaveState,
+    /// [`Budget::from_environment`]).
+    pub budget_override: Option<Budget>,
     /// A load error to report once the built-in scene has replaced a failed start-up file.
     fallback_error: Option<String>,
-    /// Where file dialogs start.
-    last_directory: PathBuf,
 }
 
 impl std::fmt::Debug for Editor {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Editor")
-            .field("document", &self.document.as_ref().map(|d| &d.title))
-            .field("mode", &self.mode)
+            .field("document", &self.document.open.as_ref().map(|d| &d.title))
+            .field("mode", &self.mode())
             .field("status", &self.status)
             .field("jobs", &self.jobs)
             .finish_non_exhaustive()
@@ -145,83 +75,55 @@ impl Editor {
     /// An editor with no document. `waker` is called from worker threads to request a
     /// repaint (progress, completion).
     pub fn new(gpu: Option<Arc<Gpu>>, waker: Waker) -> Self {
-        let sphere = meshpaint_core::camera::BoundingSphere { center: [0.0; 3], radius: 1.0 };
+        let sphere = BoundingSphere { center: [0.0; 3], radius: 1.0 };
         Editor {
             gpu,
-            document: None,
+            document: DocumentState::default(),
             camera: OrbitCamera::framing(sphere, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES),
-            view: ViewSettings::default(),
-            mode: Mode::default(),
+            panels: Panels::default(),
+            viewport: ViewportState::default(),
             status: Status { text: "Welcome to meshpaint. F1 lists the shortcuts.".into(), severity: Severity::Info },
             jobs: Jobs::new(waker),
-            dialog: None,
-            show_help: false,
-            import: ImportSettings::default(),
-            viewport: ViewportInfo {
-                rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1.0, 1.0)),
-                pixels_per_point: 1.0,
-            },
-            viewport_texture: None,
-            viewport_gpu_bytes: 0,
-            frame_stats: FrameStats::default(),
-            scene_generation: 0,
-            viewport_pointer: None,
             quit_requested: false,
-            brush: meshpaint_core::paint::brush::BrushSettings::default(),
-            paint: None,
-            history: meshpaint_core::paint::undo::UndoHistory::new(meshpaint_core::paint::undo::DEFAULT_CAP_BYTES),
-            gpu_paint_layout: false,
-            upload_bytes_last_frame: 0,
-            upload_bytes_this_frame: 0,
-            edit_generation: 0,
-            resolution_for_all: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
-            optimize_bound: 0.0,
-            source_psnr: None,
             budget_override: None,
-            autosave: AutosaveState::default(),
             fallback_error: None,
-            last_directory: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
         }
     }
 
     /// Sets the status line.
     pub fn set_status(&mut self, severity: Severity, text: impl Into<String>) {
-        let text = text.into();
-        match severity {
-            Severity::Info => log::info!("{text}"),
-            Severity::Warning => log::warn!("{text}"),
-            Severity::Error => log::error!("{text}"),
-        }
-        self.status = Status { text, severity };
+        self.status.set(severity, text);
+    }
+
+    /// The interaction mode (paint while paint mode's session is on).
+    pub fn mode(&self) -> Mode {
+        self.document.mode()
     }
 
     /// The render settings of the 3D view.
     pub fn render_settings(&self) -> RenderSettings {
-        let mut settings = RenderSettings::new(self.camera);
-        settings.filter = self.view.filter;
-        if self.gpu_paint_layout || self.mode == Mode::Paint {
-            // The paint layout holds level 0 only.
-            settings.filter = match self.view.filter {
-                FilterMode::Nearest | FilterMode::NearestMipLevel(_) => FilterMode::Nearest,
-                FilterMode::Linear | FilterMode::MipLevel(_) | FilterMode::Trilinear => FilterMode::Linear,
-            };
+        self.panels.view.settings.render_settings(self.camera, self.document.level0_only())
+    }
+
+    /// The budget every R-changing operation checks first: this machine's, with the GPU's
+    /// limits when there is a GPU.
+    pub fn budget(&self) -> Budget {
+        let budget = self.budget_override.unwrap_or_else(Budget::from_environment);
+        match &self.gpu {
+            Some(gpu) => budget.with_gpu(gpu.budget_limits()),
+            None => budget,
         }
-        settings.shading = self.view.shading;
-        settings.overlays = self.view.overlays;
-        settings
     }
 
     /// Opens `source` on a worker thread; the current document stays until the new one
     /// is ready, and stays for good if opening fails.
     pub fn open(&mut self, source: Source) {
-        let rule = self.import.rule();
+        let rule = self.panels.import.rule();
         let budget = self.budget();
         let gpu = self.gpu.clone();
         let name = source.name();
-        if let Source::File(path) = &source
-            && let Some(parent) = path.parent().filter(|p| p.is_dir())
-        {
-            self.last_directory = parent.to_owned();
+        if let Source::File(path) = &source {
+            self.panels.file.remember_directory_of(path);
         }
         let label = format!("Opening {name}");
         let kind = JobKind::Open { built_in: source == Source::BuiltIn };
@@ -236,16 +138,6 @@ impl Editor {
         }
     }
 
-    /// The budget every R-changing operation checks first: this machine's, with the GPU's
-    /// limits when there is a GPU.
-    pub fn budget(&self) -> meshpaint_core::colors::budget::Budget {
-        let budget = self.budget_override.unwrap_or_else(meshpaint_core::colors::budget::Budget::from_environment);
-        match &self.gpu {
-            Some(gpu) => budget.with_gpu(gpu.budget_limits()),
-            None => budget,
-        }
-    }
-
     /// Saves the project to `path` as a packed file in `format`.
     pub fn save_to(&mut self, path: PathBuf, format: ColorFormat) {
         self.write(path, format, WriteKind::Save);
@@ -253,14 +145,12 @@ impl Editor {
 
     /// Starts a write job (save or export).
     fn write(&mut self, path: PathBuf, format: ColorFormat, kind: WriteKind) {
-        let Some(open) = &self.document else {
+        let Some(open) = &self.document.open else {
             self.set_status(Severity::Error, "Nothing to save: no document is open.");
             return;
         };
         let document = Arc::clone(&open.document);
-        if let Some(parent) = path.parent().filter(|p| p.is_dir()) {
-            self.last_directory = parent.to_owned();
-        }
+        self.panels.file.remember_directory_of(&path);
         let label = match kind {
             WriteKind::Save => format!("Saving {}", path.display()),
             WriteKind::ExportPacked => format!("Exporting packed buffers to {}", path.display()),
@@ -298,66 +188,18 @@ impl Editor {
     }
 
     fn finish_job(&mut self, kind: JobKind, finished: Finished<JobOutput>) {
-        match finished {
-            Finished::Done { value: JobOutput::Loaded(document), elapsed } => {
-                let mut document = *document;
-                let mut text = format!(
-                    "Opened {}: {} triangles, {} samples ({:.2} s)",
-                    document.title,
-                    thousands(u64::from(document.triangles())),
-                    thousands(document.samples),
-                    elapsed.as_secs_f64()
-                );
-                let notes = &document.document.warnings;
-                match notes.as_slice() {
-                    [] => {}
-                    [note] => text.push_str(&format!("; note: {note}")),
-                    [first, ..] => text.push_str(&format!("; {} notes, first: {first}", notes.len())),
-                }
-                for note in notes {
-                    log::info!("{}: {note}", document.title);
-                }
-                self.camera = OrbitCamera::framing(document.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES);
-                // A new document: paint mode, its GPU layout and the undo history end.
-                self.paint = None;
-                self.mode = Mode::View;
-                self.gpu_paint_layout = false;
-                self.history.clear();
-                self.history.set_budget(Some((self.budget(), document.format)));
-                // Untextured documents start at the lowest R where nothing is painted, and
-                // resolution follows the brush there; textured ones keep the chosen R.
-                self.brush.follow_resolution =
-                    (!document.document.textured).then_some(meshpaint_core::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
-                self.autosave.document_opened(&mut document, self.edit_generation);
-                self.document = Some(document);
-                self.scene_generation += 1;
-                self.frame_all();
-                match self.fallback_error.take() {
-                    Some(error) => {
-                        self.set_status(Severity::Error, format!("{error} — showing the built-in Duck instead"))
-                    }
-                    None => self.set_status(Severity::Info, text),
-                }
+        let Finished::Done { value, elapsed } = finished else {
+            if let Finished::Failed(message) = finished {
+                self.finish_failed(kind, message);
             }
-            Finished::Done { value: JobOutput::Written(written, kind), elapsed } => {
-                if let (Some(repack), Some(open)) = (written.repack, self.document.as_mut()) {
-                    open.last_repack = repack;
-                }
-                if kind == WriteKind::Save
-                    && let Some(open) = self.document.as_mut()
-                {
-                    // Save now writes here, in this format.
-                    open.project_path = Some(written.path.clone());
-                    open.title = written
-                        .path
-                        .file_name()
-                        .map_or_else(|| written.path.display().to_string(), |n| n.to_string_lossy().into_owned());
-                    if let Some(format) = written.format {
-                        open.format = format;
-                    }
-                }
+            return;
+        };
+        match value {
+            JobOutput::Loaded(document) => self.finish_loaded(*document, elapsed),
+            JobOutput::Written(written, kind) => {
+                self.document.written(&written, kind);
                 if kind == WriteKind::Save {
-                    self.autosave.saved(self.document.as_ref(), self.edit_generation);
+                    self.panels.autosave.state.saved(self.document.open.as_ref(), self.document.edit_generation);
                 }
                 let verb = match kind {
                     WriteKind::Save => "Saved",
@@ -368,88 +210,64 @@ impl Editor {
                     format!("{verb} {}: {} ({:.2} s)", written.path.display(), written.summary, elapsed.as_secs_f64()),
                 );
             }
-            Finished::Done { value: JobOutput::Repacked(repacked), elapsed } => self.finish_repack(*repacked, elapsed),
-            Finished::Done { value: JobOutput::Autosaved(autosaved), .. } => self.autosave.finished(&autosaved),
-            Finished::Done { value: JobOutput::Optimized(done), elapsed } => self.finish_optimize(*done, elapsed),
-            Finished::Done { value: JobOutput::View(path, view), .. } => self.finish_view(path, *view),
-            Finished::Failed(message) if kind == JobKind::Autosave => {
-                self.autosave.failed();
-                self.set_status(Severity::Warning, format!("Autosave failed: {message}"));
+            JobOutput::Repacked(repacked) => {
+                self.document.finish_repack(*repacked, elapsed, &mut self.viewport, &mut self.status);
             }
-            Finished::Failed(message) => {
-                if kind == JobKind::Repack {
-                    self.gpu_paint_layout = true;
-                }
-                let is_open = matches!(kind, JobKind::Open { .. });
-                if kind == (JobKind::Open { built_in: false }) && self.document.is_none() {
-                    // Nothing was open (a bad file on the command line): show the Duck.
-                    self.fallback_error = Some(format!("Could not open: {message}"));
-                    self.set_status(Severity::Error, format!("Could not open: {message}"));
-                    self.open(Source::BuiltIn);
-                    return;
-                }
-                let kept = match &self.document {
-                    Some(open) => format!(" (still showing {})", open.title),
-                    None => String::new(),
-                };
-                let what = if is_open { "Could not open" } else { "Failed" };
-                self.set_status(Severity::Error, format!("{what}: {message}{kept}"));
+            JobOutput::Autosaved(autosaved) => self.panels.autosave.state.finished(&autosaved),
+            JobOutput::Optimized(done) => {
+                let (document, mut ctx) = self.paint_parts();
+                document.finish_optimize(&mut ctx, *done, elapsed);
+            }
+            JobOutput::View(path, view) => {
+                self.document.finish_view(path, *view, &mut self.viewport, &mut self.status);
             }
         }
     }
 
-    /// Keeps a built alternate view if the document is still the one it was built for.
-    fn finish_view(&mut self, path: Option<PathBuf>, view: AlternateView) {
-        let Some(open) = self.document.as_mut().filter(|open| open.path == path) else {
-            return;
-        };
-        let failed = match view {
-            AlternateView::SourceTexture(built) => {
-                let failed = built.as_ref().as_ref().err().cloned();
-                open.alternates.source_texture = Some(*built);
-                failed
-            }
-            AlternateView::PositionColors(built) => {
-                let failed = built.as_ref().as_ref().err().cloned();
-                open.alternates.position_colors = Some(*built);
-                failed
-            }
-        };
-        if let Some(message) = failed {
-            self.set_status(Severity::Warning, format!("Cannot show it: {message}"));
+    /// A document was opened: it replaces the open one, framed, with the brush and autosave
+    /// set up for it.
+    fn finish_loaded(&mut self, mut document: document::OpenDocument, elapsed: Duration) {
+        let text = opened_text(&document, elapsed);
+        self.camera = OrbitCamera::framing(document.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES);
+        let history_budget = (self.budget(), document.format);
+        // Untextured documents start at the lowest R where nothing is painted, and
+        // resolution follows the brush there; textured ones keep the chosen R.
+        self.panels.paint.brush.follow_resolution =
+            (!document.document.textured).then_some(meshpaint_core::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
+        self.panels.autosave.state.document_opened(&mut document, self.document.edit_generation);
+        self.document.replace(document, history_budget);
+        self.viewport.scene_generation += 1;
+        self.frame_all();
+        match self.fallback_error.take() {
+            Some(error) => self.set_status(Severity::Error, format!("{error} — showing the built-in Duck instead")),
+            None => self.set_status(Severity::Info, text),
         }
-        self.scene_generation += 1;
     }
 
-    /// Applies a finished repack (if the document is still the one packed).
-    pub(crate) fn finish_repack(&mut self, repacked: Repacked, elapsed: Duration) {
-        let Some(open) = self.document.as_mut() else {
+    /// A job failed: reported; a failed start-up file falls back to the built-in scene.
+    fn finish_failed(&mut self, kind: JobKind, message: String) {
+        if kind == JobKind::Autosave {
+            self.panels.autosave.state.failed();
+            self.set_status(Severity::Warning, format!("Autosave failed: {message}"));
             return;
+        }
+        if kind == JobKind::Repack {
+            self.document.gpu_paint_layout = true;
+        }
+        let is_open = matches!(kind, JobKind::Open { .. });
+        if kind == (JobKind::Open { built_in: false }) && self.document.open.is_none() {
+            // Nothing was open (a bad file on the command line): show the Duck.
+            self.fallback_error = Some(format!("Could not open: {message}"));
+            self.set_status(Severity::Error, format!("Could not open: {message}"));
+            self.open(Source::BuiltIn);
+            return;
+        }
+        let kept = match &self.document.open {
+            Some(open) => format!(" (still showing {})", open.title),
+            None => String::new(),
         };
-        if !Arc::ptr_eq(&open.document, &repacked.document) || self.mode == Mode::Paint {
-            log::info!("a repack finished for a document that changed since; ignored");
-            return;
-        }
-        if let Some(mesh) = repacked.gpu_mesh {
-            open.gpu_mesh = Some(mesh);
-        }
-        open.samples_with_mips = repacked.samples_with_mips;
-        open.packed_bytes = repacked.packed_bytes;
-        open.samples = open.document.store.sample_count();
-        open.last_repack = repacked.pack_time;
-        open.pack_cache = Some(repacked.cache);
-        self.gpu_paint_layout = false;
-        self.scene_generation += 1;
-        self.set_status(
-            Severity::Info,
-            format!(
-                "Repacked{}: {} samples with MIP chains in {:.1} ms ({:.2} s with the upload)",
-                repacked.how.note(),
-                thousands(repacked.samples_with_mips),
-                repacked.pack_time.as_secs_f64() * 1000.0,
-                elapsed.as_secs_f64()
-            ),
-        );
+        let what = if is_open { "Could not open" } else { "Failed" };
+        self.set_status(Severity::Error, format!("{what}: {message}{kept}"));
     }
 
     /// Shows the file dialog for `purpose` (refused while a job runs).
@@ -458,69 +276,19 @@ impl Editor {
             self.set_status(Severity::Warning, "Busy: wait for the running job to finish.");
             return;
         }
-        if purpose != DialogPurpose::Open && self.document.is_none() {
+        if purpose != DialogPurpose::Open && self.document.open.is_none() {
             self.set_status(Severity::Error, "Nothing to save or export: no document is open.");
             return;
         }
-        let stem = self
-            .document
-            .as_ref()
-            .and_then(|d| d.path.as_deref().and_then(Path::file_stem).map(|s| s.to_string_lossy().into_owned()))
-            .unwrap_or_else(|| "duck".to_owned());
-        let file_name = match purpose {
-            DialogPurpose::Open => String::new(),
-            DialogPurpose::SaveAs | DialogPurpose::ExportPacked => format!("{stem}.mpk"),
-            DialogPurpose::ExportGltf => format!("{stem}_meshcolors.glb"),
-        };
-        let format = self.document.as_ref().map_or_else(ColorFormat::default, |d| d.format);
-        let mut dialog = FileDialog::new(purpose, self.last_directory.clone(), file_name, format);
-        if purpose == DialogPurpose::Open {
-            dialog.import = Some(self.import);
-        }
-        self.dialog = Some(dialog);
-    }
-
-    /// Handles the dialog's decision.
-    pub(crate) fn dialog_ui(&mut self, ctx: &egui::Context) {
-        let Some(dialog) = self.dialog.as_mut() else {
-            return;
-        };
-        let purpose = dialog.purpose;
-        let outcome = dialog.file_dialog_ui(ctx);
-        if let Some(import) = dialog.import {
-            self.import = import;
-        }
-        match outcome {
-            DialogOutcome::Pending => {}
-            DialogOutcome::Cancelled => self.dialog = None,
-            DialogOutcome::Chosen(path, format) => {
-                self.dialog = None;
-                match purpose {
-                    DialogPurpose::Open => self.open(Source::File(path)),
-                    DialogPurpose::SaveAs => self.write(path, format, WriteKind::Save),
-                    DialogPurpose::ExportPacked => self.write(path, format, WriteKind::ExportPacked),
-                    DialogPurpose::ExportGltf => self.write(path, format, WriteKind::ExportGltf),
-                }
-            }
-        }
+        self.panels.file.open_dialog(purpose, self.document.open.as_ref(), self.panels.import);
     }
 
     /// Frames the whole mesh, keeping the viewing angles; the sphere fits the narrower of
     /// the two fields of view.
     pub fn frame_all(&mut self) {
-        let Some(open) = &self.document else {
-            return;
-        };
-        let (yaw, pitch) = (self.camera.yaw_degrees, self.camera.pitch_degrees);
-        let mut camera = OrbitCamera::framing(open.bounds, yaw, pitch);
-        let [w, h] = self.viewport.size_px();
-        let aspect = f64::from(w) / f64::from(h.max(1));
-        if aspect < 1.0 {
-            let half_y = (camera.fov_y_degrees.to_radians() * 0.5).tan();
-            let half_x = (half_y * aspect).atan();
-            camera.distance = open.bounds.radius / half_x.sin() * 1.1;
+        if let Some(open) = &self.document.open {
+            input::frame_all(&mut self.camera, open.bounds, &self.viewport);
         }
-        self.camera = camera;
     }
 
     /// Looks at the mesh from `yaw`/`pitch`, framing it.
@@ -533,46 +301,16 @@ impl Editor {
     /// Centres the view on the surface point under `pos` (points, window coordinates) and
     /// halves the distance to it. Reports a miss on the status line.
     pub fn frame_under(&mut self, pos: egui::Pos2) {
-        let Some(hit) = self.pick(pos) else {
-            self.set_status(Severity::Info, "Nothing under the cursor to frame.");
-            return;
-        };
-        let distance = (self.camera.eye() - hit).length() * 0.5;
-        self.camera.look_at_point(hit, distance);
-        if let Some(open) = &self.document {
-            self.camera.fit_depth_to(open.bounds);
-        }
+        input::frame_under(&mut self.camera, self.document.open.as_ref(), &self.viewport, pos, &mut self.status);
     }
 
-    /// The surface point under `pos` (points, window coordinates), if the ray hits the mesh.
-    pub fn pick(&self, pos: egui::Pos2) -> Option<DVec3> {
-        let open = self.document.as_ref()?;
-        let rect = self.viewport.rect;
-        if !rect.contains(pos) {
-            return None;
-        }
-        let ppp = f64::from(self.viewport.pixels_per_point);
-        let [w, h] = self.viewport.size_px();
-        let x = f64::from(pos.x - rect.min.x) * ppp;
-        let y = f64::from(pos.y - rect.min.y) * ppp;
-        let (origin, direction) = self.camera.ray_through_pixel(x, y, w, h);
-        let hit = open.bvh.cast(origin, direction, f64::INFINITY)?;
-        Some(DVec3::from_array(hit.position_world))
-    }
-
-    /// Starts the job that builds what [`ViewSettings::shown`] needs, when it is missing and
-    /// no other job runs (called by the view panel each frame it is shown).
-    pub fn ensure_shown_view(&mut self) {
-        let shown = self.view.shown;
-        let (Some(open), Some(gpu)) = (&self.document, &self.gpu) else {
+    /// Starts the job that builds the view `shown` needs, when it is missing and no other
+    /// job runs (the view panel asks each frame it is shown).
+    pub fn prepare_view(&mut self, shown: Shown) {
+        let (Some(open), Some(gpu)) = (&self.document.open, &self.gpu) else {
             return;
         };
-        let missing = match shown {
-            Shown::MeshColors => false,
-            Shown::SourceTexture => open.alternates.source_texture.is_none(),
-            Shown::PositionColors => open.alternates.position_colors.is_none(),
-        };
-        if !missing || self.jobs.is_busy() {
+        if !open.is_missing(shown) || self.jobs.is_busy() {
             return;
         }
         let source = open.path.clone().map_or(Source::BuiltIn, Source::File);
@@ -589,55 +327,317 @@ impl Editor {
         }
     }
 
-    /// What the 3D view draws: the alternate view chosen in [`ViewSettings::shown`] once it is
+    /// What the 3D view draws: the alternate view chosen in the view panel once it is
     /// built, else the mesh colors.
     pub fn shown_item(&self) -> Option<DrawItem<'_>> {
-        let open = self.document.as_ref()?;
-        let alternate = match self.view.shown {
-            Shown::MeshColors => None,
-            Shown::SourceTexture => match &open.alternates.source_texture {
-                Some(Ok(mesh)) => Some(DrawItem::Baseline(mesh)),
-                _ => None,
-            },
-            Shown::PositionColors => match &open.alternates.position_colors {
-                Some(Ok(mesh)) => Some(DrawItem::MeshColors(mesh)),
-                _ => None,
-            },
-        };
-        alternate.or_else(|| open.gpu_mesh.as_ref().map(DrawItem::MeshColors))
-    }
-
-    /// PSNR (dB, RGB of covered pixels) of the mesh colors against the source texture as the
-    /// 3D view shows them now, rendered offscreen at the view's aspect (at most 512 px on
-    /// the long side). `None` until the source texture is built.
-    pub fn measure_source_psnr(&self) -> Option<Result<f64, String>> {
-        let open = self.document.as_ref()?;
-        let (Some(gpu), Some(mesh), Some(Ok(baseline))) =
-            (&self.gpu, open.gpu_mesh.as_ref(), open.alternates.source_texture.as_ref())
-        else {
-            return None;
-        };
-        let [w, h] = self.viewport.size_px();
-        let scale = (512.0 / f64::from(w.max(h).max(1))).min(1.0);
-        let (w, h) = (((f64::from(w) * scale) as u32).max(16), ((f64::from(h) * scale) as u32).max(16));
-        let settings = self.render_settings();
-        let render = |item| gpu.render_image(item, &settings, w, h).map_err(|error| error.to_string());
-        Some(render(DrawItem::MeshColors(mesh)).and_then(|ours| {
-            render(DrawItem::Baseline(baseline)).map(|theirs| meshpaint_core::colors::psnr::psnr(&ours, &theirs))
-        }))
+        self.document.open.as_ref()?.shown_item(self.panels.view.settings.shown)
     }
 
     /// GPU memory in use: the mesh's buffers and atlas plus the view's render targets.
     pub fn gpu_bytes(&self) -> u64 {
-        let mesh = self.document.as_ref().and_then(|d| d.gpu_mesh.as_ref()).map_or(0, |m| m.gpu_bytes());
-        mesh + self.viewport_gpu_bytes
+        let mesh = self.document.open.as_ref().and_then(|d| d.gpu_mesh.as_ref()).map_or(0, |m| m.gpu_bytes());
+        mesh + self.viewport.gpu_bytes
     }
 
     /// The window title.
     pub fn window_title(&self) -> String {
-        match &self.document {
+        match &self.document.open {
             Some(open) => format!("{} — meshpaint", open.title),
             None => "meshpaint".to_owned(),
+        }
+    }
+
+    /// The document and what paint mode's commands use besides it (split borrows).
+    fn paint_parts(&mut self) -> (&mut DocumentState, PaintContext<'_>) {
+        let Editor { gpu, document, camera, panels, viewport, status, jobs, .. } = self;
+        let ctx = PaintContext { gpu: gpu.as_ref(), camera, viewport, brush: &mut panels.paint.brush, status, jobs };
+        (document, ctx)
+    }
+
+    /// Carries out `action`: the one place every menu entry, button and shortcut ends.
+    pub fn perform(&mut self, action: Action) {
+        let view = &mut self.panels.view.settings;
+        match action {
+            Action::Open => self.open_dialog(DialogPurpose::Open),
+            Action::Save => match self.document.open.as_ref().and_then(|d| Some((d.project_path.clone()?, d.format))) {
+                Some((path, format)) => self.save_to(path, format),
+                None => self.open_dialog(DialogPurpose::SaveAs),
+            },
+            Action::SaveAs => self.open_dialog(DialogPurpose::SaveAs),
+            Action::ExportGltf => self.open_dialog(DialogPurpose::ExportGltf),
+            Action::ExportPacked => self.open_dialog(DialogPurpose::ExportPacked),
+            Action::FrameAll => self.frame_all(),
+            Action::FrameUnderCursor => {
+                if let Some(pos) = self.viewport.pointer {
+                    self.frame_under(pos);
+                }
+            }
+            Action::ViewFront => self.set_view_angles(0.0, 0.0),
+            Action::ViewBack => self.set_view_angles(180.0, 0.0),
+            Action::ViewRight => self.set_view_angles(90.0, 0.0),
+            Action::ViewLeft => self.set_view_angles(-90.0, 0.0),
+            Action::ViewTop => self.set_view_angles(0.0, 89.0),
+            Action::ViewBottom => self.set_view_angles(0.0, -89.0),
+            Action::ToggleWireframe => view.overlays.wireframe = !view.overlays.wireframe,
+            Action::ToggleHeatmap => view.overlays.heatmap = !view.overlays.heatmap,
+            Action::ToggleShading => {
+                view.shading = match view.shading {
+                    Shading::Lit | Shading::Smooth => Shading::Unlit,
+                    Shading::Unlit => Shading::Smooth,
+                }
+            }
+            Action::CycleFilter => {
+                view.filter = match view.filter {
+                    FilterMode::Nearest | FilterMode::NearestMipLevel(_) => FilterMode::Linear,
+                    FilterMode::Linear | FilterMode::MipLevel(_) => FilterMode::Trilinear,
+                    FilterMode::Trilinear => FilterMode::Nearest,
+                }
+            }
+            Action::ToggleHelp => self.panels.help.open = !self.panels.help.open,
+            Action::Quit => self.quit_requested = true,
+            Action::TogglePaintMode => {
+                let budget = self.budget();
+                self.with_paint_parts(|document, ctx| document.toggle_paint_mode(ctx, budget));
+            }
+            Action::Undo => self.with_paint_parts(|document, ctx| document.undo(ctx)),
+            Action::Redo => self.with_paint_parts(|document, ctx| document.redo(ctx)),
+            Action::Eyedropper => self.with_paint_parts(|document, ctx| document.eyedropper(ctx)),
+            Action::RadiusGesture => {
+                self.with_paint_parts(|document, ctx| document.start_gesture(ctx, GestureKind::Radius));
+            }
+            Action::StrengthGesture => {
+                self.with_paint_parts(|document, ctx| document.start_gesture(ctx, GestureKind::Strength));
+            }
+        }
+    }
+
+    /// Runs a paint-mode command on the document with its [`PaintContext`].
+    fn with_paint_parts<T>(&mut self, work: impl FnOnce(&mut DocumentState, &mut PaintContext<'_>) -> T) -> T {
+        let (document, mut ctx) = self.paint_parts();
+        work(document, &mut ctx)
+    }
+
+    /// Carries out what a panel, dialog or the input asked for.
+    pub fn apply(&mut self, command: Command) {
+        match command {
+            Command::Action(action) => self.perform(action),
+            Command::Open(path) => self.open(Source::File(path)),
+            Command::Write(path, format, kind) => self.write(path, format, kind),
+            Command::Fill { connected } => self.with_paint_parts(|document, ctx| document.fill(ctx, connected)),
+            Command::SetResolutionAll(resolution) => {
+                let budget = self.budget();
+                self.with_paint_parts(|document, ctx| document.set_resolution_all(ctx, resolution, budget));
+            }
+            Command::Optimize(bound) => {
+                self.with_paint_parts(|document, ctx| document.optimize_resolutions(ctx, bound));
+            }
+            Command::SetUndoCap(bytes) => self.document.history.set_cap_bytes(bytes),
+            Command::PrepareView(shown) => self.prepare_view(shown),
+            Command::RestoreRecovery => self.restore_recovery(),
+            Command::DiscardRecovery => self.discard_recovery(),
+            Command::BeginStroke(pos) => self.with_paint_parts(|document, ctx| document.begin_stroke(ctx, pos)),
+            Command::StrokeTo(pos) => self.with_paint_parts(|document, ctx| document.stroke_to(ctx, pos)),
+            Command::EndStroke => self.with_paint_parts(|document, ctx| document.end_stroke(ctx)),
+        }
+    }
+
+    /// Carries out `commands` in order.
+    fn apply_all(&mut self, commands: Vec<Command>) {
+        for command in commands {
+            self.apply(command);
+        }
+    }
+
+    /// Restores the offered recovery file: it opens in place of the document, keeping the
+    /// document's name, paths and format, unsaved.
+    fn restore_recovery(&mut self) {
+        let Some(offer) = self.panels.autosave.state.offer.clone() else {
+            return;
+        };
+        let Some(open) = &self.document.open else {
+            return;
+        };
+        if self.jobs.is_busy() {
+            self.set_status(Severity::Warning, "Busy: try again when the running job has finished.");
+            return;
+        }
+        let autosave = &mut self.panels.autosave.state;
+        autosave.restoring = Some(Restoring {
+            path: open.path.clone(),
+            project_path: open.project_path.clone(),
+            title: open.title.clone(),
+            format: open.format,
+        });
+        autosave.offer = None;
+        self.open(Source::File(offer.path));
+        // Unsaved: the restored colours are not in the document's file yet.
+        self.document.edit_generation += 1;
+    }
+
+    /// Deletes the offered recovery file.
+    fn discard_recovery(&mut self) {
+        let Some(offer) = self.panels.autosave.state.offer.take() else {
+            return;
+        };
+        match autosave::discard_recovery(&offer.path) {
+            Ok(()) => self.set_status(Severity::Info, "Recovery file discarded."),
+            Err(error) => self.set_status(Severity::Error, error.to_string()),
+        }
+    }
+
+    /// Starts an autosave when one is due (called every frame). Returns how long until the
+    /// next one falls due, when one is pending: the editor draws no frame at rest, so the UI
+    /// asks to be woken then.
+    fn autosave_tick(&mut self) -> Option<Duration> {
+        let blocked = self.jobs.is_busy() || self.document.is_stroking();
+        let generation = self.document.edit_generation;
+        let Some(open) = &self.document.open else {
+            return None;
+        };
+        let path = match self.panels.autosave.state.tick(generation, blocked) {
+            AutosaveTick::Wait(after) => return after,
+            AutosaveTick::Write(path) => path,
+        };
+        let document = Arc::clone(&open.document);
+        let started = self.jobs.start(JobKind::Autosave, "Autosave", move |job| {
+            job.progress(0.1, "writing the recovery file");
+            if let Some(parent) = path.parent() {
+                std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
+            }
+            let write = autosave::write_recovery(&path, &document).map_err(|e| e.to_string())?;
+            Ok(JobOutput::Autosaved(Autosaved { path, write, generation }))
+        });
+        if let Err(message) = started {
+            log::warn!("{message}");
+        }
+        None
+    }
+
+    /// One frame of the editor's UI inside `ui` (the window's root). Afterwards
+    /// [`Editor::viewport`] holds the 3D view's area, which the window shell renders.
+    pub fn ui(&mut self, ui: &mut egui::Ui) {
+        self.viewport.upload_bytes_last_frame = std::mem::take(&mut self.viewport.upload_bytes_this_frame);
+        self.poll_jobs();
+        let ctx = ui.ctx().clone();
+        if let Some(after) = self.autosave_tick() {
+            // Nothing else wakes an idle editor: the autosave asks for the frame it needs.
+            ctx.request_repaint_after(after);
+        }
+        self.global_input(&ctx);
+        let (has_document, idle) = (self.document.open.is_some(), !self.jobs.is_busy());
+        let chosen = egui::Panel::top("menu bar").show(ui, |ui| self.panels.menu.ui(ui, has_document, idle)).inner;
+        self.apply_all(chosen);
+        egui::Panel::bottom("status line").show(ui, |ui| {
+            let mode = self.mode();
+            self.panels.status_line.ui(ui, mode, &self.status, self.jobs.status());
+        });
+        egui::Panel::left("side panel")
+            .resizable(true)
+            .default_size(SIDE_PANEL_WIDTH)
+            .show(ui, |ui| egui::ScrollArea::vertical().show(ui, |ui| self.side_panel_ui(ui)));
+        egui::CentralPanel::no_frame().show(ui, |ui| self.viewport_ui(ui));
+        self.panels.help.ui(&ctx, self.viewport.rect.center());
+        let chosen = self.panels.file.dialog_ui(&ctx, &mut self.panels.import);
+        self.apply_all(chosen);
+        let chosen = self.panels.autosave.recovery_ui(&ctx, self.viewport.rect.center());
+        self.apply_all(chosen);
+        if self.jobs.is_busy() {
+            // Animate the progress bar; a finished job wakes the UI by itself.
+            ctx.request_repaint_after(Duration::from_millis(100));
+        }
+        if self.panels.scene.continuous_redraw {
+            ctx.request_repaint();
+        }
+    }
+
+    /// Dropped files, a running brush gesture, and the keyboard shortcuts.
+    fn global_input(&mut self, ctx: &egui::Context) {
+        if let Some(path) = input::dropped_file(ctx) {
+            self.open(Source::File(path));
+        }
+        if self.with_paint_parts(|document, paint| document.gesture_input(paint, ctx)) {
+            return;
+        }
+        for action in input::shortcuts(ctx, self.mode(), self.panels.file.dialog.is_some()) {
+            self.perform(action);
+        }
+    }
+
+    /// The side panel's sections: paint (with Optimize and undo), file (with the import
+    /// settings and autosave), view, scene. Each section's commands are applied after it.
+    fn side_panel_ui(&mut self, ui: &mut egui::Ui) {
+        let painting = self.mode() == Mode::Paint;
+        egui::CollapsingHeader::new("Paint").default_open(true).show(ui, |ui| {
+            let has_document = self.document.open.is_some();
+            let bounds_radius = self.document.open.as_ref().map(|d| d.bounds.radius);
+            let context = PaintPanelContext { painting, has_document, bounds_radius };
+            let mut chosen = self.panels.paint.ui(ui, context);
+            chosen.extend(self.panels.optimize.ui(ui, painting));
+            let last_stroke = self.document.paint.as_ref().map(|session| LastStroke {
+                samples_changed: session.stroke_samples_changed,
+                upload_bytes: session.stroke_upload_bytes,
+            });
+            chosen.extend(self.panels.undo.ui(ui, painting, &self.document.history, last_stroke));
+            self.apply_all(chosen);
+        });
+        egui::CollapsingHeader::new("File").default_open(true).show(ui, |ui| {
+            let (has_document, idle) = (self.document.open.is_some(), !self.jobs.is_busy());
+            let chosen = self.panels.file.ui(ui, has_document, idle);
+            self.panels.import.ui(ui, "Open meshes at:");
+            self.panels.autosave.settings_ui(ui);
+            self.apply_all(chosen);
+        });
+        egui::CollapsingHeader::new("View").default_open(true).show(ui, |ui| {
+            let context = ViewContext {
+                document: self.document.open.as_ref(),
+                gpu: self.gpu.as_deref(),
+                camera: self.camera,
+                level0_only: self.document.level0_only(),
+                viewport_px: self.viewport.size_px(),
+                scene_generation: self.viewport.scene_generation,
+                gpu_bytes: self.gpu_bytes(),
+                frame_ms: self.viewport.frame_stats.frame_ms,
+            };
+            let chosen = self.panels.view.ui(ui, &context);
+            self.apply_all(chosen);
+        });
+        egui::CollapsingHeader::new("Scene").default_open(true).show(ui, |ui| {
+            let context = SceneContext {
+                document: self.document.open.as_ref(),
+                gpu_bytes: self.gpu_bytes(),
+                upload_bytes_last_frame: self.viewport.upload_bytes_last_frame,
+                frame_stats: &self.viewport.frame_stats,
+                gpu_name: self.gpu.as_ref().map(|gpu| gpu.ctx.adapter_info.name.as_str()),
+            };
+            self.panels.scene.ui(ui, context);
+        });
+    }
+
+    /// The 3D view's area: its image, its input, and the brush cursor over it.
+    fn viewport_ui(&mut self, ui: &mut egui::Ui) {
+        let context = ViewportContext {
+            texture: self.viewport.texture,
+            showing: self.document.open.as_ref().is_some_and(|d| d.gpu_mesh.is_some()),
+            busy: self.jobs.is_busy(),
+            has_document: self.document.open.is_some(),
+            mode: self.mode(),
+        };
+        let (response, painter) = self.panels.viewport.ui(ui, context);
+        self.viewport.rect = response.rect;
+        self.viewport.pixels_per_point = ui.ctx().pixels_per_point();
+        self.viewport.pointer = response.hover_pos();
+        let dialog_open = self.panels.file.dialog.is_some();
+        if let Some(session) = self.document.paint.as_mut() {
+            let strokes = input::paint_input(ui, &response, session, dialog_open);
+            self.apply_all(strokes);
+            if self.document.is_stroking() {
+                ui.ctx().request_repaint();
+            }
+        }
+        let open = self.document.open.as_ref();
+        input::navigate(ui, &response, &mut self.camera, open, &self.viewport, &mut self.status);
+        if let Some(session) = &self.document.paint {
+            draw_brush_cursor(&painter, session, &self.panels.paint.brush, &self.viewport, &self.camera);
         }
     }
 }

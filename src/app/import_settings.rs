@@ -1,8 +1,11 @@
-//! How the editor gives an opened mesh its face resolutions: the choice in the open dialog
-//! (and the file panel), turned into one [`ResolutionRule`] of [`meshpaint_core::convert::adaptive`].
+//! The import settings panel: how the editor gives an opened mesh its face resolutions,
+//! the choice in the open dialog (and the file panel's section), turned into one
+//! [`ResolutionRule`] of [`meshpaint_core::convert::adaptive`].
 
 use meshpaint_core::colors::layout::Resolution;
 use meshpaint_core::convert::adaptive::ResolutionRule;
+
+use super::widgets::resolution_combo;
 
 /// The kinds of choice the open dialog offers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -61,7 +64,7 @@ impl ImportMode {
     }
 }
 
-/// The open dialog's resolution choice.
+/// The open dialog's resolution choice; the import settings panel ([`ImportSettings::ui`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImportSettings {
     /// Which rule.
@@ -118,38 +121,24 @@ impl ImportSettings {
                 .on_hover_text(self.mode.explanation());
             match self.mode {
                 ImportMode::Automatic | ImportMode::Uniform => {
-                    resolution_combo(ui, "R", "import R", &mut self.resolution)
+                    resolution_combo(ui, "R", &mut self.resolution);
                 }
-                ImportMode::MatchTexture => resolution_combo(ui, "R ≤", "import max R", &mut self.max_resolution),
+                ImportMode::MatchTexture => {
+                    resolution_combo(ui, "R ≤", &mut self.max_resolution);
+                }
                 ImportMode::ErrorBound => {
                     let label = ui.label("E");
                     ui.add(egui::DragValue::new(&mut self.error_bound).range(0.0..=1.0).speed(0.001).max_decimals(4))
                         .labelled_by(label.id);
-                    resolution_combo(ui, "R ≤", "import max R", &mut self.max_resolution);
+                    resolution_combo(ui, "R ≤", &mut self.max_resolution);
                 }
                 ImportMode::Budget => {
                     let label = ui.label("N");
                     ui.add(egui::DragValue::new(&mut self.sample_budget).range(1..=1u64 << 28).speed(1000.0))
                         .labelled_by(label.id);
-                    resolution_combo(ui, "R ≤", "import max R", &mut self.max_resolution);
+                    resolution_combo(ui, "R ≤", &mut self.max_resolution);
                 }
             }
         });
     }
-}
-
-/// A labelled combo of `R` = 1 … 64.
-fn resolution_combo(ui: &mut egui::Ui, label: &str, salt: &str, resolution: &mut Resolution) {
-    let label = ui.label(label);
-    egui::ComboBox::from_id_salt(salt)
-        .selected_text(resolution.get().to_string())
-        .show_ui(ui, |ui| {
-            for log2 in 0..=6 {
-                if let Ok(r) = Resolution::from_log2(log2) {
-                    ui.selectable_value(resolution, r, r.get().to_string());
-                }
-            }
-        })
-        .response
-        .labelled_by(label.id);
 }

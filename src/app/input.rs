@@ -1,18 +1,23 @@
 //! All input handling in one place: keyboard shortcuts ([`SHORTCUTS`], also the help
-//! window's table) and the 3D view's pointer (camera navigation with Blender's habits).
+//! window's table), dropped files, and the 3D view's pointer: camera navigation with
+//! Blender's habits ([`navigate`], [`frame_all`], [`frame_under`]) and, in paint mode, the
+//! brush ([`paint_input`]).
 //!
 //! Input arrives through egui (egui-winit translates the window's events), so the same
-//! code runs in the window and under egui_kittest. A later paint mode adds its tools in
-//! [`viewport_input`], keyed on [`super::editor::Mode`].
+//! code runs in the window and under egui_kittest. What input asks of the editor comes back
+//! as [`Action`]s and [`Command`]s; the camera it moves directly.
+
+use std::path::PathBuf;
 
 use egui::{Key, Modifiers, PointerButton};
+use glam::DVec3;
 
-use meshpaint_render::{FilterMode, Shading};
+use meshpaint_core::camera::{BoundingSphere, OrbitCamera};
 
-use super::editor::Editor;
-use super::file_dialog::DialogPurpose;
-use super::paint_session::GestureKind;
-use super::state::{Action, Mode};
+use super::command::Command;
+use super::document::OpenDocument;
+use super::paint_session::PaintSession;
+use super::state::{Action, Mode, Severity, Status, ViewportState};
 
 /// In which mode a shortcut works.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -157,66 +162,15 @@ pub fn shortcut_text(action: Action) -> Option<&'static str> {
     SHORTCUTS.iter().find(|s| s.action == action).map(|s| s.keys)
 }
 
-/// Carries out `action` on `editor`: the one place every menu entry and shortcut ends.
-pub fn perform(editor: &mut Editor, action: Action) {
-    match action {
-        Action::Open => editor.open_dialog(DialogPurpose::Open),
-        Action::Save => match editor.document.as_ref().and_then(|d| Some((d.project_path.clone()?, d.format))) {
-            Some((path, format)) => editor.save_to(path, format),
-            None => editor.open_dialog(DialogPurpose::SaveAs),
-        },
-        Action::SaveAs => editor.open_dialog(DialogPurpose::SaveAs),
-        Action::ExportGltf => editor.open_dialog(DialogPurpose::ExportGltf),
-        Action::ExportPacked => editor.open_dialog(DialogPurpose::ExportPacked),
-        Action::FrameAll => editor.frame_all(),
-        Action::FrameUnderCursor => {
-            if let Some(pos) = editor.viewport_pointer {
-                editor.frame_under(pos);
-            }
-        }
-        Action::ViewFront => editor.set_view_angles(0.0, 0.0),
-        Action::ViewBack => editor.set_view_angles(180.0, 0.0),
-        Action::ViewRight => editor.set_view_angles(90.0, 0.0),
-        Action::ViewLeft => editor.set_view_angles(-90.0, 0.0),
-        Action::ViewTop => editor.set_view_angles(0.0, 89.0),
-        Action::ViewBottom => editor.set_view_angles(0.0, -89.0),
-        Action::ToggleWireframe => editor.view.overlays.wireframe = !editor.view.overlays.wireframe,
-        Action::ToggleHeatmap => editor.view.overlays.heatmap = !editor.view.overlays.heatmap,
-        Action::ToggleShading => {
-            editor.view.shading = match editor.view.shading {
-                Shading::Lit | Shading::Smooth => Shading::Unlit,
-                Shading::Unlit => Shading::Smooth,
-            }
-        }
-        Action::CycleFilter => {
-            editor.view.filter = match editor.view.filter {
-                FilterMode::Nearest | FilterMode::NearestMipLevel(_) => FilterMode::Linear,
-                FilterMode::Linear | FilterMode::MipLevel(_) => FilterMode::Trilinear,
-                FilterMode::Trilinear => FilterMode::Nearest,
-            }
-        }
-        Action::ToggleHelp => editor.show_help = !editor.show_help,
-        Action::Quit => editor.quit_requested = true,
-        Action::TogglePaintMode => editor.toggle_paint_mode(),
-        Action::Undo => editor.undo(),
-        Action::Redo => editor.redo(),
-        Action::Eyedropper => editor.eyedropper(),
-        Action::RadiusGesture => editor.start_gesture(GestureKind::Radius),
-        Action::StrengthGesture => editor.start_gesture(GestureKind::Strength),
-    }
+/// The first file dropped on the window this frame, if any.
+pub fn dropped_file(ctx: &egui::Context) -> Option<PathBuf> {
+    ctx.input(|i| i.raw.dropped_files.first().map(|file| file.path().to_owned()))
 }
 
-/// Keyboard shortcuts and dropped files, for the whole window. Keys go to a focused text
-/// field (the file dialog) rather than to shortcuts; F1 always works.
-pub fn global_input(editor: &mut Editor, ctx: &egui::Context) {
-    let dropped: Vec<std::path::PathBuf> =
-        ctx.input(|i| i.raw.dropped_files.iter().map(|file| file.path().to_owned()).collect());
-    if let Some(path) = dropped.into_iter().next() {
-        editor.open(meshpaint_core::io::document::Source::File(path));
-    }
-    if editor.gesture_input(ctx) {
-        return;
-    }
+/// The shortcuts pressed this frame that work in `mode` (consumed from the input). Keys go
+/// to a focused text field (the file dialog) rather than to shortcuts; F1 always works;
+/// while a dialog is open (`dialog_open`) only the help and Quit do.
+pub fn shortcuts(ctx: &egui::Context, mode: Mode, dialog_open: bool) -> Vec<Action> {
     // Only a text field keeps keys from the shortcuts (Tab may have focused a button).
     let typing = ctx.text_edit_focused();
     if !typing && let Some(id) = ctx.memory(|m| m.focused()) {
@@ -227,28 +181,31 @@ pub fn global_input(editor: &mut Editor, ctx: &egui::Context) {
         if typing && shortcut.key != Key::F1 {
             continue;
         }
-        if !shortcut.scope.includes(editor.mode) {
+        if !shortcut.scope.includes(mode) {
             continue;
         }
-        if editor.dialog.is_some() && !matches!(shortcut.action, Action::ToggleHelp | Action::Quit) {
+        if dialog_open && !matches!(shortcut.action, Action::ToggleHelp | Action::Quit) {
             continue;
         }
         if ctx.input_mut(|i| i.consume_key(shortcut.modifiers, shortcut.key)) {
             actions.push(shortcut.action);
         }
     }
-    for action in actions {
-        perform(editor, action);
-    }
+    actions
 }
 
-/// Navigation in the 3D view from `response` (the view's area, sensing clicks and drags).
-pub fn viewport_input(editor: &mut Editor, ui: &egui::Ui, response: &egui::Response) {
-    editor.viewport_pointer = response.hover_pos();
+/// Navigation in the 3D view from `response` (the view's area, sensing clicks and drags):
+/// orbit, pan and zoom `camera`; Alt + middle click frames the surface of `document` under
+/// the pointer (a miss is reported on `status`).
+pub fn navigate(
+    ui: &egui::Ui,
+    response: &egui::Response,
+    camera: &mut OrbitCamera,
+    document: Option<&OpenDocument>,
+    viewport: &ViewportState,
+    status: &mut Status,
+) {
     let modifiers = ui.input(|i| i.modifiers);
-    if editor.mode == Mode::Paint {
-        paint_input(editor, ui, response, modifiers);
-    }
     let height = f64::from(response.rect.height().max(1.0));
     let navigating =
         response.dragged_by(PointerButton::Middle) || (modifiers.alt && response.dragged_by(PointerButton::Primary));
@@ -257,11 +214,11 @@ pub fn viewport_input(editor: &mut Editor, ui: &egui::Ui, response: &egui::Respo
         let delta = response.drag_delta();
         let (dx, dy) = (f64::from(delta.x), f64::from(delta.y));
         if modifiers.shift {
-            editor.camera.pan_pixels(dx, dy, height);
+            camera.pan_pixels(dx, dy, height);
         } else if modifiers.ctrl || modifiers.command {
-            editor.camera.zoom((dy * 0.01).exp());
+            camera.zoom((dy * 0.01).exp());
         } else {
-            editor.camera.orbit(-dx * ORBIT_DEGREES_PER_POINT, dy * ORBIT_DEGREES_PER_POINT);
+            camera.orbit(-dx * ORBIT_DEGREES_PER_POINT, dy * ORBIT_DEGREES_PER_POINT);
         }
         moved = delta != egui::Vec2::ZERO;
     }
@@ -269,7 +226,7 @@ pub fn viewport_input(editor: &mut Editor, ui: &egui::Ui, response: &egui::Respo
         && response.clicked_by(PointerButton::Middle)
         && let Some(pos) = response.interact_pointer_pos()
     {
-        editor.frame_under(pos);
+        frame_under(camera, document, viewport, pos, status);
     }
     if response.hovered() {
         let lines: f32 = ui.input(|i| {
@@ -287,48 +244,97 @@ pub fn viewport_input(editor: &mut Editor, ui: &egui::Ui, response: &egui::Respo
         });
         let pinch = ui.input(|i| i.zoom_delta());
         if lines != 0.0 {
-            editor.camera.zoom(ZOOM_PER_WHEEL_LINE.powf(f64::from(lines)));
+            camera.zoom(ZOOM_PER_WHEEL_LINE.powf(f64::from(lines)));
             moved = true;
         }
         if pinch != 1.0 && pinch.is_finite() && pinch > 0.0 {
-            editor.camera.zoom(1.0 / f64::from(pinch));
+            camera.zoom(1.0 / f64::from(pinch));
             moved = true;
         }
     }
-    if moved && let Some(open) = &editor.document {
-        editor.camera.fit_depth_to(open.bounds);
+    if moved && let Some(open) = document {
+        camera.fit_depth_to(open.bounds);
     }
 }
 
 /// The brush in paint mode: the left button paints (not with Alt, which navigates).
-fn paint_input(editor: &mut Editor, ui: &egui::Ui, response: &egui::Response, modifiers: Modifiers) {
-    let (pressed, down, latest) =
-        ui.input(|i| (i.pointer.primary_pressed(), i.pointer.primary_down(), i.pointer.latest_pos()));
-    let Some(session) = editor.paint.as_mut() else {
-        return;
-    };
+/// Records the pointer in `session`; returns the stroke's commands. Nothing paints while a
+/// gesture runs or a dialog is open (`dialog_open`).
+pub fn paint_input(
+    ui: &egui::Ui,
+    response: &egui::Response,
+    session: &mut PaintSession,
+    dialog_open: bool,
+) -> Vec<Command> {
+    let (pressed, down, latest, alt) =
+        ui.input(|i| (i.pointer.primary_pressed(), i.pointer.primary_down(), i.pointer.latest_pos(), i.modifiers.alt));
     if let Some(pos) = response.hover_pos() {
         session.last_pointer = Some(pos);
     }
     if session.swallow_primary {
         session.swallow_primary = down;
-        return;
+        return Vec::new();
     }
-    if session.gesture.is_some() || editor.dialog.is_some() {
-        return;
+    if session.gesture.is_some() || dialog_open {
+        return Vec::new();
     }
+    let mut commands = Vec::new();
     let stroking = session.painter.is_stroking();
-    if !stroking && pressed && !modifiers.alt && response.hovered() {
+    if !stroking && pressed && !alt && response.hovered() {
         if let Some(pos) = latest {
-            editor.begin_stroke(pos);
+            commands.push(Command::BeginStroke(pos));
         }
     } else if stroking && let Some(pos) = latest {
-        editor.stroke_to(pos);
+        commands.push(Command::StrokeTo(pos));
     }
     if !down {
-        editor.end_stroke();
+        commands.push(Command::EndStroke);
     }
-    if editor.paint.as_ref().is_some_and(|p| p.painter.is_stroking()) {
-        ui.ctx().request_repaint();
+    commands
+}
+
+/// Frames the whole of `bounds` with `camera`, keeping the viewing angles; the sphere fits
+/// the narrower of the 3D view's two fields of view.
+pub fn frame_all(camera: &mut OrbitCamera, bounds: BoundingSphere, viewport: &ViewportState) {
+    let (yaw, pitch) = (camera.yaw_degrees, camera.pitch_degrees);
+    let mut framed = OrbitCamera::framing(bounds, yaw, pitch);
+    let [w, h] = viewport.size_px();
+    let aspect = f64::from(w) / f64::from(h.max(1));
+    if aspect < 1.0 {
+        let half_y = (framed.fov_y_degrees.to_radians() * 0.5).tan();
+        let half_x = (half_y * aspect).atan();
+        framed.distance = bounds.radius / half_x.sin() * 1.1;
     }
+    *camera = framed;
+}
+
+/// Centres `camera` on the surface point of `document` under `pos` (points, window
+/// coordinates) and halves the distance to it. Reports a miss on `status`.
+pub fn frame_under(
+    camera: &mut OrbitCamera,
+    document: Option<&OpenDocument>,
+    viewport: &ViewportState,
+    pos: egui::Pos2,
+    status: &mut Status,
+) {
+    let Some((open, hit)) = document.and_then(|open| Some((open, pick(open, camera, viewport, pos)?))) else {
+        status.set(Severity::Info, "Nothing under the cursor to frame.");
+        return;
+    };
+    let distance = (camera.eye() - hit).length() * 0.5;
+    camera.look_at_point(hit, distance);
+    camera.fit_depth_to(open.bounds);
+}
+
+/// The surface point of `open` under `pos` (points, window coordinates) seen through
+/// `camera`, if the ray hits the mesh.
+pub fn pick(open: &OpenDocument, camera: &OrbitCamera, viewport: &ViewportState, pos: egui::Pos2) -> Option<DVec3> {
+    if !viewport.rect.contains(pos) {
+        return None;
+    }
+    let [x, y] = viewport.view_px(pos);
+    let [w, h] = viewport.size_px();
+    let (origin, direction) = camera.ray_through_pixel(x, y, w, h);
+    let hit = open.bvh.cast(origin, direction, f64::INFINITY)?;
+    Some(DVec3::from_array(hit.position_world))
 }

@@ -3,40 +3,47 @@
 //! `meshpaint` with no argument opens the built-in Duck, `meshpaint FILE` opens FILE.
 //! This module is the shell where the library, egui, winit and wgpu meet:
 //!
-//! The files form layers; each uses only the layers below it (`tests/architecture.rs`
-//! checks that no two files import each other):
+//! The files form layers; each uses only the layers below it (`tests/app/architecture.rs`
+//! checks that no two files import each other). Panels and input never reach into the
+//! editor: they get what they read as arguments and return [`Action`]s and
+//! [`Command`](command::Command)s, which the editor carries out in one place.
 //!
 //! | layer | file | role |
 //! |---|---|---|
-//! | 5 | [`window`] | winit event loop, surface, egui-winit / egui-wgpu, offscreen 3D view, redraw scheduling |
-//! | 4 | [`input`] | all input: shortcuts ([`input::SHORTCUTS`]), 3D-view navigation, [`input::perform`] (every [`Action`]) |
-//! | 3 | [`panels`], [`paint`], [`optimize_ui`], [`autosave_ui`] | the `*_ui` panels; paint-mode commands (strokes, live GPU upload, undo / redo, tool panel); Optimize on a worker thread; autosave tick and recovery dialog |
-//! | 2 | [`editor`] | the editor: document, camera, view settings, mode, status, jobs (applied by [`jobs::JobKind`]) |
-//! | 1 | [`document`], [`autosave`], [`paint_session`] | the open document (store and GPU mesh side by side; open, save, export work); autosave state; paint-mode state |
-//! | 0 | [`state`], [`jobs`], [`text`], [`file_dialog`], [`import_settings`] | shared small types and [`Action`]s; one background job at a time with progress; number / error text; an egui file browser; the open dialog's resolution choice |
+//! | 6 | [`window`] | winit event loop, surface, egui-winit / egui-wgpu, offscreen 3D view, redraw scheduling |
+//! | 5 | [`editor`] | [`Editor`]: the document, camera, panels, 3D view state, status, jobs; one frame of UI ([`Editor::ui`]); every [`Action`] ([`Editor::perform`]) and [`command::Command`] ([`Editor::apply`]) carried out; finished jobs applied by [`jobs::JobKind`] |
+//! | 4 | [`paint`] | paint-mode commands on the document: strokes, live GPU upload, undo / redo, eyedropper, fill, resolution, Optimize, radius / strength gestures, brush cursor |
+//! | 3 | [`panels`], [`job_output`] | each panel a type that owns its state and draws itself, returning commands (menu, status line, file, import settings, autosave, view, paint, optimize, undo, scene, help, 3D view area); what jobs produce |
+//! | 2 | [`session`], [`input`], [`autosave`], [`file_dialog`] | the document being edited ([`session::DocumentState`]: open document, paint session, undo history); all input (shortcuts [`input::SHORTCUTS`], 3D-view navigation, the brush's pointer); autosave state; an egui file browser |
+//! | 1 | [`document`], [`command`], [`import_settings`] | the open document (store and GPU mesh side by side; open, save, export work); the commands panels return; the import settings panel (the open dialog's resolution choice) |
+//! | 0 | [`state`], [`jobs`], [`text`], [`widgets`], [`paint_session`] | shared small types and [`Action`]s; one background job at a time with progress; number / error text; the resolution combo box; paint-mode state |
 //!
 //! Paint mode is [`Mode::Paint`] (Tab, [`input::SHORTCUTS`]): its tools get the pointer in
-//! [`input::viewport_input`], edit the store through `Arc::make_mut` on
+//! [`input::paint_input`], edit the store through `Arc::make_mut` on
 //! [`document::OpenDocument::document`] (jobs hold their own snapshot), upload dirty samples
 //! with `GpuMesh::write_samples` on the document's `gpu_mesh`, bump
-//! [`Editor::scene_generation`] so the view redraws, and repack when the mode is left.
+//! [`state::ViewportState::scene_generation`] so the view redraws, and repack when the mode
+//! is left.
 
 pub mod autosave;
-pub mod autosave_ui;
+pub mod command;
 pub mod document;
 pub mod editor;
 pub mod file_dialog;
 pub mod import_settings;
 pub mod input;
+pub mod job_output;
 pub mod jobs;
-pub mod optimize_ui;
 pub mod paint;
 pub mod paint_session;
 pub mod panels;
+pub mod session;
 pub mod state;
 pub mod text;
+pub mod widgets;
 pub mod window;
 
+pub use command::Command;
 pub use editor::Editor;
 pub use state::{Action, Mode, Severity};
 pub use window::{AppOptions, run};

@@ -1,54 +1,71 @@
-//! Paint mode: the session state (brush, paint layout, base snapshot), strokes from the
-//! pointer, the live GPU upload after every dab, undo / redo, eyedropper, fill, resolution
-//! commands, the interactive radius / strength gestures (F / Shift+F), the tool panel and
-//! the brush cursor.
+//! Paint mode's commands on the document ([`DocumentState`]): entering and leaving it,
+//! strokes from the pointer, the live GPU upload after every dab, undo / redo, eyedropper,
+//! fill, resolution commands, Optimize, the interactive radius / strength gestures
+//! (F / Shift+F) and the brush cursor. The brush settings and the tool panel are the paint
+//! panel's (`panels::paint`); what the commands need besides the document comes in a
+//! [`PaintContext`].
 //!
 //! Entering paint mode switches the GPU mesh to the paint layout
 //! ([`meshpaint_core::packing::paint_layout::PaintLayout`], level 0 only); leaving repacks the store into the
-//! compact layout with MIP chains on a worker thread ([`Editor::leave_paint_mode`]).
+//! compact layout with MIP chains on a worker thread ([`DocumentState::leave_paint_mode`]).
+//! Optimize plans on a worker thread too (`paint::optimize::plan`); its changes are applied
+//! as one undo step when it is done, if the colours did not change meanwhile.
 
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
+use meshpaint_core::camera::OrbitCamera;
+use meshpaint_core::colors::budget::Budget;
 use meshpaint_core::colors::layout::Resolution;
 use meshpaint_core::colors::store::{ColorStore, DirtyAccumulator};
 use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::packing::paint_layout::PaintLayout;
-use meshpaint_core::paint::brush::{
-    self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, ResolutionOp, StrokeUpdate,
-    Tool,
-};
+use meshpaint_core::paint::brush::{self, BrushRadius, BrushSettings, FillScope, PaintView, Painter, StrokeUpdate};
+use meshpaint_core::paint::optimize;
 use meshpaint_core::paint::undo::UndoHistory;
+use meshpaint_render::Gpu;
 
-use super::editor::{Editor, JobOutput};
-use super::jobs::JobKind;
+use super::job_output::{JobOutput, Optimized};
+use super::jobs::{JobKind, Jobs};
 use super::paint_session::{Gesture, GestureKind, PaintSession, Repack, Repacked, STRENGTH_GESTURE_POINTS};
-use super::state::{Mode, Severity};
+use super::session::DocumentState;
+use super::state::{Mode, Severity, Status, ViewportState};
 use super::text::{human_bytes, thousands};
 
-/// The egui colour of a linear straight-alpha colour.
-fn to_egui(color: [f32; 4]) -> egui::Rgba {
-    egui::Rgba::from_rgba_unmultiplied(color[0], color[1], color[2], color[3])
+/// What paint mode's commands use besides the document: the GPU, the view, the brush, the
+/// status line and the job runner (the editor lends them).
+pub struct PaintContext<'a> {
+    /// GPU objects (`None` in UI tests without a GPU).
+    pub gpu: Option<&'a Arc<Gpu>>,
+    /// The camera of the 3D view.
+    pub camera: &'a OrbitCamera,
+    /// The 3D view: its area and pointer; uploads and scene changes are counted here.
+    pub viewport: &'a mut ViewportState,
+    /// The brush settings (the paint panel's).
+    pub brush: &'a mut BrushSettings,
+    /// The status line.
+    pub status: &'a mut Status,
+    /// Background work (repack, Optimize).
+    pub jobs: &'a mut Jobs<JobOutput>,
 }
 
-impl Editor {
+impl DocumentState {
     /// Tab: enters or leaves paint mode.
-    pub fn toggle_paint_mode(&mut self) {
-        match self.mode {
-            Mode::View => self.enter_paint_mode(),
-            Mode::Paint => self.leave_paint_mode(),
+    pub fn toggle_paint_mode(&mut self, ctx: &mut PaintContext<'_>, budget: Budget) {
+        match self.mode() {
+            Mode::View => self.enter_paint_mode(ctx, budget),
+            Mode::Paint => self.leave_paint_mode(ctx),
         }
     }
 
     /// Enters paint mode: snapshots the base colours, builds the paint layout and uploads it.
-    pub fn enter_paint_mode(&mut self) {
-        if self.jobs.is_busy() {
-            self.set_status(Severity::Warning, "Busy: wait for the running job to finish before painting.");
+    pub fn enter_paint_mode(&mut self, ctx: &mut PaintContext<'_>, budget: Budget) {
+        if ctx.jobs.is_busy() {
+            ctx.status.set(Severity::Warning, "Busy: wait for the running job to finish before painting.");
             return;
         }
-        let budget = self.budget();
-        let Some(open) = self.document.as_mut() else {
-            self.set_status(Severity::Error, "Nothing to paint: no document is open.");
+        let Some(open) = self.open.as_mut() else {
+            ctx.status.set(Severity::Error, "Nothing to paint: no document is open.");
             return;
         };
         let started = Instant::now();
@@ -58,23 +75,23 @@ impl Editor {
         let unpacked_changes = !document.store.take_dirty().is_empty();
         let layout = PaintLayout::new(&document.store);
         let (mut compact_gpu_mesh, mut encoded) = (None, None);
-        if let Some(gpu) = &self.gpu {
+        if let Some(gpu) = ctx.gpu {
             match gpu.upload_paint_layout(&layout, &document.store, &document.positions, open.format) {
                 Ok(upload) => {
-                    self.upload_bytes_this_frame += upload.bytes;
+                    ctx.viewport.upload_bytes_this_frame += upload.bytes;
                     compact_gpu_mesh = open.gpu_mesh.replace(upload.mesh);
                     encoded = Some(upload.encoded);
                 }
                 Err(error) => {
                     let text = format!("Cannot enter paint mode: uploading the paint layout failed: {error}");
-                    self.set_status(Severity::Error, text);
+                    ctx.status.set(Severity::Error, text);
                     return;
                 }
             }
         }
         let painter = {
             let mut painter = Painter::new(&document.positions);
-            painter.set_settings(self.brush);
+            painter.set_settings(*ctx.brush);
             painter.set_budget(Some((budget, open.format)));
             painter
         };
@@ -94,23 +111,21 @@ impl Editor {
             repack_dirty: DirtyAccumulator::new(document.store.topology()),
         });
         self.gpu_paint_layout = true;
-        self.mode = Mode::Paint;
-        self.scene_generation += 1;
+        ctx.viewport.scene_generation += 1;
         let ms = started.elapsed().as_secs_f64() * 1000.0;
-        self.set_status(Severity::Info, format!("Paint mode (level 0 on the GPU, set up in {ms:.0} ms). Tab leaves."));
+        ctx.status.set(Severity::Info, format!("Paint mode (level 0 on the GPU, set up in {ms:.0} ms). Tab leaves."));
     }
 
     /// Leaves paint mode: repacks the store into compact buffers with MIP chains on a worker
     /// thread (the status line shows its progress) and replaces the GPU buffers when done.
-    pub fn leave_paint_mode(&mut self) {
-        if self.jobs.is_busy() {
-            self.set_status(Severity::Warning, "Busy: wait for the running job to finish before leaving paint mode.");
+    pub fn leave_paint_mode(&mut self, ctx: &mut PaintContext<'_>) {
+        if ctx.jobs.is_busy() {
+            ctx.status.set(Severity::Warning, "Busy: wait for the running job to finish before leaving paint mode.");
             return;
         }
-        self.end_stroke();
+        self.end_stroke(ctx);
         let session = self.paint.take();
-        self.mode = Mode::View;
-        let Some(open) = &self.document else {
+        let Some(open) = &self.open else {
             return;
         };
         let (cache, mut dirty, compact_gpu_mesh) = match session {
@@ -119,8 +134,8 @@ impl Editor {
         };
         let document = Arc::clone(&open.document);
         let format = open.format;
-        let gpu = self.gpu.clone();
-        let started = self.jobs.start(JobKind::Repack, "Repacking", move |job| {
+        let gpu = ctx.gpu.cloned();
+        let started = ctx.jobs.start(JobKind::Repack, "Repacking", move |job| {
             job.progress(0.1, "packing colours with MIP chains");
             let started = Instant::now();
             let dirty = dirty.take();
@@ -165,38 +180,32 @@ impl Editor {
             })))
         });
         match started {
-            Ok(()) => self.set_status(Severity::Info, "Repacking…"),
-            Err(message) => self.set_status(Severity::Error, message),
+            Ok(()) => ctx.status.set(Severity::Info, "Repacking…"),
+            Err(message) => ctx.status.set(Severity::Error, message),
         }
-    }
-
-    /// Pixel coordinates in the 3D view of `pos` (points, window coordinates).
-    fn view_px(&self, pos: egui::Pos2) -> [f64; 2] {
-        let ppp = f64::from(self.viewport.pixels_per_point);
-        let rect = self.viewport.rect;
-        [f64::from(pos.x - rect.min.x) * ppp, f64::from(pos.y - rect.min.y) * ppp]
     }
 
     /// Runs `work` with the paint view, the store, the painter and the history; uploads the
     /// changes afterwards.
     pub(crate) fn with_paint<T>(
         &mut self,
+        ctx: &mut PaintContext<'_>,
         work: impl FnOnce(&PaintView, &mut ColorStore, &mut Painter, &mut UndoHistory) -> T,
     ) -> Option<T> {
-        let viewport_px = self.viewport.size_px();
-        let Editor { document, paint, history, camera, .. } = self;
-        let (open, session) = (document.as_mut()?, paint.as_mut()?);
+        let viewport_px = ctx.viewport.size_px();
+        let DocumentState { open, paint, history, .. } = self;
+        let (open, session) = (open.as_mut()?, paint.as_mut()?);
         let doc = Arc::make_mut(&mut open.document);
         let PaintSession { base, painter, .. } = session;
         let view =
-            PaintView { positions: &doc.positions, bvh: &open.bvh, camera: &*camera, viewport_px, base: Some(base) };
+            PaintView { positions: &doc.positions, bvh: &open.bvh, camera: ctx.camera, viewport_px, base: Some(base) };
         let result = work(&view, &mut doc.store, painter, history);
-        self.sync_gpu();
+        self.sync_gpu(ctx);
         Some(result)
     }
 
     /// Counts a stroke update; reports brush errors.
-    fn stroke_result(&mut self, result: Option<Result<StrokeUpdate, brush::BrushError>>) {
+    fn stroke_result(&mut self, ctx: &mut PaintContext<'_>, result: Option<Result<StrokeUpdate, brush::BrushError>>) {
         match result {
             Some(Ok(update)) => {
                 if let Some(session) = self.paint.as_mut() {
@@ -207,36 +216,37 @@ impl Editor {
                 }
             }
             Some(Err(error)) => {
-                self.end_stroke();
-                self.set_status(Severity::Error, format!("Brush: {error}"));
+                self.end_stroke(ctx);
+                ctx.status.set(Severity::Error, format!("Brush: {error}"));
             }
             None => {}
         }
     }
 
     /// Starts a stroke at `pos` (points).
-    pub fn begin_stroke(&mut self, pos: egui::Pos2) {
-        let px = self.view_px(pos);
-        let settings = self.brush;
+    pub fn begin_stroke(&mut self, ctx: &mut PaintContext<'_>, pos: egui::Pos2) {
+        let px = ctx.viewport.view_px(pos);
+        let settings = *ctx.brush;
         if let Some(session) = self.paint.as_mut() {
             session.painter.set_settings(settings);
             session.stroke_upload_bytes = 0;
             session.stroke_samples_changed = 0;
         }
-        let result = self.with_paint(|view, store, painter, history| painter.begin_stroke(view, store, history, px));
-        self.stroke_result(result);
+        let result =
+            self.with_paint(ctx, |view, store, painter, history| painter.begin_stroke(view, store, history, px));
+        self.stroke_result(ctx, result);
     }
 
     /// Extends the stroke to `pos` (points).
-    pub fn stroke_to(&mut self, pos: egui::Pos2) {
-        let px = self.view_px(pos);
-        let result = self.with_paint(|view, store, painter, history| painter.stroke_to(view, store, history, px));
-        self.stroke_result(result);
+    pub fn stroke_to(&mut self, ctx: &mut PaintContext<'_>, pos: egui::Pos2) {
+        let px = ctx.viewport.view_px(pos);
+        let result = self.with_paint(ctx, |view, store, painter, history| painter.stroke_to(view, store, history, px));
+        self.stroke_result(ctx, result);
     }
 
     /// Ends the stroke (closes its undo step).
-    pub fn end_stroke(&mut self) {
-        let Editor { paint, history, .. } = self;
+    pub fn end_stroke(&mut self, ctx: &mut PaintContext<'_>) {
+        let DocumentState { paint, history, .. } = self;
         let Some(session) = paint.as_mut() else {
             return;
         };
@@ -247,7 +257,7 @@ impl Editor {
         let (bytes, changed) = (session.stroke_upload_bytes, session.stroke_samples_changed);
         if let Some(summary) = summary {
             let kept = if summary.kept { "" } else { " (too large for the undo memory cap: not undoable)" };
-            self.set_status(
+            ctx.status.set(
                 Severity::Info,
                 format!(
                     "{}: {} sample updates, {} uploaded{kept}",
@@ -261,9 +271,9 @@ impl Editor {
 
     /// Uploads what changed in the store since the last call: the dirty blocks of the paint
     /// layout and the changed face records, or everything when the layout grew.
-    pub fn sync_gpu(&mut self) {
-        let Editor { document, paint, gpu, .. } = self;
-        let (Some(open), Some(session)) = (document.as_mut(), paint.as_mut()) else {
+    pub fn sync_gpu(&mut self, ctx: &mut PaintContext<'_>) {
+        let DocumentState { open, paint, .. } = self;
+        let (Some(open), Some(session)) = (open.as_mut(), paint.as_mut()) else {
             return;
         };
         let doc = Arc::make_mut(&mut open.document);
@@ -278,7 +288,7 @@ impl Editor {
         let plan = session.layout.sync(&doc.store, &dirty);
         let mut bytes = 0u64;
         let mut error = None;
-        if let (Some(gpu), Some(mesh)) = (gpu.as_ref(), open.gpu_mesh.as_mut()) {
+        if let (Some(gpu), Some(mesh)) = (ctx.gpu, open.gpu_mesh.as_mut()) {
             match session.encoded.as_mut() {
                 Some(encoded) if !plan.grown && encoded.format() == open.format => {
                     let spans = encoded.apply(&session.layout, &doc.store, &dirty, &plan);
@@ -299,11 +309,11 @@ impl Editor {
             }
         }
         session.stroke_upload_bytes += bytes;
-        self.upload_bytes_this_frame += bytes;
-        self.scene_generation += 1;
+        ctx.viewport.upload_bytes_this_frame += bytes;
+        ctx.viewport.scene_generation += 1;
         if let Some(error) = error {
             session.upload_failed = true;
-            self.set_status(
+            ctx.status.set(
                 Severity::Error,
                 format!("Uploading the painted samples failed: {error}. The view shows the colours before; leave paint mode (Tab) to upload them again."),
             );
@@ -311,113 +321,110 @@ impl Editor {
     }
 
     /// Ctrl+Z: undoes the last stroke (paint mode only).
-    pub fn undo(&mut self) {
-        self.undo_redo(true);
+    pub fn undo(&mut self, ctx: &mut PaintContext<'_>) {
+        self.undo_redo(ctx, true);
     }
 
     /// Ctrl+Shift+Z: redoes the last undone stroke (paint mode only).
-    pub fn redo(&mut self) {
-        self.undo_redo(false);
+    pub fn redo(&mut self, ctx: &mut PaintContext<'_>) {
+        self.undo_redo(ctx, false);
     }
 
-    fn undo_redo(&mut self, undo: bool) {
-        if self.mode != Mode::Paint {
-            self.set_status(Severity::Info, "Undo and redo work in paint mode (Tab).");
+    fn undo_redo(&mut self, ctx: &mut PaintContext<'_>, undo: bool) {
+        if self.mode() != Mode::Paint {
+            ctx.status.set(Severity::Info, "Undo and redo work in paint mode (Tab).");
             return;
         }
-        self.end_stroke();
+        self.end_stroke(ctx);
         let label = if undo { self.history.undo_label() } else { self.history.redo_label() }.map(str::to_owned);
         let result =
-            self.with_paint(|_, store, _, history| if undo { history.undo(store) } else { history.redo(store) });
+            self.with_paint(ctx, |_, store, _, history| if undo { history.undo(store) } else { history.redo(store) });
         let verb = if undo { "Undo" } else { "Redo" };
         match result {
             Some(Ok(true)) => {
                 self.edit_generation += 1;
-                self.set_status(Severity::Info, format!("{verb}: {}", label.unwrap_or_default()));
+                ctx.status.set(Severity::Info, format!("{verb}: {}", label.unwrap_or_default()));
             }
-            Some(Ok(false)) => self.set_status(Severity::Info, format!("Nothing to {}.", verb.to_lowercase())),
-            Some(Err(error)) => self.set_status(Severity::Error, format!("{verb} failed: {error}")),
+            Some(Ok(false)) => ctx.status.set(Severity::Info, format!("Nothing to {}.", verb.to_lowercase())),
+            Some(Err(error)) => ctx.status.set(Severity::Error, format!("{verb} failed: {error}")),
             None => {}
         }
     }
 
     /// S: picks the colour under the pointer into the brush.
-    pub fn eyedropper(&mut self) {
-        let Some(pos) = self.viewport_pointer.or_else(|| self.paint.as_ref().and_then(|p| p.last_pointer)) else {
+    pub fn eyedropper(&mut self, ctx: &mut PaintContext<'_>) {
+        let Some(pos) = ctx.viewport.pointer.or_else(|| self.paint.as_ref().and_then(|p| p.last_pointer)) else {
             return;
         };
-        let px = self.view_px(pos);
-        let picked = self.with_paint(|view, store, _, _| brush::eyedropper(view, store, px)).flatten();
+        let px = ctx.viewport.view_px(pos);
+        let picked = self.with_paint(ctx, |view, store, _, _| brush::eyedropper(view, store, px)).flatten();
         match picked {
             Some(color) => {
-                self.brush.color = color;
+                ctx.brush.color = color;
                 let [r, g, b, _] = color.map(meshpaint_core::colors::format::encode_srgb8);
-                self.set_status(Severity::Info, format!("Picked colour #{r:02x}{g:02x}{b:02x}"));
+                ctx.status.set(Severity::Info, format!("Picked colour #{r:02x}{g:02x}{b:02x}"));
             }
-            None => self.set_status(Severity::Info, "Eyedropper: nothing under the cursor."),
+            None => ctx.status.set(Severity::Info, "Eyedropper: nothing under the cursor."),
         }
     }
 
     /// Fills the whole mesh, or the part connected to the face last under the pointer.
-    pub fn fill(&mut self, connected: bool) {
+    pub fn fill(&mut self, ctx: &mut PaintContext<'_>, connected: bool) {
         let scope = if connected {
             let pos = self.paint.as_ref().and_then(|p| p.last_pointer);
             let face = pos.and_then(|pos| {
-                let px = self.view_px(pos);
-                self.with_paint(|view, _, _, _| view.pick(px)).flatten().map(|hit| hit.face)
+                let px = ctx.viewport.view_px(pos);
+                self.with_paint(ctx, |view, _, _, _| view.pick(px)).flatten().map(|hit| hit.face)
             });
             match face {
                 Some(face) => FillScope::Connected { face },
                 None => {
-                    self.set_status(Severity::Info, "Fill connected: point at the mesh first.");
+                    ctx.status.set(Severity::Info, "Fill connected: point at the mesh first.");
                     return;
                 }
             }
         } else {
             FillScope::All
         };
-        let settings = self.brush;
-        let result = self.with_paint(|view, store, _, history| {
+        let settings = *ctx.brush;
+        let result = self.with_paint(ctx, |view, store, _, history| {
             brush::fill(store, history, scope, settings.color, settings.blend, settings.strength, view.base)
         });
         match result {
             Some(Ok(stats)) => {
                 self.edit_generation += 1;
-                self.set_status(Severity::Info, format!("Fill: {} samples changed", thousands(stats.samples_changed)));
+                ctx.status.set(Severity::Info, format!("Fill: {} samples changed", thousands(stats.samples_changed)));
             }
-            Some(Err(error)) => self.set_status(Severity::Error, format!("Fill: {error}")),
+            Some(Err(error)) => ctx.status.set(Severity::Error, format!("Fill: {error}")),
             None => {}
         }
     }
 
     /// Sets the resolution of every face.
-    pub fn set_resolution_all(&mut self, resolution: Resolution) {
-        let budget = self.budget();
-        let format = self.document.as_ref().map_or_else(Default::default, |open| open.format);
-        let result = self.with_paint(|_, store, _, history| {
+    pub fn set_resolution_all(&mut self, ctx: &mut PaintContext<'_>, resolution: Resolution, budget: Budget) {
+        let format = self.open.as_ref().map_or_else(Default::default, |open| open.format);
+        let result = self.with_paint(ctx, |_, store, _, history| {
             brush::set_resolution(store, history, None, resolution, Some((&budget, format)))
         });
         match result {
             Some(Ok(changed)) => {
                 self.edit_generation += 1;
-                if let Some(open) = self.document.as_mut() {
+                if let Some(open) = self.open.as_mut() {
                     open.samples = open.document.store.sample_count();
                 }
-                self.set_status(
-                    Severity::Info,
-                    format!("R = {} on {} faces", resolution.get(), thousands(changed.into())),
-                );
+                ctx.status
+                    .set(Severity::Info, format!("R = {} on {} faces", resolution.get(), thousands(changed.into())));
             }
-            Some(Err(error)) => self.set_status(Severity::Error, format!("Set resolution: {error}")),
-            None => self.set_status(Severity::Info, "Set R for all works in paint mode (Tab)."),
+            Some(Err(error)) => ctx.status.set(Severity::Error, format!("Set resolution: {error}")),
+            None => ctx.status.set(Severity::Info, "Set R for all works in paint mode (Tab)."),
         }
     }
 
     /// Starts the radius (F) or strength (Shift+F) gesture at the pointer.
-    pub fn start_gesture(&mut self, kind: GestureKind) {
-        let pointer = self.viewport_pointer.unwrap_or_else(|| self.viewport.rect.center());
-        let radius_pt = self.brush_radius_points(None);
-        let before = self.brush;
+    pub fn start_gesture(&mut self, ctx: &mut PaintContext<'_>, kind: GestureKind) {
+        let pointer = ctx.viewport.pointer.unwrap_or_else(|| ctx.viewport.rect.center());
+        let radius_pt = brush_radius_points(ctx.brush, ctx.viewport, ctx.camera);
+        let before = *ctx.brush;
         let Some(session) = self.paint.as_mut() else {
             return;
         };
@@ -430,42 +437,43 @@ impl Editor {
             GestureKind::Radius => "radius",
             GestureKind::Strength => "strength",
         };
-        self.set_status(Severity::Info, format!("Move to set the {what}; click or Enter confirms, Esc cancels."));
+        ctx.status.set(Severity::Info, format!("Move to set the {what}; click or Enter confirms, Esc cancels."));
     }
 
     /// Follows the pointer during a gesture, and confirms or cancels it. Returns whether a
     /// gesture is running (it then owns the pointer).
-    pub(crate) fn gesture_input(&mut self, ctx: &egui::Context) -> bool {
+    pub(crate) fn gesture_input(&mut self, ctx: &mut PaintContext<'_>, input: &egui::Context) -> bool {
         let Some(gesture) = self.paint.as_ref().and_then(|p| p.gesture) else {
             return false;
         };
         let (pointer, primary, secondary) =
-            ctx.input(|i| (i.pointer.latest_pos(), i.pointer.primary_pressed(), i.pointer.secondary_pressed()));
-        let enter = ctx.input_mut(|i| i.consume_key(egui::Modifiers::NONE, egui::Key::Enter));
-        let escape = ctx.input_mut(|i| i.consume_key(egui::Modifiers::NONE, egui::Key::Escape));
+            input.input(|i| (i.pointer.latest_pos(), i.pointer.primary_pressed(), i.pointer.secondary_pressed()));
+        let enter = input.input_mut(|i| i.consume_key(egui::Modifiers::NONE, egui::Key::Enter));
+        let escape = input.input_mut(|i| i.consume_key(egui::Modifiers::NONE, egui::Key::Escape));
         if let Some(pointer) = pointer {
             let distance = (pointer - gesture.center).length();
             match gesture.kind {
                 GestureKind::Radius => {
-                    let ppp = f64::from(self.viewport.pixels_per_point);
+                    let ppp = f64::from(ctx.viewport.pixels_per_point);
                     let px = (f64::from(distance) * ppp).clamp(1.0, 2000.0);
-                    self.brush.radius = match gesture.before.radius {
+                    ctx.brush.radius = match gesture.before.radius {
                         BrushRadius::Pixels { .. } => BrushRadius::Pixels { radius_px: px },
                         BrushRadius::World { radius_world } => {
-                            let before = f64::from(self.brush_radius_points(Some(gesture.before))).max(1e-6);
+                            let before =
+                                f64::from(brush_radius_points(&gesture.before, ctx.viewport, ctx.camera)).max(1e-6);
                             BrushRadius::World { radius_world: radius_world * f64::from(distance).max(0.5) / before }
                         }
                     }
                 }
                 GestureKind::Strength => {
-                    self.brush.strength = (distance / STRENGTH_GESTURE_POINTS).clamp(0.0, 1.0);
+                    ctx.brush.strength = (distance / STRENGTH_GESTURE_POINTS).clamp(0.0, 1.0);
                 }
             }
         }
         if primary || enter || secondary || escape {
             let confirmed = primary || enter;
             if !confirmed {
-                self.brush = gesture.before;
+                *ctx.brush = gesture.before;
             }
             if let Some(session) = self.paint.as_mut() {
                 session.gesture = None;
@@ -473,265 +481,130 @@ impl Editor {
             }
             let text = match (confirmed, gesture.kind) {
                 (false, _) => "Cancelled.".to_owned(),
-                (true, GestureKind::Radius) => format!("Radius {}", radius_text(self.brush.radius)),
-                (true, GestureKind::Strength) => format!("Strength {:.2}", self.brush.strength),
+                (true, GestureKind::Radius) => format!("Radius {}", radius_text(ctx.brush.radius)),
+                (true, GestureKind::Strength) => format!("Strength {:.2}", ctx.brush.strength),
             };
-            self.set_status(Severity::Info, text);
+            ctx.status.set(Severity::Info, text);
         }
-        ctx.request_repaint();
+        input.request_repaint();
         true
     }
 
-    /// The brush radius on screen, points (`settings` or the current brush). A world radius
-    /// is converted at the depth of the camera's target.
-    pub fn brush_radius_points(&self, settings: Option<brush::BrushSettings>) -> f32 {
-        let settings = settings.unwrap_or(self.brush);
-        let ppp = f64::from(self.viewport.pixels_per_point.max(0.01));
-        let px = match settings.radius {
-            BrushRadius::Pixels { radius_px } => radius_px,
-            BrushRadius::World { radius_world } => {
-                let [_, h] = self.viewport.size_px();
-                radius_world / self.camera.world_per_pixel(f64::from(h)).max(f64::MIN_POSITIVE)
-            }
-        };
-        (px / ppp) as f32
-    }
-
-    /// Draws the brush circle (and the gesture's circle) over the 3D view.
-    pub fn brush_cursor_ui(&self, painter: &egui::Painter) {
-        let Some(session) = &self.paint else {
-            return;
-        };
-        let stroke = egui::Stroke::new(1.5, egui::Color32::WHITE);
-        let shadow = egui::Stroke::new(3.0, egui::Color32::from_black_alpha(140));
-        if let Some(gesture) = session.gesture {
-            let radius = match gesture.kind {
-                GestureKind::Radius => self.brush_radius_points(None),
-                GestureKind::Strength => self.brush.strength * STRENGTH_GESTURE_POINTS,
-            };
-            painter.circle_stroke(gesture.center, radius, shadow);
-            painter.circle_stroke(gesture.center, radius, stroke);
-            if gesture.kind == GestureKind::Strength {
-                let fill = egui::Color32::from_white_alpha((self.brush.strength * 120.0) as u8);
-                painter.circle_filled(gesture.center, radius, fill);
-            }
+    /// Lowers face resolutions while every shown colour stays within `bound`
+    /// (`paint::optimize`): plans the changes on a worker thread (the status line shows its
+    /// progress), then applies them as one undo step and reports the memory before and after.
+    pub fn optimize_resolutions(&mut self, ctx: &mut PaintContext<'_>, bound: f32) {
+        if self.paint.is_none() {
+            ctx.status.set(Severity::Info, "Optimize works in paint mode (Tab).");
             return;
         }
-        if let Some(pos) = self.viewport_pointer {
-            let radius = self.brush_radius_points(None);
-            painter.circle_stroke(pos, radius, shadow);
-            painter.circle_stroke(pos, radius, stroke);
-            let [r, g, b, _] = self.brush.color.map(meshpaint_core::colors::format::encode_srgb8);
-            painter.circle_filled(pos, 2.5, egui::Color32::from_rgb(r, g, b));
+        if ctx.jobs.is_busy() {
+            ctx.status.set(Severity::Warning, "Busy: wait for the running job to finish before optimizing.");
+            return;
         }
-    }
-
-    /// The paint tool panel: tool, colour, radius, strength, falloff, spacing, blend mode,
-    /// occlusion, culling, mirror, fill, resolution, undo / redo and their memory.
-    pub fn paint_panel_ui(&mut self, ui: &mut egui::Ui) {
-        let painting = self.mode == Mode::Paint;
-        let button = if painting { "Leave paint mode (Tab)" } else { "Enter paint mode (Tab)" };
-        if ui.add_enabled(self.document.is_some(), egui::Button::new(button)).clicked() {
-            self.toggle_paint_mode();
-        }
-        let bounds_radius = self.document.as_ref().map(|d| d.bounds.radius);
-        brush_settings_ui(ui, &mut self.brush, bounds_radius);
-        ui.separator();
-        self.paint_commands_ui(ui, painting);
-    }
-
-    /// The panel's commands (eyedropper, fill, resolution for all, undo / redo) and the undo
-    /// memory.
-    fn paint_commands_ui(&mut self, ui: &mut egui::Ui, painting: bool) {
-        ui.add_enabled_ui(painting, |ui| {
-            ui.horizontal_wrapped(|ui| {
-                if ui.button("Eyedropper").on_hover_text("S over the mesh").clicked() {
-                    self.eyedropper();
-                }
-                if ui.button("Fill all").clicked() {
-                    self.fill(false);
-                }
-                if ui.button("Fill connected").on_hover_text("The part last under the cursor").clicked() {
-                    self.fill(true);
-                }
-            });
-            ui.horizontal(|ui| {
-                let mut r = self.resolution_for_all;
-                resolution_combo_ui(ui, "All faces:", &mut r);
-                self.resolution_for_all = r;
-                if ui.button("Set R for all").clicked() {
-                    self.set_resolution_all(r);
-                }
-            });
-            ui.horizontal(|ui| {
-                ui.label("Error bound");
-                ui.add(egui::DragValue::new(&mut self.optimize_bound).range(0.0..=1.0).speed(0.001).max_decimals(3))
-                    .on_hover_text("Largest change of any shown colour channel (linear light, 0..1); 0 = lossless");
-                if ui
-                    .button("Optimize")
-                    .on_hover_text("Lower each face's R while what the mesh shows stays within the bound (undoable)")
-                    .clicked()
-                {
-                    self.optimize_resolutions();
-                }
-            });
-            ui.horizontal(|ui| {
-                let undo = ui
-                    .add_enabled(self.history.undo_len() > 0, egui::Button::new("Undo"))
-                    .on_hover_text(self.history.undo_label().unwrap_or("Ctrl+Z"));
-                if undo.clicked() {
-                    self.undo();
-                }
-                let redo = ui
-                    .add_enabled(self.history.redo_len() > 0, egui::Button::new("Redo"))
-                    .on_hover_text(self.history.redo_label().unwrap_or("Ctrl+Shift+Z"));
-                if redo.clicked() {
-                    self.redo();
-                }
-            });
+        self.end_stroke(ctx);
+        let Some(open) = &self.open else {
+            return;
+        };
+        let document = Arc::clone(&open.document);
+        let generation = self.edit_generation;
+        let started = ctx.jobs.start(JobKind::Optimize, "Optimizing", move |job| {
+            let plan =
+                optimize::plan(&document.store, bound, &|fraction| job.progress(fraction, "trying lower resolutions"))
+                    .map_err(|error| error.to_string())?;
+            Ok(JobOutput::Optimized(Box::new(Optimized { plan, generation, bound })))
         });
-        ui.label(format!(
-            "Undo: {} steps, {} / {}",
-            self.history.undo_len(),
-            human_bytes(self.history.bytes_used() as u64),
-            human_bytes(self.history.cap_bytes() as u64)
-        ));
-        let mut cap_mib = (self.history.cap_bytes() >> 20) as u32;
-        if ui.add(egui::Slider::new(&mut cap_mib, 1..=4096).logarithmic(true).text("Undo memory (MiB)")).changed() {
-            self.history.set_cap_bytes((cap_mib as usize) << 20);
+        match started {
+            Ok(()) => ctx.status.set(Severity::Info, format!("Optimizing (E = {bound})…")),
+            Err(message) => ctx.status.set(Severity::Error, message),
         }
-        if let Some(session) = &self.paint {
-            ui.label(
-                egui::RichText::new(format!(
-                    "Last stroke: {} sample updates, {} uploaded",
-                    thousands(session.stroke_samples_changed),
-                    human_bytes(session.stroke_upload_bytes)
-                ))
-                .weak(),
+    }
+
+    /// Applies a finished Optimize plan if the document is still the one planned on.
+    pub(crate) fn finish_optimize(&mut self, ctx: &mut PaintContext<'_>, optimized: Optimized, elapsed: Duration) {
+        let Optimized { plan, generation, bound } = optimized;
+        if generation != self.edit_generation || self.paint.is_none() {
+            ctx.status.set(
+                Severity::Warning,
+                "The colours changed while Optimize ran (or paint mode ended); nothing was changed. Run it again.",
             );
+            return;
+        }
+        let result = self.with_paint(ctx, |_, store, _, history| optimize::apply(store, history, &plan));
+        match result {
+            Some(Ok(report)) => {
+                if report.step.is_some() {
+                    self.edit_generation += 1;
+                }
+                if let Some(open) = self.open.as_mut() {
+                    open.samples = open.document.store.sample_count();
+                }
+                // The store keeps RGBA32F samples: 16 bytes each.
+                let bytes = |samples: u64| human_bytes(samples.saturating_mul(16));
+                ctx.status.set(
+                    Severity::Info,
+                    format!(
+                        "Optimize (E = {bound}): {} faces lowered, samples {} to {} ({} to {}), largest change {:.2e} ({:.2} s)",
+                        thousands(report.faces_lowered.into()),
+                        thousands(report.samples_before),
+                        thousands(report.samples_after),
+                        bytes(report.samples_before),
+                        bytes(report.samples_after),
+                        report.max_error,
+                        elapsed.as_secs_f64()
+                    ),
+                );
+            }
+            Some(Err(error)) => ctx.status.set(Severity::Error, format!("Optimize: {error}")),
+            None => ctx.status.set(Severity::Info, "Optimize works in paint mode (Tab)."),
         }
     }
 }
 
-/// The brush settings: tool, colour, radius (pixels or world units; `bounds_radius` of the
-/// mesh scales the world slider), strength, spacing, falloff, blend, occlusion, culling,
-/// mirror. The panel owns nothing else: it edits `brush` in place.
-fn brush_settings_ui(ui: &mut egui::Ui, brush: &mut BrushSettings, bounds_radius: Option<f64>) {
-    ui.horizontal(|ui| {
-        ui.label("Tool:");
-        ui.selectable_value(&mut brush.tool, Tool::Paint, "Colour");
-        ui.selectable_value(&mut brush.tool, Tool::Blur, "Blur");
-        let is_resolution = matches!(brush.tool, Tool::Resolution(_));
-        if ui.selectable_label(is_resolution, "Resolution").clicked() && !is_resolution {
-            brush.tool = Tool::Resolution(ResolutionOp::Raise);
-        }
-    });
-    if let Tool::Resolution(op) = &mut brush.tool {
-        ui.horizontal(|ui| {
-            ui.radio_value(op, ResolutionOp::Raise, "Raise");
-            ui.radio_value(op, ResolutionOp::Lower, "Lower");
-            let is_set = matches!(op, ResolutionOp::Set(_));
-            if ui.radio(is_set, "Set").clicked() && !is_set {
-                *op = ResolutionOp::Set(Resolution::from_log2(3).unwrap_or(Resolution::ONE));
-            }
-        });
-        if let ResolutionOp::Set(r) = op {
-            ui.horizontal(|ui| resolution_combo_ui(ui, "To:", r));
-        }
-    }
-    ui.horizontal(|ui| {
-        ui.label("Colour:");
-        let mut color = to_egui(brush.color);
-        if egui::color_picker::color_edit_button_rgba(ui, &mut color, egui::color_picker::Alpha::OnlyBlend).changed() {
-            brush.color = color.to_rgba_unmultiplied();
-        }
-        let [r, g, b, _] = brush.color.map(meshpaint_core::colors::format::encode_srgb8);
-        ui.label(egui::RichText::new(format!("#{r:02x}{g:02x}{b:02x}")).monospace().weak());
-    });
-    ui.horizontal(|ui| {
-        let mut world = matches!(brush.radius, BrushRadius::World { .. });
-        ui.label("Radius in:");
-        let pixels_clicked = ui.radio_value(&mut world, false, "pixels").clicked();
-        let world_clicked = ui.radio_value(&mut world, true, "world").clicked();
-        if pixels_clicked && !matches!(brush.radius, BrushRadius::Pixels { .. }) {
-            brush.radius = BrushRadius::Pixels { radius_px: 30.0 };
-        }
-        if world_clicked && !matches!(brush.radius, BrushRadius::World { .. }) {
-            let scale = bounds_radius.unwrap_or(1.0);
-            brush.radius = BrushRadius::World { radius_world: scale * 0.05 };
-        }
-    });
-    match &mut brush.radius {
-        BrushRadius::Pixels { radius_px } => {
-            ui.add(egui::Slider::new(radius_px, 1.0..=500.0).logarithmic(true).text("Radius (px)"))
-                .on_hover_text("F: set interactively");
-        }
+/// The radius of `brush` on screen, points. A world radius is converted at the depth of
+/// the camera's target.
+pub fn brush_radius_points(brush: &BrushSettings, viewport: &ViewportState, camera: &OrbitCamera) -> f32 {
+    let ppp = f64::from(viewport.pixels_per_point.max(0.01));
+    let px = match brush.radius {
+        BrushRadius::Pixels { radius_px } => radius_px,
         BrushRadius::World { radius_world } => {
-            let max = bounds_radius.map_or(10.0, |r| r * 2.0).max(1e-3);
-            ui.add(egui::Slider::new(radius_world, max * 1e-4..=max).logarithmic(true).text("Radius (world)"))
-                .on_hover_text("F: set interactively");
+            let [_, h] = viewport.size_px();
+            radius_world / camera.world_per_pixel(f64::from(h)).max(f64::MIN_POSITIVE)
         }
+    };
+    (px / ppp) as f32
+}
+
+/// Draws the brush circle (and the gesture's circle) of paint mode's `session` over the
+/// 3D view.
+pub fn draw_brush_cursor(
+    painter: &egui::Painter,
+    session: &PaintSession,
+    brush: &BrushSettings,
+    viewport: &ViewportState,
+    camera: &OrbitCamera,
+) {
+    let stroke = egui::Stroke::new(1.5, egui::Color32::WHITE);
+    let shadow = egui::Stroke::new(3.0, egui::Color32::from_black_alpha(140));
+    if let Some(gesture) = session.gesture {
+        let radius = match gesture.kind {
+            GestureKind::Radius => brush_radius_points(brush, viewport, camera),
+            GestureKind::Strength => brush.strength * STRENGTH_GESTURE_POINTS,
+        };
+        painter.circle_stroke(gesture.center, radius, shadow);
+        painter.circle_stroke(gesture.center, radius, stroke);
+        if gesture.kind == GestureKind::Strength {
+            let fill = egui::Color32::from_white_alpha((brush.strength * 120.0) as u8);
+            painter.circle_filled(gesture.center, radius, fill);
+        }
+        return;
     }
-    ui.add(egui::Slider::new(&mut brush.strength, 0.0..=1.0).text("Strength")).on_hover_text("Shift+F");
-    ui.add(egui::Slider::new(&mut brush.spacing_percent, 1.0..=200.0).text("Spacing (%)"));
-    ui.horizontal(|ui| {
-        let label = ui.label("Falloff:");
-        egui::ComboBox::from_id_salt("falloff")
-            .selected_text(brush.falloff.name())
-            .show_ui(ui, |ui| {
-                for falloff in [Falloff::Smooth, Falloff::Linear, Falloff::Constant, Falloff::Sharp] {
-                    ui.selectable_value(&mut brush.falloff, falloff, falloff.name());
-                }
-            })
-            .response
-            .labelled_by(label.id);
-    });
-    ui.horizontal(|ui| {
-        let label = ui.label("Blend:");
-        egui::ComboBox::from_id_salt("blend")
-            .selected_text(blend_name(brush.blend))
-            .show_ui(ui, |ui| {
-                for blend in BlendMode::ALL {
-                    ui.selectable_value(&mut brush.blend, blend, blend_name(blend));
-                }
-            })
-            .response
-            .labelled_by(label.id);
-    });
-    ui.checkbox(&mut brush.occlusion, "Occlusion").on_hover_text("Paint only what the eye sees");
-    ui.checkbox(&mut brush.backface_culling, "Backface culling");
-    ui.checkbox(&mut brush.mirror_x, "X mirror");
-    // Resolution follows the brush: faces under a dab are raised until their sample spacing
-    // is at most a quarter of the radius (up to R = 64).
-    let mut follow = brush.follow_resolution.is_some();
-    ui.checkbox(&mut follow, "Resolution follows the brush")
-        .on_hover_text("Raise the faces under each dab to the R that resolves the brush (spacing at most a quarter of the radius, R up to 64)");
-    brush.follow_resolution = follow.then_some(meshpaint_core::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
-}
-
-/// A labelled combo box of resolutions 1 … 64.
-fn resolution_combo_ui(ui: &mut egui::Ui, label: &str, resolution: &mut Resolution) {
-    let label = ui.label(label);
-    egui::ComboBox::from_id_salt(label.id)
-        .selected_text(format!("R = {}", resolution.get()))
-        .show_ui(ui, |ui| {
-            for log2 in 0..=6 {
-                if let Ok(r) = Resolution::from_log2(log2) {
-                    ui.selectable_value(resolution, r, format!("R = {}", r.get()));
-                }
-            }
-        })
-        .response
-        .labelled_by(label.id);
-}
-
-/// The name of a blend mode in the panel.
-pub fn blend_name(blend: BlendMode) -> &'static str {
-    match blend {
-        BlendMode::Mix => "Mix",
-        BlendMode::Add => "Add",
-        BlendMode::Multiply => "Multiply",
-        BlendMode::EraseToBase => "Erase to base",
+    if let Some(pos) = viewport.pointer {
+        let radius = brush_radius_points(brush, viewport, camera);
+        painter.circle_stroke(pos, radius, shadow);
+        painter.circle_stroke(pos, radius, stroke);
+        let [r, g, b, _] = brush.color.map(meshpaint_core::colors::format::encode_srgb8);
+        painter.circle_filled(pos, 2.5, egui::Color32::from_rgb(r, g, b));
     }
 }
 

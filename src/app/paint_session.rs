@@ -1,6 +1,6 @@
 //! The state of paint mode while it is on: the paint layout, the base snapshot, the brush
 //! engine and an interactive gesture; and the result of the repack job that ends it. The
-//! editor's paint-mode commands and panel are in [`super::paint`].
+//! editor's paint-mode commands are in [`super::paint`], its panel in `panels::paint`.
 
 use std::sync::Arc;
 use std::time::Duration;

@@ -1,14 +1,16 @@
 //! The editor's small shared types: mode, status, view settings, the [`Action`]s every
-//! menu and shortcut maps to, the viewport and frame timing. They depend on nothing else
-//! in the app, so every other file may use them.
+//! menu and shortcut maps to, the 3D view's area and frame timing. They depend on nothing
+//! else in the app, so every other file may use them.
 
 use std::time::{Duration, Instant};
 
-use meshpaint_render::{FilterMode, Overlays, Shading};
+use meshpaint_core::camera::OrbitCamera;
+use meshpaint_render::{FilterMode, Overlays, RenderSettings, Shading};
 
 /// What the editor is doing with the pointer in the 3D view. Paint mode (Tab) slots in
-/// here: its tools get the pointer in [`super::input::viewport_input`], edit the document's
-/// store and upload dirty samples to its GPU mesh.
+/// here: its tools get the pointer in [`super::input::paint_input`], edit the document's
+/// store and upload dirty samples to its GPU mesh. The editor derives it from the paint
+/// session (`DocumentState::mode`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Mode {
     /// Look at the mesh: navigation only.
@@ -46,6 +48,19 @@ pub struct Status {
     pub text: String,
     /// Its severity.
     pub severity: Severity,
+}
+
+impl Status {
+    /// Replaces the message, and logs it at its severity's level.
+    pub fn set(&mut self, severity: Severity, text: impl Into<String>) {
+        let text = text.into();
+        match severity {
+            Severity::Info => log::info!("{text}"),
+            Severity::Warning => log::warn!("{text}"),
+            Severity::Error => log::error!("{text}"),
+        }
+        *self = Status { text, severity };
+    }
 }
 
 /// What the 3D view shows of the document.
@@ -87,8 +102,6 @@ pub struct ViewSettings {
     pub shading: Shading,
     /// Wireframe and resolution heat map.
     pub overlays: Overlays,
-    /// Redraw every frame (to measure fps) instead of only when something changes.
-    pub continuous_redraw: bool,
 }
 
 impl Default for ViewSettings {
@@ -98,13 +111,33 @@ impl Default for ViewSettings {
             filter: FilterMode::Trilinear,
             shading: Shading::Smooth,
             overlays: Overlays::default(),
-            continuous_redraw: false,
         }
     }
 }
 
+impl ViewSettings {
+    /// The render settings of the 3D view seen through `camera`. `level0_only`: the GPU mesh
+    /// holds the paint layout (level 0 only), so the filter is limited to level 0.
+    pub fn render_settings(&self, camera: OrbitCamera, level0_only: bool) -> RenderSettings {
+        let mut settings = RenderSettings::new(camera);
+        settings.filter = self.filter;
+        if level0_only {
+            settings.filter = match self.filter {
+                FilterMode::Nearest | FilterMode::NearestMipLevel(_) => FilterMode::Nearest,
+                FilterMode::Linear | FilterMode::MipLevel(_) | FilterMode::Trilinear => FilterMode::Linear,
+            };
+        }
+        settings.shading = self.shading;
+        settings.overlays = self.overlays;
+        settings
+    }
+}
+
+/// The view a PSNR was measured in: render settings, 3D view size in pixels, scene generation.
+pub type PsnrKey = (RenderSettings, [u32; 2], u64);
+
 /// Every command the UI offers: shortcuts and menus map to these
-/// ([`super::input::SHORTCUTS`]), and [`super::input::perform`] carries them out.
+/// ([`super::input::SHORTCUTS`]), and `Editor::perform` carries them out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Action {
     /// Show the Open dialog.
@@ -159,16 +192,49 @@ pub enum Action {
     StrengthGesture,
 }
 
-/// The 3D view's area this frame, as the last `Editor::ui` laid it out.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ViewportInfo {
+/// The 3D view: its area as the last `Editor::ui` laid it out, the pointer over it, and
+/// what the window shell and the GPU uploads record about it.
+#[derive(Debug, Clone)]
+pub struct ViewportState {
     /// The area in points.
     pub rect: egui::Rect,
     /// Physical pixels per point.
     pub pixels_per_point: f32,
+    /// The pointer over the 3D view (points), if it is there.
+    pub pointer: Option<egui::Pos2>,
+    /// The egui texture showing the 3D view (registered by the window shell).
+    pub texture: Option<egui::TextureId>,
+    /// GPU memory of the 3D view's render targets (set by the window shell).
+    pub gpu_bytes: u64,
+    /// Frame timing (recorded by the window shell).
+    pub frame_stats: FrameStats,
+    /// Counts changes of what the GPU mesh shows (a new document, paint uploads, a repack,
+    /// an alternate view): the window shell redraws the 3D view only when this, the size or
+    /// the settings change.
+    pub scene_generation: u64,
+    /// Bytes uploaded to the GPU during the previous frame.
+    pub upload_bytes_last_frame: u64,
+    /// Bytes uploaded to the GPU so far this frame.
+    pub upload_bytes_this_frame: u64,
 }
 
-impl ViewportInfo {
+impl Default for ViewportState {
+    fn default() -> Self {
+        ViewportState {
+            rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1.0, 1.0)),
+            pixels_per_point: 1.0,
+            pointer: None,
+            texture: None,
+            gpu_bytes: 0,
+            frame_stats: FrameStats::default(),
+            scene_generation: 0,
+            upload_bytes_last_frame: 0,
+            upload_bytes_this_frame: 0,
+        }
+    }
+}
+
+impl ViewportState {
     /// The area's size in physical pixels (at least 1×1).
     pub fn size_px(&self) -> [u32; 2] {
         let w = (self.rect.width() * self.pixels_per_point).round().max(1.0) as u32;
@@ -182,6 +248,12 @@ impl ViewportInfo {
             (self.rect.min.x * self.pixels_per_point).round() as i32,
             (self.rect.min.y * self.pixels_per_point).round() as i32,
         ]
+    }
+
+    /// Pixel coordinates in the 3D view of `pos` (points, window coordinates).
+    pub fn view_px(&self, pos: egui::Pos2) -> [f64; 2] {
+        let ppp = f64::from(self.pixels_per_point);
+        [f64::from(pos.x - self.rect.min.x) * ppp, f64::from(pos.y - self.rect.min.y) * ppp]
     }
 }
 

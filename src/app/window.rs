@@ -209,7 +209,7 @@ impl Shell {
 
         let waker_ctx = egui_ctx.clone();
         let mut editor = Editor::new(gpu.clone(), Arc::new(move || waker_ctx.request_repaint()));
-        editor.viewport_texture = Some(view.texture_id);
+        editor.viewport.texture = Some(view.texture_id);
         editor.open(match &self.options.file {
             Some(path) => Source::File(path.clone()),
             None => Source::BuiltIn,
@@ -298,7 +298,7 @@ impl Running {
             self.egui_renderer.free_texture(&id);
         }
         if drawn {
-            self.editor.frame_stats.record(started.elapsed());
+            self.editor.viewport.frame_stats.record(started.elapsed());
         }
         self.frame_count.0 += 1;
         if let Some(path) = &self.frame_count.1 {
@@ -335,11 +335,10 @@ impl Running {
         };
         let ctx = Arc::clone(&self.ctx);
         let ctx = &*ctx;
-        let viewport = self.editor.viewport;
-        let view_size = viewport.size_px();
+        let view_size = self.editor.viewport.size_px();
         self.view.resize(ctx, &mut self.egui_renderer, view_size);
-        self.editor.viewport_gpu_bytes = self.view.gpu_bytes();
-        let logged = (viewport.min_px(), view_size);
+        self.editor.viewport.gpu_bytes = self.view.gpu_bytes();
+        let logged = (self.editor.viewport.min_px(), view_size);
         if self.last_logged_viewport != Some(logged) {
             log::info!(
                 "3D view at {},{} size {}x{} px (window {}x{})",
@@ -354,11 +353,12 @@ impl Running {
         }
 
         let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        if self.editor.view.continuous_redraw {
+        if self.editor.panels.scene.continuous_redraw {
             self.drawn_view = None;
         }
         let settings = self.editor.render_settings();
-        let view_key = (settings, self.editor.view.shown, self.view.size, self.editor.scene_generation);
+        let view_key =
+            (settings, self.editor.panels.view.settings.shown, self.view.size, self.editor.viewport.scene_generation);
         let item = self.editor.shown_item();
         if let (Some(item), Some(gpu)) = (item.filter(|_| self.drawn_view != Some(view_key)), &self.gpu) {
             self.drawn_view = Some(view_key);

@@ -1,6 +1,6 @@
 //! UI logic of the editor without a window: egui_kittest drives `Editor::ui` (panels,
 //! shortcuts, help window, file dialog, status line) and the editor's open/save/export
-//! paths, with no GPU (the 3D view is covered by tests/app_window.rs under Xvfb).
+//! paths, with no GPU (the 3D view is covered by tests/editor/app_window.rs under Xvfb).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -26,7 +26,7 @@ fn editor_with_duck() -> Editor {
     let mut editor = new_editor();
     editor.open(Source::BuiltIn);
     assert!(editor.wait_for_job(JOB_TIMEOUT), "opening the Duck timed out");
-    assert!(editor.document.is_some(), "the Duck did not open: {:?}", editor.status);
+    assert!(editor.document.open.is_some(), "the Duck did not open: {:?}", editor.status);
     editor
 }
 
@@ -38,10 +38,10 @@ fn harness(editor: Editor) -> Harness<'static, Editor> {
 fn view_panel_changes_the_render_settings() {
     let mut harness = harness(editor_with_duck());
     harness.run_steps(2);
-    assert!(!harness.state().view.overlays.wireframe);
+    assert!(!harness.state().panels.view.settings.overlays.wireframe);
     harness.get_by_label("Wireframe").click();
     harness.run_steps(2);
-    assert!(harness.state().view.overlays.wireframe);
+    assert!(harness.state().panels.view.settings.overlays.wireframe);
     assert!(harness.state().render_settings().overlays.wireframe);
 
     harness.get_by_label("Resolution heat map").click();
@@ -53,7 +53,7 @@ fn view_panel_changes_the_render_settings() {
     assert_eq!(harness.state().render_settings().shading, Shading::Unlit);
     harness.get_by_label("Flat").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().view.shading, Shading::Lit);
+    assert_eq!(harness.state().panels.view.settings.shading, Shading::Lit);
     harness.get_by_label("Smooth").click();
     harness.run_steps(2);
     assert_eq!(harness.state().render_settings().shading, Shading::Smooth);
@@ -63,7 +63,7 @@ fn view_panel_changes_the_render_settings() {
 fn filter_combo_box_selects_the_filter() {
     let mut harness = harness(editor_with_duck());
     harness.run_steps(2);
-    assert_eq!(harness.state().view.filter, FilterMode::Trilinear);
+    assert_eq!(harness.state().panels.view.settings.filter, FilterMode::Trilinear);
     harness.get_by_value("Trilinear (auto MIP)").click();
     harness.run_steps(2);
     harness.get_by_label("Nearest").click();
@@ -77,20 +77,20 @@ fn shortcuts_toggle_overlays_shading_and_filter() {
     harness.run_steps(2);
     harness.key_press(egui::Key::W);
     harness.run_steps(2);
-    assert!(harness.state().view.overlays.wireframe);
+    assert!(harness.state().panels.view.settings.overlays.wireframe);
     harness.key_press(egui::Key::H);
     harness.run_steps(2);
-    assert!(harness.state().view.overlays.heatmap);
+    assert!(harness.state().panels.view.settings.overlays.heatmap);
     harness.key_press(egui::Key::L);
     harness.run_steps(2);
-    assert_eq!(harness.state().view.shading, Shading::Unlit);
+    assert_eq!(harness.state().panels.view.settings.shading, Shading::Unlit);
     harness.key_press(egui::Key::M);
     harness.run_steps(2);
-    assert_eq!(harness.state().view.filter, FilterMode::Nearest);
+    assert_eq!(harness.state().panels.view.settings.filter, FilterMode::Nearest);
     // The checkbox shows the state the shortcut set.
     harness.get_by_label("Wireframe").click();
     harness.run_steps(2);
-    assert!(!harness.state().view.overlays.wireframe);
+    assert!(!harness.state().panels.view.settings.overlays.wireframe);
 }
 
 #[test]
@@ -100,7 +100,7 @@ fn f1_opens_the_help_window_listing_every_shortcut() {
     assert!(harness.query_by_label("Keyboard and mouse").is_none());
     harness.key_press(egui::Key::F1);
     harness.run_steps(3);
-    assert!(harness.state().show_help);
+    assert!(harness.state().panels.help.open);
     assert!(harness.query_by_label("Keyboard and mouse").is_some(), "no help window");
     for shortcut in meshpaint::app::input::SHORTCUTS {
         // F is listed twice: once per mode.
@@ -186,7 +186,7 @@ fn middle_drag_orbits_shift_pans_and_the_wheel_zooms() {
     harness.key_press(egui::Key::Home);
     harness.run_steps(2);
     let framed = harness.state().camera;
-    let bounds = harness.state().document.as_ref().unwrap().bounds;
+    let bounds = harness.state().document.open.as_ref().unwrap().bounds;
     assert_eq!(framed.target, bounds.center, "Home did not frame the mesh");
 }
 
@@ -218,15 +218,15 @@ fn file_dialog_opens_and_escape_cancels() {
     harness.run_steps(2);
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::O);
     harness.run_steps(3);
-    assert!(harness.state().dialog.is_some());
+    assert!(harness.state().panels.file.dialog.is_some());
     assert!(harness.query_by_label("Up").is_some(), "no file list");
     // Shortcuts are off while the dialog is open (its field has the keyboard).
     harness.key_press(egui::Key::W);
     harness.run_steps(2);
-    assert!(!harness.state().view.overlays.wireframe);
+    assert!(!harness.state().panels.view.settings.overlays.wireframe);
     harness.key_press(egui::Key::Escape);
     harness.run_steps(2);
-    assert!(harness.state().dialog.is_none());
+    assert!(harness.state().panels.file.dialog.is_none());
 }
 
 #[test]
@@ -240,12 +240,12 @@ fn export_gltf_through_the_dialog_writes_a_glb() {
     harness.run_steps(2);
     harness.get_by_label("Export glTF…").click();
     harness.run_steps(3);
-    assert!(harness.state().dialog.is_some(), "no export dialog");
-    harness.state_mut().dialog.as_mut().unwrap().file_name = out.display().to_string();
+    assert!(harness.state().panels.file.dialog.is_some(), "no export dialog");
+    harness.state_mut().panels.file.dialog.as_mut().unwrap().file_name = out.display().to_string();
     harness.run_steps(1);
     harness.get_by_label("Export").click();
     harness.run_steps(2);
-    assert!(harness.state().dialog.is_none());
+    assert!(harness.state().panels.file.dialog.is_none());
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "export timed out");
     harness.run_steps(2);
     let bytes = std::fs::read(&out).expect("no exported file");
@@ -259,10 +259,10 @@ fn export_gltf_through_the_dialog_writes_a_glb() {
     let _ = std::fs::remove_file(&project);
     harness.state_mut().save_to(project.clone(), meshpaint_core::colors::format::ColorFormat::Rgba16F);
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
-    assert_eq!(harness.state().document.as_ref().unwrap().project_path.as_deref(), Some(project.as_path()));
+    assert_eq!(harness.state().document.open.as_ref().unwrap().project_path.as_deref(), Some(project.as_path()));
     harness.state_mut().open(Source::File(project.clone()));
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
-    let open = harness.state().document.as_ref().unwrap();
+    let open = harness.state().document.open.as_ref().unwrap();
     assert_eq!(open.triangles(), 4212);
     assert_eq!(open.format, meshpaint_core::colors::format::ColorFormat::Rgba16F);
     let _ = std::fs::remove_dir_all(&dir);
@@ -293,13 +293,13 @@ fn opening_every_invalid_fixture_keeps_the_document_and_shows_the_error() {
     harness.run_steps(2);
     let mut refused = 0;
     for file in &files {
-        let before = harness.state().document.as_ref().map(|d| Arc::clone(&d.document));
+        let before = harness.state().document.open.as_ref().map(|d| Arc::clone(&d.document));
         harness.state_mut().open(Source::File(file.clone()));
         harness.run_steps(1);
         assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "{}: opening timed out", file.display());
         harness.run_steps(2);
         let editor = harness.state();
-        let now = editor.document.as_ref().map(|d| Arc::clone(&d.document));
+        let now = editor.document.open.as_ref().map(|d| Arc::clone(&d.document));
         match editor.status.severity {
             Severity::Error => {
                 refused += 1;
@@ -318,7 +318,7 @@ fn opening_every_invalid_fixture_keeps_the_document_and_shows_the_error() {
             }
             // Some fixtures are valid files with odd features: they open like any file.
             Severity::Info | Severity::Warning => {
-                let open = editor.document.as_ref().expect("opened without a document");
+                let open = editor.document.open.as_ref().expect("opened without a document");
                 assert!(open.triangles() > 0);
                 assert_eq!(open.path.as_deref(), Some(file.as_path()));
             }
@@ -334,7 +334,7 @@ fn a_bad_start_up_file_falls_back_to_the_duck_with_the_error_shown() {
     assert!(editor.wait_for_job(JOB_TIMEOUT));
     // The failure started the built-in scene.
     assert!(editor.wait_for_job(JOB_TIMEOUT));
-    assert_eq!(editor.document.as_ref().map(|d| d.title.as_str()), Some("Duck (built-in)"));
+    assert_eq!(editor.document.open.as_ref().map(|d| d.title.as_str()), Some("Duck (built-in)"));
     assert_eq!(editor.status.severity, Severity::Error);
     assert!(editor.status.text.contains("invalid_magic.glb"), "{}", editor.status.text);
     let mut harness = harness(editor);
@@ -348,7 +348,7 @@ fn save_without_a_project_file_asks_for_a_name() {
     harness.run_steps(2);
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
     harness.run_steps(3);
-    let dialog = harness.state().dialog.as_ref().expect("Save did not ask for a name");
+    let dialog = harness.state().panels.file.dialog.as_ref().expect("Save did not ask for a name");
     assert_eq!(dialog.purpose, meshpaint::app::file_dialog::DialogPurpose::SaveAs);
     assert!(dialog.file_name.ends_with(".mpk"));
 }
@@ -376,7 +376,7 @@ fn dropping_a_file_on_the_window_opens_it() {
     harness.run_steps(1);
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
     harness.run_steps(2);
-    let open = harness.state().document.as_ref().expect("no document");
+    let open = harness.state().document.open.as_ref().expect("no document");
     assert_eq!(open.path.as_deref(), Some(box_glb.as_path()));
     assert_eq!(open.triangles(), 12);
     assert!(harness.query_by_label_contains("Opened BoxTextured.glb").is_some());
@@ -384,7 +384,7 @@ fn dropping_a_file_on_the_window_opens_it() {
 
 /// The Duck's colours, sample by sample (interiors, edges, vertices).
 fn colors_of(editor: &Editor) -> Vec<[f32; 4]> {
-    let store = &editor.document.as_ref().unwrap().document.store;
+    let store = &editor.document.open.as_ref().unwrap().document.store;
     let mut out = Vec::new();
     store.for_each_site(|site| out.push(store.get(site.sample).unwrap()));
     out
@@ -414,18 +414,18 @@ fn left_drag(harness: &mut Harness<'static, Editor>, from: egui::Pos2, to: egui:
 fn tab_toggles_paint_mode_and_leaving_repacks() {
     let mut harness = harness(editor_with_duck());
     harness.run_steps(2);
-    assert_eq!(harness.state().mode, Mode::View);
+    assert_eq!(harness.state().mode(), Mode::View);
     harness.key_press(egui::Key::Tab);
     harness.run_steps(2);
-    assert_eq!(harness.state().mode, Mode::Paint, "{:?}", harness.state().status);
-    assert!(harness.state().paint.is_some());
+    assert_eq!(harness.state().mode(), Mode::Paint, "{:?}", harness.state().status);
+    assert!(harness.state().document.paint.is_some());
     assert!(harness.query_by_label("Paint mode").is_some(), "the mode is not shown");
     // The paint layout has level 0 only: trilinear becomes linear.
-    assert_eq!(harness.state().view.filter, FilterMode::Trilinear);
+    assert_eq!(harness.state().panels.view.settings.filter, FilterMode::Trilinear);
     assert_eq!(harness.state().render_settings().filter, FilterMode::Linear);
     harness.key_press(egui::Key::Tab);
     harness.run_steps(2);
-    assert_eq!(harness.state().mode, Mode::View);
+    assert_eq!(harness.state().mode(), Mode::View);
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
     harness.run_steps(2);
     assert!(harness.state().status.text.contains("Repacked"), "{:?}", harness.state().status);
@@ -437,27 +437,30 @@ fn tab_toggles_paint_mode_and_leaving_repacks() {
 fn paint_panel_changes_the_brush_settings() {
     let mut harness = harness(editor_with_duck());
     harness.run_steps(2);
-    assert!(!harness.state().brush.mirror_x);
+    assert!(!harness.state().panels.paint.brush.mirror_x);
     harness.get_by_label("X mirror").click();
     harness.run_steps(2);
-    assert!(harness.state().brush.mirror_x);
+    assert!(harness.state().panels.paint.brush.mirror_x);
     harness.get_by_label("Occlusion").click();
     harness.run_steps(2);
-    assert!(!harness.state().brush.occlusion);
+    assert!(!harness.state().panels.paint.brush.occlusion);
     harness.get_by_label("Blur").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().brush.tool, meshpaint_core::paint::brush::Tool::Blur);
+    assert_eq!(harness.state().panels.paint.brush.tool, meshpaint_core::paint::brush::Tool::Blur);
     harness.get_by_label("Colour").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().brush.tool, meshpaint_core::paint::brush::Tool::Paint);
+    assert_eq!(harness.state().panels.paint.brush.tool, meshpaint_core::paint::brush::Tool::Paint);
     harness.get_by_value("Mix").click();
     harness.run_steps(2);
     harness.get_by_label("Erase to base").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().brush.blend, meshpaint_core::paint::brush::BlendMode::EraseToBase);
+    assert_eq!(harness.state().panels.paint.brush.blend, meshpaint_core::paint::brush::BlendMode::EraseToBase);
     harness.get_by_label("world").click();
     harness.run_steps(2);
-    assert!(matches!(harness.state().brush.radius, meshpaint_core::paint::brush::BrushRadius::World { .. }));
+    assert!(matches!(
+        harness.state().panels.paint.brush.radius,
+        meshpaint_core::paint::brush::BrushRadius::World { .. }
+    ));
 }
 
 #[test]
@@ -472,8 +475,8 @@ fn a_stroke_paints_and_undo_redo_buttons_and_keys_revert_it() {
     let painted = colors_of(harness.state());
     let changed = original.iter().zip(&painted).filter(|(a, b)| a != b).count();
     assert!(changed > 100, "the stroke changed {changed} samples: {:?}", harness.state().status);
-    assert_eq!(harness.state().history.undo_len(), 1);
-    assert!(harness.state().history.bytes_used() > 0);
+    assert_eq!(harness.state().document.history.undo_len(), 1);
+    assert!(harness.state().document.history.bytes_used() > 0);
     assert!(harness.query_by_label_contains("Undo: 1 steps").is_some(), "undo memory is not shown");
 
     harness.get_by_label("Undo").click();
@@ -499,7 +502,7 @@ fn f_and_shift_f_set_radius_and_strength_interactively() {
     let center = harness.state().viewport.rect.center();
     harness.event(egui::Event::PointerMoved(center));
     harness.run_steps(1);
-    let before = harness.state().brush;
+    let before = harness.state().panels.paint.brush;
     // F: the radius follows the pointer; Enter confirms.
     harness.key_press(egui::Key::F);
     harness.run_steps(1);
@@ -507,7 +510,8 @@ fn f_and_shift_f_set_radius_and_strength_interactively() {
     harness.run_steps(1);
     harness.key_press(egui::Key::Enter);
     harness.run_steps(2);
-    let meshpaint_core::paint::brush::BrushRadius::Pixels { radius_px } = harness.state().brush.radius else {
+    let meshpaint_core::paint::brush::BrushRadius::Pixels { radius_px } = harness.state().panels.paint.brush.radius
+    else {
         panic!("the radius is not in pixels");
     };
     assert!((radius_px - 80.0).abs() < 1.0, "radius {radius_px} px after moving 50 px out from 30 px");
@@ -520,11 +524,11 @@ fn f_and_shift_f_set_radius_and_strength_interactively() {
     harness.run_steps(1);
     harness.event(egui::Event::PointerMoved(center - egui::vec2(100.0, 0.0)));
     harness.run_steps(1);
-    assert!(harness.state().brush.strength < before.strength);
+    assert!(harness.state().panels.paint.brush.strength < before.strength);
     harness.key_press(egui::Key::Escape);
     harness.run_steps(2);
-    assert_eq!(harness.state().brush.strength, before.strength);
-    assert!(harness.state().paint.as_ref().unwrap().gesture.is_none());
+    assert_eq!(harness.state().panels.paint.brush.strength, before.strength);
+    assert!(harness.state().document.paint.as_ref().unwrap().gesture.is_none());
 }
 
 /// The Duck in paint mode after one stroke of the resolution brush across the view's middle.
@@ -535,7 +539,7 @@ fn duck_after_a_resolution_stroke() -> Harness<'static, Editor> {
     harness.run_steps(2);
     harness.get_by_label("Resolution").click();
     harness.run_steps(2);
-    assert!(matches!(harness.state().brush.tool, meshpaint_core::paint::brush::Tool::Resolution(_)));
+    assert!(matches!(harness.state().panels.paint.brush.tool, meshpaint_core::paint::brush::Tool::Resolution(_)));
     let center = harness.state().viewport.rect.center();
     left_drag(&mut harness, center - egui::vec2(30.0, 0.0), center + egui::vec2(30.0, 0.0));
     harness
@@ -544,7 +548,8 @@ fn duck_after_a_resolution_stroke() -> Harness<'static, Editor> {
 #[test]
 fn resolution_brush_and_set_r_for_all_change_face_resolutions() {
     let mut harness = duck_after_a_resolution_stroke();
-    let resolutions = |editor: &Editor| editor.document.as_ref().unwrap().document.store.face_resolutions().to_vec();
+    let resolutions =
+        |editor: &Editor| editor.document.open.as_ref().unwrap().document.store.face_resolutions().to_vec();
     let raised = resolutions(harness.state()).iter().filter(|r| r.get() == 16).count();
     assert!(raised > 0, "the resolution brush raised no face: {:?}", harness.state().status);
     harness.get_by_label("Set R for all").click();
@@ -568,7 +573,7 @@ fn leaving_paint_mode_after_a_resolution_stroke_gives_the_full_pack() {
     // The relayout ran (not a full repack after all), and gave a full pack's buffers.
     let status = &harness.state().status.text;
     assert!(status.contains("Repacked (new layout, unchanged chains moved)"), "{status}");
-    let open = harness.state().document.as_ref().unwrap();
+    let open = harness.state().document.open.as_ref().unwrap();
     let store = &open.document.store;
     assert!(store.face_resolutions().iter().any(|r| r.get() == 16), "the stroke raised no face");
     let full = meshpaint_core::packing::pack(store, &open.document.positions, open.format).unwrap();
@@ -584,7 +589,7 @@ fn optimize_button_lowers_resolutions_losslessly_and_undoes() {
     harness.run_steps(2);
     harness.key_press(egui::Key::Tab);
     harness.run_steps(2);
-    let store = |editor: &Editor| editor.document.as_ref().unwrap().document.store.clone();
+    let store = |editor: &Editor| editor.document.open.as_ref().unwrap().document.store.clone();
     let before = store(harness.state());
     harness.get_by_label("Optimize").click();
     harness.run_steps(2);
@@ -629,12 +634,12 @@ fn duck_painting_within(bytes: u64) -> Harness<'static, Editor> {
     ));
     editor.open(Source::BuiltIn);
     assert!(editor.wait_for_job(JOB_TIMEOUT), "opening the Duck timed out");
-    assert!(editor.document.is_some(), "the Duck did not open: {:?}", editor.status);
+    assert!(editor.document.open.is_some(), "the Duck did not open: {:?}", editor.status);
     let mut harness = harness(editor);
     harness.run_steps(2);
     harness.key_press(egui::Key::Tab);
     harness.run_steps(2);
-    assert_eq!(harness.state().mode, Mode::Paint);
+    assert_eq!(harness.state().mode(), Mode::Paint);
     harness
 }
 
@@ -642,23 +647,24 @@ fn duck_painting_within(bytes: u64) -> Harness<'static, Editor> {
 fn set_r_for_all_past_the_budget_is_refused_and_the_document_stays_valid() {
     // 100 MB holds the Duck at R = 8 and 16 (about 11 and 37 MB estimated), not at R = 64.
     let mut harness = duck_painting_within(100_000_000);
-    let resolutions = |editor: &Editor| editor.document.as_ref().unwrap().document.store.face_resolutions().to_vec();
+    let resolutions =
+        |editor: &Editor| editor.document.open.as_ref().unwrap().document.store.face_resolutions().to_vec();
     let before = resolutions(harness.state());
-    harness.state_mut().resolution_for_all = meshpaint_core::colors::layout::Resolution::new(64).unwrap();
+    harness.state_mut().panels.paint.resolution_for_all = meshpaint_core::colors::layout::Resolution::new(64).unwrap();
     harness.get_by_label("Set R for all").click();
     harness.run_steps(2);
     let status = harness.state().status.clone();
     assert_eq!(status.severity, Severity::Error, "{status:?}");
     assert!(status.text.contains("R = 64 on every face") && status.text.contains("of memory"), "{status:?}");
     assert_eq!(resolutions(harness.state()), before, "nothing changed");
-    assert_eq!(harness.state().history.undo_len(), 0, "no step recorded");
+    assert_eq!(harness.state().document.history.undo_len(), 0, "no step recorded");
     // R = 16 fits; the document still saves and reopens.
-    harness.state_mut().resolution_for_all = meshpaint_core::colors::layout::Resolution::new(16).unwrap();
+    harness.state_mut().panels.paint.resolution_for_all = meshpaint_core::colors::layout::Resolution::new(16).unwrap();
     harness.get_by_label("Set R for all").click();
     harness.run_steps(2);
     assert!(resolutions(harness.state()).iter().all(|r| r.get() == 16), "{:?}", harness.state().status);
     let file = common::TempFile::new("app_ui_budget", "duck16.mpk");
-    let document = harness.state().document.as_ref().unwrap().document.clone();
+    let document = harness.state().document.open.as_ref().unwrap().document.clone();
     let packed = document.pack(meshpaint_core::colors::format::ColorFormat::Rgba8Srgb).unwrap();
     meshpaint_core::packing::file::write_file(file.path(), &packed).unwrap();
     let reopened =
@@ -676,8 +682,17 @@ fn the_resolution_brush_stops_at_the_budget_with_one_message() {
     let center = harness.state().viewport.rect.center();
     left_drag(&mut harness, center - egui::vec2(60.0, 0.0), center + egui::vec2(60.0, 0.0));
     let editor = harness.state();
-    let raised =
-        editor.document.as_ref().unwrap().document.store.face_resolutions().iter().filter(|r| r.get() == 16).count();
+    let raised = editor
+        .document
+        .open
+        .as_ref()
+        .unwrap()
+        .document
+        .store
+        .face_resolutions()
+        .iter()
+        .filter(|r| r.get() == 16)
+        .count();
     assert!(raised > 0, "some faces fit: {:?}", editor.status);
     assert_eq!(editor.status.severity, Severity::Error, "{:?}", editor.status);
     assert!(
@@ -685,7 +700,7 @@ fn the_resolution_brush_stops_at_the_budget_with_one_message() {
         "{:?}",
         editor.status
     );
-    let store = &editor.document.as_ref().unwrap().document.store;
+    let store = &editor.document.open.as_ref().unwrap().document.store;
     let counts = meshpaint_core::colors::budget::SampleCounts::of_store(store);
     assert!(counts.estimated_bytes(meshpaint_core::colors::format::ColorFormat::Rgba8Srgb) <= 11_136_784 + 100_000);
 }
@@ -694,7 +709,7 @@ fn the_resolution_brush_stops_at_the_budget_with_one_message() {
 fn open_and_wait(editor: &mut Editor, path: &Path) {
     editor.open(Source::File(path.to_owned()));
     assert!(editor.wait_for_job(JOB_TIMEOUT), "opening {} timed out", path.display());
-    assert!(editor.document.is_some(), "{} did not open: {:?}", path.display(), editor.status);
+    assert!(editor.document.open.is_some(), "{} did not open: {:?}", path.display(), editor.status);
 }
 
 /// The open dialog's resolution choice reaches the document: "Automatic" keeps R on the
@@ -718,46 +733,47 @@ fn the_open_dialog_offers_uniform_match_texture_error_bound_and_budget_resolutio
     harness.run_steps(2);
     harness.get_by_label("Error ≤ E").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().import.mode, ImportMode::ErrorBound, "the dialog's choice is the editor's");
-    harness.state_mut().dialog = None;
+    assert_eq!(harness.state().panels.import.mode, ImportMode::ErrorBound, "the dialog's choice is the editor's");
+    harness.state_mut().panels.file.dialog = None;
 
-    let resolutions = |editor: &Editor| editor.document.as_ref().unwrap().document.store.face_resolutions().to_vec();
+    let resolutions =
+        |editor: &Editor| editor.document.open.as_ref().unwrap().document.store.face_resolutions().to_vec();
     let editor = harness.state_mut();
-    editor.import.error_bound = 0.02;
+    editor.panels.import.error_bound = 0.02;
     open_and_wait(editor, &duck);
-    let rule = ResolutionRule::ErrorBound { bound: 0.02, max: editor.import.max_resolution };
+    let rule = ResolutionRule::ErrorBound { bound: 0.02, max: editor.panels.import.max_resolution };
     let expected = Document::open_within(&duck, rule, &Budget::from_environment()).unwrap();
     assert_eq!(resolutions(editor), expected.store.face_resolutions(), "the rule's resolutions, face by face");
     assert!(resolutions(editor).iter().any(|r| r.get() != resolutions(editor)[0].get()), "not uniform");
 
-    editor.import.mode = ImportMode::Automatic;
+    editor.panels.import.mode = ImportMode::Automatic;
     open_and_wait(editor, &duck);
     assert!(resolutions(editor).iter().all(|r| r.get() == 8), "the textured Duck keeps R = 8");
-    assert_eq!(editor.brush.follow_resolution, None, "textured: resolution does not follow the brush");
+    assert_eq!(editor.panels.paint.brush.follow_resolution, None, "textured: resolution does not follow the brush");
     open_and_wait(editor, &stl);
     assert!(resolutions(editor).iter().all(|r| r.get() == 1), "untextured: the lowest R");
-    assert!(editor.brush.follow_resolution.is_some(), "untextured: resolution follows the brush");
+    assert!(editor.panels.paint.brush.follow_resolution.is_some(), "untextured: resolution follows the brush");
 
-    editor.import.mode = ImportMode::Uniform;
-    editor.import.resolution = meshpaint_core::colors::layout::Resolution::new(4).unwrap();
+    editor.panels.import.mode = ImportMode::Uniform;
+    editor.panels.import.resolution = meshpaint_core::colors::layout::Resolution::new(4).unwrap();
     open_and_wait(editor, &stl);
     assert!(resolutions(editor).iter().all(|r| r.get() == 4), "uniform R is uniform, textured or not");
 
-    editor.import.mode = ImportMode::MatchTexture;
+    editor.panels.import.mode = ImportMode::MatchTexture;
     open_and_wait(editor, &duck);
-    let rule = ResolutionRule::TexelDensity { max: editor.import.max_resolution };
+    let rule = ResolutionRule::TexelDensity { max: editor.panels.import.max_resolution };
     let expected = Document::open_within(&duck, rule, &Budget::from_environment()).unwrap();
     assert_eq!(resolutions(editor), expected.store.face_resolutions());
 
     // "Samples ≤ N": the budget rule's resolutions, within N (BoxTextured: 12 faces, fast).
     let box_textured = workspace_path("assets/models/BoxTextured/BoxTextured.glb");
-    editor.import.mode = ImportMode::Budget;
-    editor.import.sample_budget = 600;
+    editor.panels.import.mode = ImportMode::Budget;
+    editor.panels.import.sample_budget = 600;
     open_and_wait(editor, &box_textured);
-    let rule = ResolutionRule::Budget { samples: 600, max: editor.import.max_resolution };
+    let rule = ResolutionRule::Budget { samples: 600, max: editor.panels.import.max_resolution };
     let expected = Document::open_within(&box_textured, rule, &Budget::from_environment()).unwrap();
     assert_eq!(resolutions(editor), expected.store.face_resolutions());
-    let samples = editor.document.as_ref().unwrap().document.store.sample_count();
+    let samples = editor.document.open.as_ref().unwrap().document.store.sample_count();
     assert!(samples <= 600 && samples > 386, "{samples} samples: within N, more than uniform R = 8's 386");
 }
 
@@ -767,12 +783,12 @@ fn editor_with_gpu_and_duck() -> Editor {
     let mut editor = Editor::new(Some(Arc::new(gpu)), Arc::new(|| {}));
     editor.open(Source::BuiltIn);
     assert!(editor.wait_for_job(JOB_TIMEOUT), "opening the Duck timed out");
-    assert!(editor.document.is_some(), "the Duck did not open: {:?}", editor.status);
+    assert!(editor.document.open.is_some(), "the Duck did not open: {:?}", editor.status);
     editor
 }
 
 /// "Show: Source texture" draws the UV-textured source and reports the PSNR of this view
-/// (the Duck at R = 8 looks like its texture: tests/gpu_render.rs measures a mean below 1
+/// (the Duck at R = 8 looks like its texture: tests/app/gpu_render.rs measures a mean below 1
 /// step at R = 16); "Position colours" draws a colour field, never the document's colours.
 #[test]
 fn the_view_compares_mesh_colors_with_the_source_texture_and_shows_the_psnr() {
@@ -787,13 +803,13 @@ fn the_view_compares_mesh_colors_with_the_source_texture_and_shows_the_psnr() {
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "building the source texture timed out");
     harness.run_steps(3);
     assert!(matches!(harness.state().shown_item(), Some(DrawItem::Baseline(_))), "{:?}", harness.state().status);
-    let psnr = match &harness.state().source_psnr {
+    let psnr = match &harness.state().panels.view.source_psnr {
         Some((_, Ok(db))) => *db,
         other => panic!("no PSNR measured: {other:?}"),
     };
     assert!(psnr > 25.0 && psnr.is_finite(), "Duck R = 8 vs its texture: {psnr} dB");
     harness.get_by_label_contains("PSNR");
-    let colors_before = harness.state().document.as_ref().unwrap().document.store.clone();
+    let colors_before = harness.state().document.open.as_ref().unwrap().document.store.clone();
     harness.get_by_label("Show:").click();
     harness.run_steps(2);
     harness.get_by_label("Position colours").click();
@@ -801,7 +817,7 @@ fn the_view_compares_mesh_colors_with_the_source_texture_and_shows_the_psnr() {
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "building the position colours timed out");
     harness.run_steps(2);
     let editor = harness.state();
-    let open = editor.document.as_ref().unwrap();
+    let open = editor.document.open.as_ref().unwrap();
     match (editor.shown_item(), open.gpu_mesh.as_ref()) {
         (Some(DrawItem::MeshColors(shown)), Some(own)) => assert!(!std::ptr::eq(shown, own), "a separate mesh"),
         _ => panic!("position colours are not shown"),
@@ -823,7 +839,7 @@ fn comparing_an_untextured_mesh_says_why_and_shows_the_mesh_colors() {
     open_and_wait(&mut editor, &workspace_path("assets/models/AssimpTestModels/sphereWithHole.stl"));
     let mut harness = harness(editor);
     harness.run_steps(2);
-    harness.state_mut().view.shown = meshpaint::app::state::Shown::SourceTexture;
+    harness.state_mut().panels.view.settings.shown = meshpaint::app::state::Shown::SourceTexture;
     harness.run_steps(2);
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
     harness.run_steps(2);

@@ -284,7 +284,7 @@ fn reference_view(file: &Path, size: (u32, u32)) -> RgbImage {
     editor.viewport.rect = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(size.0 as f32, size.1 as f32));
     editor.viewport.pixels_per_point = 1.0;
     editor.frame_all();
-    let open = editor.document.as_ref().expect("the reference document did not open");
+    let open = editor.document.open.as_ref().expect("the reference document did not open");
     let packed = open.document.pack(open.format).unwrap();
     let Gpu { ctx, renderer } = Gpu::create();
     let mesh = GpuMesh::upload(&ctx, renderer.layouts(), &packed, &MeshUploadOptions::default()).unwrap();
@@ -424,16 +424,14 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
         (broken_ply.to_str().unwrap(), "Could not open"),
     ] {
         let from = read_log(&log_path).len();
-        xdotool(&display, &["key", "ctrl+o"]);
-        pause(1.5);
-        xdotool(&display, &["key", "ctrl+a"]);
-        xdotool(&display, &["type", "--delay", "30", &workspace_path(file).display().to_string()]);
-        xdotool(&display, &["key", "Return"]);
+        type_into_dialog(&display, &log_path, "ctrl+o", &workspace_path(file), app!());
         wait_for_log(&log_path, needle, from, Duration::from_secs(60), app!());
-        pause(2.0);
-        let shot = screenshot(&display, &dir.join("mesh_format.png"));
-        // A longer document name can widen the side panel: the view's latest rectangle.
-        check_view_not_blank(&crop(&shot, view_rect(&read_log(&log_path))), needle);
+        // A longer document name can widen the side panel: the view's latest rectangle, once
+        // two screenshots in a row agree on a drawn view.
+        let latest = || view_rect(&read_log(&log_path));
+        let drawn = |shot: &RgbImage| view_drawn(shot, latest());
+        let shot = wait_for_screen(&display, &dir.join("mesh_format.png"), latest(), needle, &drawn, app!());
+        check_view_not_blank(&crop(&shot, latest()), needle);
     }
 
     // 5. Ctrl+Q quits cleanly.
