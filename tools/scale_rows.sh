@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Every row of the scale table (README "Benchmarks"): runs each `meshpaint bench …` command
+# Every row of the scale table (docs/BENCHMARKS.md): runs each `meshpaint bench …` command
 # once (`bench load` three times), on this machine, and prints the rows as a Markdown table,
 # with the raw JSON in DIR.
 #   tools/scale_rows.sh [BINARY] [DIR]
@@ -26,7 +26,7 @@ echo "binary: $bin" >&2
 [ -f "$out/duck1m.glb" ] || "$bin" export "$duck" -r 16 -o "$out/duck1m.glb" >/dev/null
 # Three opens back to back: on a VM that hands freed memory back to its host (virtio-balloon
 # free page reporting), the first open after other programs freed gigabytes waits for the
-# host to back its pages again (README, "Where the time goes where a goal is missed").
+# host to back its pages again (docs/BENCHMARKS.md, "Where the time goes where a goal is missed").
 for run in 1 2 3; do "$bin" bench load "$out/duck1m.glb" -r 8 >"$out/load_1m_$run.json"; done
 # Over the sample limit: refused before anything is allocated (time and peak memory).
 /usr/bin/time -f '%e %M' -o "$out/refuse.txt" "$bin" pack "$bunny" -r 64 -o "$out/never.mpk" 2>"$out/refuse.err" || true
