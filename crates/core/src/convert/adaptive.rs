@@ -577,7 +577,8 @@ struct FaceFit<'a> {
     /// The test lattice from the texture alone: twice the face's longest UV edge in
     /// texels (a power of two), at least 8, at most `2·max`.
     dense: u32,
-    /// Barycentrics of the test points of `dense` and the truth there.
+    /// Barycentrics of the test points of `dense` and the truth there, encoded as
+    /// [`difference`] compares it ([`encoded`]).
     points: Vec<([f32; 3], Rgba)>,
 }
 
@@ -614,7 +615,8 @@ impl<'a> FaceFit<'a> {
     }
 
     /// The centroids of the `dense²` sub-triangles of a lattice `dense` and the truth there
-    /// (the texture's level 0 read bilinearly, times the factor).
+    /// (the texture's level 0 read bilinearly, times the factor), [`encoded`] once here
+    /// rather than at every resolution a face is tried at.
     fn test_points(&self, dense: u32) -> Vec<([f32; 3], Rgba)> {
         let material = self.material;
         let level0 = material
@@ -626,7 +628,7 @@ impl<'a> FaceFit<'a> {
             .map(|bary| {
                 let uv = interpolate_uv(self.uvs, bary);
                 let texel = level0.map_or([1.0; 4], |level| level.sample_bilinear(uv));
-                (bary, std::array::from_fn(|c| material.factor[c] * texel[c]))
+                (bary, encoded(std::array::from_fn(|c| material.factor[c] * texel[c])))
             })
             .collect()
     }
@@ -726,14 +728,14 @@ impl<'a> FaceFit<'a> {
     }
 }
 
-/// Squared differences summed over the channels: RGB of the sRGB-encoded colours (module
-/// docs), alpha as is.
+/// A colour as the error compares it: RGB sRGB-encoded (module docs), alpha as is.
+fn encoded(color: Rgba) -> Rgba {
+    [linear_to_srgb(color[0]), linear_to_srgb(color[1]), linear_to_srgb(color[2]), color[3]]
+}
+
+/// Squared differences summed over the channels of `shown` [`encoded`] and `truth`, already
+/// encoded.
 fn difference(shown: Rgba, truth: Rgba) -> f64 {
-    (0..4)
-        .map(|c| {
-            let (a, b) =
-                if c < 3 { (linear_to_srgb(shown[c]), linear_to_srgb(truth[c])) } else { (shown[c], truth[c]) };
-            f64::from(a - b).powi(2)
-        })
-        .sum()
+    let shown = encoded(shown);
+    (0..4).map(|c| f64::from(shown[c] - truth[c]).powi(2)).sum()
 }

@@ -55,11 +55,9 @@ pub struct MipLevel {
 }
 
 impl MipLevel {
-    /// The texel at `(x, y)` with `REPEAT` wrapping.
+    /// The texel at `(x, y)`, both already wrapped into the level.
     fn texel(&self, x: i64, y: i64) -> Rgba {
-        let x = x.rem_euclid(i64::from(self.width)) as usize;
-        let y = y.rem_euclid(i64::from(self.height)) as usize;
-        self.texels.get(y * self.width as usize + x).copied().unwrap_or([0.0; 4])
+        self.texels.get(y as usize * self.width as usize + x as usize).copied().unwrap_or([0.0; 4])
     }
 
     /// Bilinear sample at `uv` (glTF convention, `REPEAT`).
@@ -68,7 +66,12 @@ impl MipLevel {
         let y = f64::from(uv[1]) * f64::from(self.height) - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-        let (x0, y0) = (x0 as i64, y0 as i64);
+        // The two columns and rows, wrapped once (`REPEAT`): one division per axis, not one
+        // per texel read.
+        let (w, h) = (i64::from(self.width), i64::from(self.height));
+        let (x0, y0) = ((x0 as i64).rem_euclid(w), (y0 as i64).rem_euclid(h));
+        let columns = [x0, if x0 + 1 == w { 0 } else { x0 + 1 }];
+        let rows = [y0, if y0 + 1 == h { 0 } else { y0 + 1 }];
         let mut out = [0.0; 4];
         for (dx, dy, weight) in
             [(0, 0, (1.0 - fx) * (1.0 - fy)), (1, 0, fx * (1.0 - fy)), (0, 1, (1.0 - fx) * fy), (1, 1, fx * fy)]
@@ -76,7 +79,7 @@ impl MipLevel {
             if weight == 0.0 {
                 continue;
             }
-            let texel = self.texel(x0 + dx, y0 + dy);
+            let texel = self.texel(columns[dx], rows[dy]);
             add_scaled(&mut out, weight, texel);
         }
         out
