@@ -202,6 +202,17 @@ fn death(status: ExitStatus, stderr: &str, memory_mb: u64) -> (&'static str, Str
 }
 
 impl Report {
+    /// A report of `campaign` with nothing run yet.
+    fn empty(campaign: &Campaign) -> Report {
+        Report {
+            campaign: campaign.clone(),
+            crashes: BTreeMap::new(),
+            outcomes: BTreeMap::new(),
+            elapsed: Duration::ZERO,
+            workers: 0,
+        }
+    }
+
     fn record(&mut self, corpus: &Corpus, index: u64, kind: &'static str, message: String) {
         if self.crashes.contains_key(&index) {
             return;
@@ -277,13 +288,7 @@ pub fn run(campaign: &Campaign, spawn: &(dyn Fn(&WorkerArgs) -> Command + Sync))
             .map(|h| h.join().unwrap_or_else(|_| Err(std::io::Error::other("a shard panicked"))))
             .collect()
     });
-    let mut report = Report {
-        campaign: campaign.clone(),
-        crashes: BTreeMap::new(),
-        outcomes: BTreeMap::new(),
-        elapsed: Duration::ZERO,
-        workers: 0,
-    };
+    let mut report = Report::empty(campaign);
     for shard in results {
         let shard = shard?;
         report.crashes.extend(shard.crashes);
@@ -306,13 +311,7 @@ fn run_shard(
     spawn: &(dyn Fn(&WorkerArgs) -> Command + Sync),
 ) -> std::io::Result<Report> {
     let corpus = Corpus::new(campaign.target, &campaign.models);
-    let mut report = Report {
-        campaign: campaign.clone(),
-        crashes: BTreeMap::new(),
-        outcomes: BTreeMap::new(),
-        elapsed: Duration::ZERO,
-        workers: 0,
-    };
+    let mut report = Report::empty(campaign);
     let mut next = start;
     let args = |start: u64, verbose: bool| WorkerArgs {
         target: campaign.target,
