@@ -49,6 +49,7 @@ pub mod camera;
 pub mod colors;
 pub mod convert;
 pub mod io;
+pub mod mct;
 pub mod memory;
 pub mod mesh;
 pub mod packing;

@@ -11,6 +11,7 @@ mod fuzz;
 mod import;
 mod layout;
 mod least_squares;
+mod mct;
 mod occlusion;
 mod optimize;
 mod packed_file;

@@ -1,0 +1,482 @@
+//! Where every face's texel block lies in the Mesh Color Texture atlas.
+//!
+//! Faces are grouped by their *block resolution* `R_b = max(R_f, R_e of its three edges)`
+//! (the talk's "two resolutions per face": content at `R_f`, block at `R_b`, so the finer
+//! side of a mixed edge keeps all its samples), and paired with a neighbour of the same
+//! `R_b` across a manifold edge `p → q` (greedy, in face order). A pair is laid out
+//!
+//! - at **level 0** as a *tent*: both faces are right triangles whose right angle is `p`,
+//!   sharing the leg `p → q` (one column of texels: the edge's colours stored once). Each
+//!   face's hypotenuse is followed by a *ring* of interpolated texels
+//!   `c₃ = c₁ + c₂ − c₀`, which makes hardware bilinear filtering across the hypotenuse
+//!   cells equal mesh colors' linear filter along that edge. Tents alternate up and down
+//!   so their rings interlock: a row of height `R_b + 1` holds two pairs every
+//!   `2R_b + 6` texels, 1 texel per face unused;
+//! - at **levels ≥ 1** as a *square* of `(r + 1)²` texels, `r = R_b >> level`, the two
+//!   faces sharing its diagonal `p → q` (no ring: the diagonal is read from the same
+//!   texels by both faces, so it is continuous, but it is the bilinear patch of the
+//!   square's cells there rather than the linear interpolation of the edge; measured).
+//!
+//! A face without a partner takes a tent or square alone, with its ring. Every group and
+//! level is a full-width band of block rows in one atlas: level-0 bands first, then the
+//! bands of levels 1, 2, ... A face record (`u32`) and the band table ([`MctBands`]) are all
+//! a shader needs to place a face's corners at any level.
+
+use crate::colors::layout::MAX_LOG2_RESOLUTION;
+use crate::mct::MctError;
+use crate::packing::linear::PackedMesh;
+use rayon::prelude::*;
+
+/// Number of block-resolution groups (`log2 R_b` = 0..=12) and of levels per group.
+pub const GROUPS: usize = MAX_LOG2_RESOLUTION as usize + 1;
+
+/// Largest pair index a face record holds (24 bits).
+pub const MAX_PAIRS_PER_GROUP: u32 = 1 << 24;
+
+/// One face's placement in a `u32` (keep in sync with `mct_record_*` in
+/// crates/render/shaders/mct.wgsl):
+///
+/// | bits | field |
+/// |---|---|
+/// | 0–1 | corner of `p` (0, 1, 2) |
+/// | 2 | `q` is the corner after `p` (1) or before it (0) |
+/// | 3 | side: 0 = first face of its pair, 1 = second |
+/// | 4–7 | `log2 R_b` |
+/// | 8–31 | pair index within the group |
+#[repr(transparent)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct MctFaceRecord(pub u32);
+
+const _: () = assert!(std::mem::size_of::<MctFaceRecord>() == 4);
+
+impl MctFaceRecord {
+    /// Packs the fields; `pair < MAX_PAIRS_PER_GROUP`, `corner_p < 3`, `log2_block <= 12`.
+    pub fn new(corner_p: u32, q_next: bool, second: bool, log2_block: u32, pair: u32) -> Self {
+        MctFaceRecord(
+            (corner_p & 3)
+                | (u32::from(q_next) << 2)
+                | (u32::from(second) << 3)
+                | ((log2_block & 15) << 4)
+                | (pair << 8),
+        )
+    }
+    /// The corner of the shared edge's start `p`.
+    pub fn corner_p(self) -> usize {
+        (self.0 & 3) as usize
+    }
+    /// The corner of the shared edge's end `q`.
+    pub fn corner_q(self) -> usize {
+        (self.corner_p() + if self.0 & 4 != 0 { 1 } else { 2 }) % 3
+    }
+    /// The corner opposite the shared edge.
+    pub fn corner_third(self) -> usize {
+        3 - self.corner_p() - self.corner_q()
+    }
+    /// Whether the face is the second of its pair.
+    pub fn second(self) -> bool {
+        self.0 & 8 != 0
+    }
+    /// `log2 R_b`.
+    pub fn log2_block(self) -> u32 {
+        (self.0 >> 4) & 15
+    }
+    /// The pair's index within its group.
+    pub fn pair(self) -> u32 {
+        self.0 >> 8
+    }
+}
+
+/// Where the band of group `g` (`log2 R_b`) at `level` starts and how many blocks a row
+/// holds: `[y, per_row, 0, 0]` at index `g · GROUPS + level` (level 0: tent *periods*
+/// per row, two pairs each; levels ≥ 1: squares per row). Keep in sync with `MctBands`
+/// in crates/render/shaders/mct.wgsl (a uniform array of 169 `vec4<u32>`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct MctBands {
+    /// `[y, per_row, 0, 0]` per group and level.
+    pub bands: [[u32; 4]; GROUPS * GROUPS],
+}
+
+const _: () = assert!(std::mem::size_of::<MctBands>() == 2704);
+
+impl Default for MctBands {
+    fn default() -> Self {
+        MctBands { bands: [[0; 4]; GROUPS * GROUPS] }
+    }
+}
+
+impl MctBands {
+    /// `(y, per_row)` of group `log2_block` at `level`.
+    pub fn band(&self, log2_block: u32, level: u32) -> (u32, u32) {
+        let b = self.bands[log2_block as usize * GROUPS + level as usize];
+        (b[0], b[1])
+    }
+}
+
+/// A texel block's frame: the texel of the face's right-angle corner and the texel steps
+/// of its two legs. Lattice point `(α, β)` (`α + β <= r`) is texel `origin + α·ex + β·ey`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BlockFrame {
+    /// Texel of the right-angle corner.
+    pub origin: [i64; 2],
+    /// Texel step along the `α` leg.
+    pub ex: [i64; 2],
+    /// Texel step along the `β` leg.
+    pub ey: [i64; 2],
+    /// Face corners at the right angle, at the end of the `α` leg and of the `β` leg.
+    pub corners: [usize; 3],
+    /// Resolution of the block at this level.
+    pub r: u32,
+}
+
+impl BlockFrame {
+    /// The texel-space point (texel centres at integers) of barycentric `w` (face corner order).
+    pub fn point(&self, w: [f32; 3]) -> [f32; 2] {
+        let r = self.r as f32;
+        let (a, b) = (r * w[self.corners[1]], r * w[self.corners[2]]);
+        std::array::from_fn(|c| self.origin[c] as f32 + a * self.ex[c] as f32 + b * self.ey[c] as f32)
+    }
+    /// The texel of lattice point `(α, β)`.
+    pub fn texel(&self, alpha: u32, beta: u32) -> [i64; 2] {
+        std::array::from_fn(|c| self.origin[c] + i64::from(alpha) * self.ex[c] + i64::from(beta) * self.ey[c])
+    }
+}
+
+/// The atlas layout of a mesh: one record per face, the band table and the atlas size.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MctLayout {
+    /// One record per face.
+    pub records: Vec<MctFaceRecord>,
+    /// Band of every group and level.
+    pub bands: MctBands,
+    /// Atlas width in texels.
+    pub width: u32,
+    /// Atlas height in texels.
+    pub height: u32,
+    /// Faces of each pair (`[first, second]`, `second == u32::MAX` for a lone face), per group.
+    pub pairs: Vec<Vec<[u32; 2]>>,
+    /// MIP levels of every face: the packed mesh's vertex levels (`1 + log2 max R`), so a
+    /// coarse face keeps following its vertices' chains as far as its finer neighbours
+    /// (blocks of resolution 1 past `log2 R_b`).
+    pub levels: u32,
+}
+
+/// Width in texels a level-0 row of `periods` tent periods of resolution `r` needs.
+fn tent_row_width(r: u64, periods: u64) -> u64 {
+    periods * (2 * r + 6) + r
+}
+
+impl MctLayout {
+    /// Lays out `packed`'s faces in an atlas at most `max_dimension` texels wide and high.
+    ///
+    /// Fails before allocating anything atlas-sized when a face record is unreadable, a
+    /// group has more than [`MAX_PAIRS_PER_GROUP`] pairs, or the atlas would not fit.
+    pub fn new(packed: &PackedMesh, max_dimension: u32) -> Result<MctLayout, MctError> {
+        let log2_blocks = block_resolutions(packed)?;
+        let pairs = pair_faces(packed, &log2_blocks);
+        for (g, list) in pairs.iter().enumerate() {
+            if list.len() as u64 >= u64::from(MAX_PAIRS_PER_GROUP) {
+                return Err(MctError::TooManyFaces { resolution: 1 << g, pairs: list.len() as u64 });
+            }
+        }
+        let counts: Vec<u64> = pairs.iter().map(|p| p.len() as u64).collect();
+        let levels = packed.vertex_levels.clamp(1, GROUPS as u32);
+        let width = choose_width(&counts, levels, max_dimension)?;
+        let (bands, y) = place_bands(&counts, levels, width);
+        check_height(y, max_dimension, width)?;
+        let mut records = vec![MctFaceRecord::default(); packed.indices.len()];
+        for (g, list) in pairs.iter().enumerate() {
+            for (index, pair) in list.iter().enumerate() {
+                assign_records(packed, &mut records, g as u32, index as u32, *pair);
+            }
+        }
+        Ok(MctLayout { records, bands, width, height: y.max(1) as u32, pairs, levels })
+    }
+
+    /// The frame of `face`'s block at `level` (clamped to the last level
+    /// `levels − 1`), or `None` for a face that does not exist.
+    pub fn frame(&self, face: u32, level: u32) -> Option<BlockFrame> {
+        let record = *self.records.get(face as usize)?;
+        Some(frame_of(record, &self.bands, level.min(self.levels - 1)))
+    }
+
+    /// Texels in the atlas.
+    pub fn texel_count(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height)
+    }
+}
+
+/// [`MctLayout::frame`] from a record and the band table (the shader's arithmetic);
+/// `level` must be below the layout's `levels`. Past `log2 R_b` the block has resolution 1.
+pub fn frame_of(record: MctFaceRecord, bands: &MctBands, level: u32) -> BlockFrame {
+    let g = record.log2_block();
+    let level = level.min(GROUPS as u32 - 1);
+    let pair = u64::from(record.pair());
+    let (band_y, per_row) = bands.band(g, level);
+    let (band_y, per_row) = (i64::from(band_y), u64::from(per_row.max(1)));
+    let (p, q, t) = (record.corner_p(), record.corner_q(), record.corner_third());
+    let r = 1i64 << g.saturating_sub(level);
+    if level == 0 {
+        // Tent: right angle at p, α leg towards the third corner (±x), β leg towards q (±y).
+        let period = pair / 2;
+        let (row, col) = ((period / per_row) as i64, (period % per_row) as i64);
+        let base_x = col * (2 * r + 6);
+        let top = band_y + row * (r + 1);
+        let up = pair % 2 == 0;
+        let (xc, yb, dy) = if up { (base_x + r + 1, top, 1) } else { (base_x + 2 * r + 4, top + r, -1) };
+        let dx = if record.second() { -1 } else { 1 };
+        BlockFrame { origin: [xc, yb], ex: [dx, 0], ey: [0, dy], corners: [p, t, q], r: r as u32 }
+    } else {
+        // Square: the first face's right angle (its third corner) at the square's origin,
+        // p at (r, 0), q at (0, r); the second face's at (r, r).
+        let side = r + 1;
+        let (row, col) = ((pair / per_row) as i64, (pair % per_row) as i64);
+        let (x0, y0) = (col * side, band_y + row * side);
+        if record.second() {
+            BlockFrame { origin: [x0 + r, y0 + r], ex: [0, -1], ey: [-1, 0], corners: [t, p, q], r: r as u32 }
+        } else {
+            BlockFrame { origin: [x0, y0], ex: [1, 0], ey: [0, 1], corners: [t, p, q], r: r as u32 }
+        }
+    }
+}
+
+fn check_height(height: u64, max_dimension: u32, width: u32) -> Result<(), MctError> {
+    if height > u64::from(max_dimension) {
+        return Err(MctError::AtlasTooLarge { width, height, max_dimension });
+    }
+    Ok(())
+}
+
+/// `log2 R_b` of every face.
+fn block_resolutions(packed: &PackedMesh) -> Result<Vec<u8>, MctError> {
+    packed
+        .face_records
+        .par_iter()
+        .enumerate()
+        .map(|(face, record)| {
+            let mut log2 = record.resolution().ok_or(MctError::BadRecord { face: face as u32 })?.log2();
+            for k in 0..3 {
+                log2 = log2.max(record.edge(k).ok_or(MctError::BadRecord { face: face as u32 })?.1.log2());
+            }
+            Ok(log2 as u8)
+        })
+        .collect()
+}
+
+/// Pairs every face with an unpaired neighbour of the same `R_b` across a manifold edge,
+/// greedily in face order; lists per group.
+fn pair_faces(packed: &PackedMesh, log2_blocks: &[u8]) -> Vec<Vec<[u32; 2]>> {
+    // Half-edges (lo, hi, face) sorted, so the faces of an edge are adjacent.
+    let mut half: Vec<(u64, u32)> = packed
+        .indices
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(face, c)| {
+            (0..3).filter_map(move |k| {
+                let (a, b) = (c[k], c[(k + 1) % 3]);
+                (a != b).then(|| ((u64::from(a.min(b)) << 32) | u64::from(a.max(b)), face as u32))
+            })
+        })
+        .collect();
+    half.par_sort_unstable();
+    // Neighbour across each manifold edge, per face (up to 3).
+    let mut neighbours = vec![[u32::MAX; 3]; packed.indices.len()];
+    let mut start = 0;
+    while start < half.len() {
+        let mut end = start + 1;
+        while end < half.len() && half[end].0 == half[start].0 {
+            end += 1;
+        }
+        if end - start == 2 {
+            let (f, g) = (half[start].1, half[start + 1].1);
+            if f != g {
+                push_neighbour(&mut neighbours[f as usize], g);
+                push_neighbour(&mut neighbours[g as usize], f);
+            }
+        }
+        start = end;
+    }
+    // Only neighbours of the same block resolution can share a block.
+    for (face, slots) in neighbours.iter_mut().enumerate() {
+        for slot in slots.iter_mut() {
+            if *slot != u32::MAX && log2_blocks[*slot as usize] != log2_blocks[face] {
+                *slot = u32::MAX;
+            }
+        }
+    }
+    let mate = maximal_matching(&neighbours);
+    let mut pairs = vec![Vec::new(); GROUPS];
+    for (face, &m) in mate.iter().enumerate() {
+        if m == u32::MAX || (face as u32) < m {
+            pairs[usize::from(log2_blocks[face])].push([face as u32, m]);
+        }
+    }
+    pairs
+}
+
+/// A near-maximum matching of the faces' dual graph (degree ≤ 3): greedy by fewest
+/// unmatched neighbours first (a face with one candidate left takes it before a neighbour
+/// with more choices steals it), then augmenting paths `u – v = w – x` that turn two
+/// unmatched faces and one pair into two pairs. Returns each face's mate or `u32::MAX`.
+fn maximal_matching(neighbours: &[[u32; 3]]) -> Vec<u32> {
+    let n = neighbours.len();
+    let mut mate = vec![u32::MAX; n];
+    let free = |mate: &[u32], f: u32| f != u32::MAX && mate[f as usize] == u32::MAX;
+    let degree = |mate: &[u32], f: usize| neighbours[f].iter().filter(|&&g| free(mate, g)).count();
+    let mut buckets: [Vec<u32>; 4] = Default::default();
+    for f in 0..n {
+        buckets[degree(&mate, f)].push(f as u32);
+    }
+    loop {
+        // The unmatched face of smallest positive degree (stale entries skipped).
+        let mut picked = None;
+        for d in 1..4 {
+            while let Some(f) = buckets[d].pop() {
+                if mate[f as usize] != u32::MAX {
+                    continue;
+                }
+                let now = degree(&mate, f as usize);
+                if now == d {
+                    picked = Some(f);
+                    break;
+                }
+                if now > 0 {
+                    buckets[now].push(f);
+                }
+            }
+            if picked.is_some() {
+                break;
+            }
+        }
+        let Some(f) = picked else { break };
+        let partner = neighbours[f as usize]
+            .iter()
+            .copied()
+            .filter(|&g| g != f && free(&mate, g))
+            .min_by_key(|&g| degree(&mate, g as usize));
+        let Some(g) = partner else { continue };
+        mate[f as usize] = g;
+        mate[g as usize] = f;
+        for h in neighbours[f as usize].into_iter().chain(neighbours[g as usize]) {
+            if free(&mate, h) {
+                let d = degree(&mate, h as usize);
+                buckets[d].push(h);
+            }
+        }
+    }
+    // Augmenting paths of length 3.
+    for u in 0..n as u32 {
+        if mate[u as usize] != u32::MAX {
+            continue;
+        }
+        'search: for v in neighbours[u as usize] {
+            if v == u32::MAX || v == u {
+                continue;
+            }
+            let w = mate[v as usize];
+            if w == u32::MAX {
+                continue;
+            }
+            for x in neighbours[w as usize] {
+                if x != u && x != v && free(&mate, x) {
+                    mate[u as usize] = v;
+                    mate[v as usize] = u;
+                    mate[w as usize] = x;
+                    mate[x as usize] = w;
+                    break 'search;
+                }
+            }
+        }
+    }
+    mate
+}
+
+fn push_neighbour(slots: &mut [u32; 3], face: u32) {
+    if let Some(slot) = slots.iter_mut().find(|s| **s == u32::MAX) {
+        *slot = face;
+    }
+}
+
+/// Writes the records of pair `index` of group `g`.
+fn assign_records(packed: &PackedMesh, records: &mut [MctFaceRecord], g: u32, index: u32, pair: [u32; 2]) {
+    let [first, second] = pair;
+    let corners = packed.indices[first as usize];
+    // The shared edge p → q as the first face walks it (corners 0 → 1 for a lone face).
+    let (kp, kq) = if second == u32::MAX {
+        (0, 1)
+    } else {
+        let other = packed.indices[second as usize];
+        (0..3)
+            .map(|k| (k, (k + 1) % 3))
+            .find(|&(a, b)| other.contains(&corners[a]) && other.contains(&corners[b]))
+            .unwrap_or((0, 1))
+    };
+    records[first as usize] = MctFaceRecord::new(kp as u32, kq == (kp + 1) % 3, false, g, index);
+    if second != u32::MAX {
+        let other = packed.indices[second as usize];
+        let find = |v: u32| other.iter().position(|&c| c == v).unwrap_or(0);
+        let (op, oq) = (find(corners[kp]), find(corners[kq]));
+        records[second as usize] = MctFaceRecord::new(op as u32, oq == (op + 1) % 3, true, g, index);
+    }
+}
+
+/// The band of every group and level at atlas width `width` (which must hold the widest
+/// group's tent row), and the atlas height.
+fn place_bands(counts: &[u64], levels: u32, width: u32) -> (MctBands, u64) {
+    let mut bands = MctBands::default();
+    let mut y = 0u64;
+    // Level 0: tents, groups from the finest down.
+    for g in (0..GROUPS).rev() {
+        if counts[g] == 0 {
+            continue;
+        }
+        let r = 1u64 << g;
+        let periods = ((u64::from(width) - r) / (2 * r + 6)).max(1);
+        bands.bands[g * GROUPS] = [y as u32, periods as u32, 0, 0];
+        y += counts[g].div_ceil(2 * periods) * (r + 1);
+    }
+    // Levels ≥ 1: squares, down to the last vertex level for every group.
+    for level in 1..levels as usize {
+        for g in (0..GROUPS).rev() {
+            if counts[g] == 0 {
+                continue;
+            }
+            let side = (1u64 << g.saturating_sub(level)) + 1;
+            let per_row = u64::from(width) / side;
+            bands.bands[g * GROUPS + level] = [y as u32, per_row as u32, 0, 0];
+            y += counts[g].div_ceil(per_row) * side;
+        }
+    }
+    (bands, y)
+}
+
+/// The atlas width of least area (ties: the squarer) among the widths that hold the widest
+/// group's tent row and keep both sides within `max_dimension`.
+fn choose_width(counts: &[u64], levels: u32, max_dimension: u32) -> Result<u32, MctError> {
+    let widest = (0..GROUPS).filter(|&g| counts[g] > 0).map(|g| tent_row_width(1 << g, 1)).max().unwrap_or(1);
+    if widest > u64::from(max_dimension) {
+        return Err(MctError::AtlasTooLarge { width: widest as u32, height: 0, max_dimension });
+    }
+    let mut best: Option<(u64, u64, u32)> = None;
+    let mut width = widest;
+    while width <= u64::from(max_dimension) {
+        let (_, height) = place_bands(counts, levels, width as u32);
+        if height <= u64::from(max_dimension) {
+            let key = (width * height.max(1), width.abs_diff(height));
+            if best.is_none_or(|(area, skew, _)| key < (area, skew)) {
+                best = Some((key.0, key.1, width as u32));
+            }
+        }
+        if height < width / 2 {
+            break;
+        }
+        width += 1;
+    }
+    match best {
+        Some((_, _, width)) => Ok(width),
+        None => {
+            let (_, height) = place_bands(counts, levels, max_dimension);
+            Err(MctError::AtlasTooLarge { width: max_dimension, height, max_dimension })
+        }
+    }
+}
