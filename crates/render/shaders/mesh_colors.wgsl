@@ -25,8 +25,9 @@
 // `index` is texel (index % W, index / W). Rgba8 sRGB samples are decoded to linear by
 // the hardware on textureLoad; 16F and 32F samples are linear already.
 
-// `FrameUniforms` (the uniform block `u`), the `FLAG_*` bits and `wireframe_overlay` are in
-// shaders/frame.wgsl, which the renderer prepends to this file.
+// `FrameUniforms`, the `FLAG_*` bits and `wireframe_overlay` are in shaders/frame.wgsl; the
+// uniform block `u`, the geometry data textures, the level of detail, `pull_corner` and
+// `finish_fragment` in shaders/mesh_common.wgsl. The renderer prepends both to this file.
 
 // Pipeline constants, set by the renderer from `FilterMode::uniform_fields` (keep in sync
 // with `MESH_PIPELINE_KEYS` in crates/render/src/renderer.rs): 0 = nearest, 1 = linear.
@@ -38,28 +39,10 @@ const LOG2_SHIFT: u32 = 28u;
 const BASE_MASK: u32 = 0x0fffffffu;
 const MAX_LOG2_RESOLUTION: u32 = 12u;
 
-// Data textures: entry k is texel (k % 2^MESH_DATA_WIDTH_LOG2, k >> MESH_DATA_WIDTH_LOG2).
-// Keep in sync with `MESH_DATA_WIDTH` in crates/render/src/mesh_gpu.rs.
-const MESH_DATA_WIDTH_LOG2: u32 = 12u;
-
-@group(0) @binding(0) var<uniform> u: FrameUniforms;
-// (x, y, z, 0) of each vertex, relative to the render origin.
-@group(0) @binding(1) var positions: texture_2d<f32>;
-// (c0, c1, c2, 0) of each face.
-@group(0) @binding(2) var indices: texture_2d<u32>;
 // Keep in sync with `FaceRecord` in src/packed.rs: (interior, edge0, edge1, edge2),
 // each word `base | log2 << 28`.
 @group(0) @binding(3) var face_records: texture_2d<u32>;
 @group(0) @binding(4) var atlas: texture_2d<f32>;
-// (nx, ny, nz, 0) of each vertex: the unit area-weighted normal (Rgba16Float), and the
-// vertex's sample density in `positions.w` — the trilinear level of detail's inputs
-// (keep in sync with `VertexLod` in crates/core/src/packing/lod.rs).
-@group(0) @binding(5) var normals: texture_2d<f32>;
-
-// Keep in sync with `MIN_COSINE` and `LOD_TERM_LIMIT` in crates/core/src/packing/lod.rs.
-const LOD_MIN_COSINE: f32 = 0.0625;
-const LOD_TERM_LIMIT: f32 = 64.0;
-
 // Per-face addressing at one requested MIP level L: the colour-buffer index of every
 // lattice point (i, j) of resolution `r` follows from these (see `sample_index`). Every
 // shared element is read at a level that does not depend on the face reading it
@@ -109,47 +92,6 @@ struct VertexOut {
     @location(4) lod: vec2<f32>,
     // FLAG_SMOOTH: dot(corner normal, light direction), interpolated (Gouraud).
     @location(5) light_dot: f32,
-}
-
-// Smooth shading's crease: a corner takes its vertex's area-weighted normal when that is
-// within 45° of the face normal, else the face normal (a cube's corners, 54.7° away, stay
-// sharp; the faces of a sphere blend). Keep in sync with `SMOOTH_CREASE_COSINE` in
-// crates/core/src/mesh/normals.rs (crates/render/tests/gpu/shaders.rs compares them).
-const SMOOTH_CREASE_COSINE: f32 = 0.70710677;
-
-fn data_texel(k: u32) -> vec2<u32> {
-    return vec2<u32>(k & ((1u << MESH_DATA_WIDTH_LOG2) - 1u), k >> MESH_DATA_WIDTH_LOG2);
-}
-
-fn face_corners(face: u32) -> vec3<u32> {
-    let f = min(face, max(u.face_count, 1u) - 1u);
-    let last = max(u.vertex_count, 1u) - 1u;
-    return min(textureLoad(indices, data_texel(f), 0).xyz, vec3<u32>(last));
-}
-
-// The per-vertex term μ of the level of detail (crates/core/src/packing/lod.rs): log2 of the pixel's
-// footprint at unit depth, stretched by 1 / |n · v̂| on surfaces seen at a grazing angle,
-// in samples (times the vertex's sample density), clamped to ±LOD_TERM_LIMIT.
-fn lod_term(v: u32, p: vec3<f32>) -> f32 {
-    let density = textureLoad(positions, data_texel(v), 0).w;
-    let n = textureLoad(normals, data_texel(v), 0).xyz;
-    let to_eye = u.lod_eye.xyz - p;
-    let distance = length(to_eye);
-    let cosine = select(0.0, abs(dot(n, to_eye)) / distance, distance > 0.0);
-    let term = log2(u.lod_eye.w * density / max(cosine, LOD_MIN_COSINE));
-    return clamp(select(term, -LOD_TERM_LIMIT, is_nan(term)), -LOD_TERM_LIMIT, LOD_TERM_LIMIT);
-}
-
-fn load_position(v: u32) -> vec3<f32> {
-    return textureLoad(positions, data_texel(v), 0).xyz;
-}
-
-fn is_finite(x: f32) -> bool {
-    return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
-}
-
-fn is_nan(x: f32) -> bool {
-    return (bitcast<u32>(x) & 0x7fffffffu) > 0x7f800000u;
 }
 
 // layout::edge_level_offset: 2R − 2(R >> level) − level.
@@ -249,55 +191,12 @@ fn unpack_face(a: vec4<u32>, b: vec4<u32>) -> FaceData {
     return f;
 }
 
-// Resolution heat map: a ramp over log2 R = 0..12 (dark blue, blue, cyan, green, yellow,
-// orange, magenta at 0, 2, 4, …, 12, mixed in sRGB), tabulated in linear RGB.
-fn heat_color(log2_r: u32) -> vec3<f32> {
-    var table = array<vec3<f32>, 13>(
-        vec3<f32>(0.0100228, 0.0100228, 0.1706449),
-        vec3<f32>(0.0143499, 0.0508761, 0.4479884),
-        vec3<f32>(0.0196066, 0.1328683, 0.8900055),
-        vec3<f32>(0.0065714, 0.3485102, 0.8377929),
-        vec3<f32>(0.0000000, 0.6920712, 0.7874123),
-        vec3<f32>(0.0100228, 0.6920712, 0.2901425),
-        vec3<f32>(0.0331048, 0.6920712, 0.0508761),
-        vec3<f32>(0.3069994, 0.7388448, 0.0331048),
-        vec3<f32>(0.9551046, 0.7874123, 0.0196066),
-        vec3<f32>(0.9551046, 0.4132082, 0.0125104),
-        vec3<f32>(0.9551046, 0.1706449, 0.0071944),
-        vec3<f32>(0.8688995, 0.0732390, 0.1259674),
-        vec3<f32>(0.7874123, 0.0196066, 0.4479884),
-    );
-    return table[min(log2_r, 12u)];
-}
-
 @vertex
 fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
     let face = vertex_index / 3u;
     let corner = vertex_index % 3u;
-    let c = face_corners(face);
-    let p0 = load_position(c.x);
-    let p1 = load_position(c.y);
-    let p2 = load_position(c.z);
-    var p = p0;
-    var v = c.x;
-    var bary = vec3<f32>(1.0, 0.0, 0.0);
-    if corner == 1u {
-        p = p1;
-        v = c.y;
-        bary = vec3<f32>(0.0, 1.0, 0.0);
-    } else if corner == 2u {
-        p = p2;
-        v = c.z;
-        bary = vec3<f32>(0.0, 0.0, 1.0);
-    }
-    // Face normal from the three positions (counter-clockwise front); a degenerate
-    // face gets +Z instead of NaN.
-    let n = cross(p1 - p0, p2 - p0);
-    let len = length(n);
-    var normal = vec3<f32>(0.0, 0.0, 1.0);
-    if len > 0.0 && is_finite(len) {
-        normal = n / len;
-    }
+    let pulled = pull_corner(face, corner, LEVEL_MODE == 1u);
+    let c = pulled.corners;
     let f = face_data(face, c);
     var packed: array<vec4<u32>, 2>;
     if LEVEL_MODE == 1u {
@@ -306,24 +205,11 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
         packed = pack_level(f, level_data(f, u.level));
     }
     var out: VertexOut;
-    out.clip = u.clip_from_world * vec4<f32>(p, 1.0);
-    out.bary = bary;
-    out.lod = vec2<f32>(0.0);
-    if LEVEL_MODE == 1u {
-        out.lod = vec2<f32>(out.clip.w, lod_term(v, p));
-    }
-    // The fragment stage flips the sign for back faces: dot(−n, l) = −dot(n, l) exactly.
-    out.shade = vec4<f32>(heat_color(f.log2_f), dot(normal, u.light.xyz));
-    out.light_dot = out.shade.w;
-    if (u.flags & FLAG_SMOOTH) != 0u {
-        // The vertex normal is stored in f16; it is renormalised here. A face wound against
-        // its neighbours (mixed winding) sees it more than 45° away and stays flat.
-        let vn = textureLoad(normals, data_texel(v), 0).xyz;
-        let vn_len = length(vn);
-        if vn_len > 0.0 && dot(vn, normal) >= SMOOTH_CREASE_COSINE * vn_len {
-            out.light_dot = dot(vn / vn_len, u.light.xyz);
-        }
-    }
+    out.clip = pulled.clip;
+    out.bary = pulled.bary;
+    out.lod = pulled.lod;
+    out.shade = vec4<f32>(heat_color(f.log2_f), pulled.face_dot);
+    out.light_dot = pulled.light_dot;
     out.face0 = packed[0];
     out.face1 = packed[1];
     return out;
@@ -525,19 +411,5 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
         color = sample_level(unpack_level(in.face0, in.face1), bary);
     }
 
-    var rgb = color.rgb * u.tint.rgb;
-    let alpha = color.a * u.tint.a;
-    if (u.flags & FLAG_HEATMAP) != 0u {
-        rgb = in.shade.rgb;
-    }
-    if (u.flags & FLAG_LIT) != 0u {
-        let ambient = u.light.w;
-        let d = select(in.shade.w, in.light_dot, (u.flags & FLAG_SMOOTH) != 0u);
-        let diffuse = max(select(-d, d, front_facing), 0.0);
-        rgb = rgb * (ambient + (1.0 - ambient) * diffuse);
-    }
-    if (u.flags & FLAG_WIREFRAME) != 0u {
-        rgb = wireframe_overlay(rgb, in.bary, bary_width, u.wire_color, u.wire_width);
-    }
-    return vec4<f32>(rgb, alpha);
+    return finish_fragment(color, in.shade.rgb, in.shade.w, in.light_dot, front_facing, in.bary, bary_width);
 }

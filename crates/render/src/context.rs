@@ -76,7 +76,8 @@ impl GpuContext {
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("meshpaint device"),
-                required_features: wgpu::Features::empty(),
+                // Filtering RGBA32F Mesh Color Textures, where the adapter can.
+                required_features: adapter.features() & wgpu::Features::FLOAT32_FILTERABLE,
                 required_limits: adapter.limits(),
                 experimental_features: wgpu::ExperimentalFeatures::disabled(),
                 memory_hints: wgpu::MemoryHints::Performance,

@@ -1,5 +1,5 @@
-//! The bind-group layouts of the two pipelines (keep in sync with `@group(0)` of
-//! shaders/mesh_colors.wgsl and shaders/uv_baseline.wgsl): meshes make their bind groups
+//! The bind-group layouts of the three pipelines (keep in sync with `@group(0)` of
+//! shaders/mesh_colors.wgsl, shaders/mct.wgsl and shaders/uv_baseline.wgsl): meshes make their bind groups
 //! against them and the renderer builds its pipelines with them, so neither needs the other.
 
 use super::uniforms::FrameUniforms;
@@ -9,6 +9,7 @@ use super::uniforms::FrameUniforms;
 pub struct BindLayouts {
     mesh: wgpu::BindGroupLayout,
     baseline: wgpu::BindGroupLayout,
+    mct: wgpu::BindGroupLayout,
 }
 
 impl BindLayouts {
@@ -67,13 +68,57 @@ impl BindLayouts {
                 ),
             ],
         });
-        BindLayouts { mesh: mesh_layout, baseline: baseline_layout }
+        // Mesh Color Textures (shaders/mct.wgsl): the mesh's geometry textures as above, the
+        // face records (R32Uint) for the vertex stage, the filterable atlas and its sampler for
+        // the fragment stage, the band table for both.
+        let mct_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("mesh color textures layout"),
+            entries: &[
+                uniform_entry(0),
+                data(1, wgpu::TextureSampleType::Float { filterable: false }),
+                data(2, wgpu::TextureSampleType::Uint),
+                data(3, wgpu::TextureSampleType::Uint),
+                data(5, wgpu::TextureSampleType::Float { filterable: false }),
+                layout_entry(
+                    4,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                ),
+                layout_entry(
+                    6,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                ),
+                layout_entry(
+                    7,
+                    wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(
+                            std::mem::size_of::<meshpaint_core::mct::MctBands>() as u64
+                        ),
+                    },
+                ),
+            ],
+        });
+        BindLayouts { mesh: mesh_layout, baseline: baseline_layout, mct: mct_layout }
     }
 
     /// The mesh-colors pipeline's layout (uniforms; positions, vertex ids and face records
     /// for the vertex stage; the colour atlas for the fragment stage).
     pub fn mesh(&self) -> &wgpu::BindGroupLayout {
         &self.mesh
+    }
+
+    /// The Mesh Color Textures pipeline's layout (the mesh layout's geometry, MCT records,
+    /// the filterable atlas, its sampler and the band table).
+    pub fn mct(&self) -> &wgpu::BindGroupLayout {
+        &self.mct
     }
 
     /// The baseline pipeline's layout (uniforms, texture, sampler).

@@ -38,6 +38,7 @@ mod baseline;
 mod context;
 mod gpu;
 mod layouts;
+mod mct;
 mod mesh_gpu;
 mod readback;
 mod renderer;
@@ -47,10 +48,11 @@ pub use baseline::{BaselineMesh, BaselineSource, BaselineVertex, mip_chain_linea
 pub use context::{GpuContext, backends_from_env};
 pub use gpu::{Gpu, PaintUpload};
 pub use layouts::BindLayouts;
+pub use mct::GpuMct;
 pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshUploadOptions, atlas_texture_format, default_atlas_width};
 pub use renderer::{
-    DrawItem, FRAME_WGSL, FilterMode, MESH_COLORS_WGSL, Overlays, RenderSettings, RenderTarget, Renderer, Shading,
-    UV_BASELINE_WGSL,
+    DrawItem, FRAME_WGSL, FilterMode, MCT_WGSL, MESH_COLORS_WGSL, Overlays, RenderSettings, RenderTarget, Renderer,
+    Shading, UV_BASELINE_WGSL,
 };
 pub use uniforms::FrameUniforms;
 

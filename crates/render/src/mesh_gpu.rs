@@ -84,7 +84,7 @@ fn write_texel_rows(
 /// A data texture of `format` (RGBA32 float or uint) holding `entries` 16-byte entries in
 /// rows of [`MESH_DATA_WIDTH`], filled with `bytes`; refused when it needs more rows than
 /// the device allows.
-fn data_texture(
+pub(super) fn data_texture(
     ctx: &GpuContext,
     what: &'static str,
     format: wgpu::TextureFormat,
@@ -387,6 +387,12 @@ impl GpuMesh {
         let bytes = bytemuck::cast_slice::<FaceRecord, u8>(records);
         write_texel_rows(ctx, &self.face_records, MESH_DATA_WIDTH, DATA_TEXEL_BYTES, u64::from(first_face), bytes);
         Ok(())
+    }
+
+    /// The geometry textures the Mesh Color Textures pipeline shares: positions, vertex ids
+    /// and normals.
+    pub(super) fn geometry_textures(&self) -> [&wgpu::Texture; 3] {
+        [&self.positions, &self.indices, &self.normals]
     }
 
     pub(super) fn atlas_texture(&self) -> &wgpu::Texture {

@@ -5,17 +5,32 @@ use image::RgbaImage;
 
 use super::layouts::BindLayouts;
 use super::uniforms::FrameUniforms;
-use super::{BaselineMesh, BaselineVertex, DEPTH_FORMAT, GpuContext, GpuMesh, RenderError};
+use super::{BaselineMesh, BaselineVertex, DEPTH_FORMAT, GpuContext, GpuMct, GpuMesh, RenderError};
 use meshpaint_core::camera::OrbitCamera;
 use meshpaint_core::colors::format::Rgba;
 
 /// shaders/frame.wgsl: the uniform block ([`FrameUniforms`]), its `FLAG_*` bits and helpers
 /// both pipelines share. Not a shader by itself: it is prepended to each shader below.
 pub const FRAME_WGSL: &str = include_str!("../shaders/frame.wgsl");
-/// The mesh-colors shader exactly as the pipelines compile it: shaders/frame.wgsl followed
-/// by shaders/mesh_colors.wgsl (crates/render/tests/gpu/shaders.rs validates this very string).
-pub const MESH_COLORS_WGSL: &str =
-    concat!(include_str!("../shaders/frame.wgsl"), "\n", include_str!("../shaders/mesh_colors.wgsl"));
+/// The mesh-colors shader exactly as the pipelines compile it: shaders/frame.wgsl,
+/// shaders/mesh_common.wgsl and shaders/mesh_colors.wgsl (crates/render/tests/gpu/shaders.rs
+/// validates this very string).
+pub const MESH_COLORS_WGSL: &str = concat!(
+    include_str!("../shaders/frame.wgsl"),
+    "\n",
+    include_str!("../shaders/mesh_common.wgsl"),
+    "\n",
+    include_str!("../shaders/mesh_colors.wgsl")
+);
+/// The Mesh Color Textures shader exactly as its pipelines compile it: shaders/frame.wgsl,
+/// shaders/mesh_common.wgsl and shaders/mct.wgsl (crates/render/tests/gpu/shaders.rs validates it).
+pub const MCT_WGSL: &str = concat!(
+    include_str!("../shaders/frame.wgsl"),
+    "\n",
+    include_str!("../shaders/mesh_common.wgsl"),
+    "\n",
+    include_str!("../shaders/mct.wgsl")
+);
 /// The UV-baseline shader exactly as its pipeline compiles it: shaders/frame.wgsl followed
 /// by shaders/uv_baseline.wgsl (crates/render/tests/gpu/shaders.rs validates this very string).
 pub const UV_BASELINE_WGSL: &str =
@@ -133,6 +148,9 @@ pub enum DrawItem<'a> {
     MeshColors(&'a GpuMesh),
     /// A UV-textured mesh through the baseline pipeline.
     Baseline(&'a BaselineMesh),
+    /// A Mesh Color Texture through the MCT pipeline (hardware bilinear; nearest filter
+    /// modes draw bilinear: MCT has no hexagonal nearest).
+    Mct(&'a GpuMct),
 }
 
 impl DrawItem<'_> {
@@ -141,6 +159,7 @@ impl DrawItem<'_> {
         match self {
             DrawItem::MeshColors(mesh) => mesh.origin,
             DrawItem::Baseline(mesh) => mesh.origin,
+            DrawItem::Mct(mct) => mct.origin,
         }
     }
 }
@@ -167,6 +186,8 @@ pub struct Renderer {
     /// One mesh-colors pipeline per `(filter_kind, level_mode)`, see [`mesh_pipeline_index`].
     mesh_pipelines: Vec<wgpu::RenderPipeline>,
     baseline_pipeline: wgpu::RenderPipeline,
+    /// The MCT pipelines for `LEVEL_MODE` fixed (0) and automatic (1).
+    mct_pipelines: [wgpu::RenderPipeline; 2],
 }
 
 /// The `(filter_kind, level_mode)` combinations the mesh-colors shader is specialised for,
@@ -219,7 +240,13 @@ impl Renderer {
             &[Some(BaselineVertex::LAYOUT)],
             color_format,
         );
-        Renderer { color_format, layouts, mesh_pipelines, baseline_pipeline }
+        let mct_module = Self::module(ctx, "mesh color textures", MCT_WGSL);
+        let mct_pipelines = [FrameUniforms::LEVEL_FIXED, FrameUniforms::LEVEL_AUTO].map(|level_mode| {
+            let constants = [("LEVEL_MODE", f64::from(level_mode))];
+            let label = format!("mesh color textures (level mode {level_mode})");
+            Self::pipeline(ctx, &label, &mct_module, &constants, layouts.mct(), &[], color_format)
+        });
+        Renderer { color_format, layouts, mesh_pipelines, baseline_pipeline, mct_pipelines }
     }
 
     fn module(ctx: &GpuContext, label: &str, source: &str) -> wgpu::ShaderModule {
@@ -343,6 +370,11 @@ impl Renderer {
             DrawItem::Baseline(mesh) => {
                 uniforms.face_count = mesh.vertex_count / 3;
             }
+            DrawItem::Mct(mct) => {
+                uniforms.vertex_levels = mct.levels.max(1);
+                uniforms.face_count = mct.face_count;
+                uniforms.vertex_count = mct.vertex_count;
+            }
         }
         uniforms
     }
@@ -365,6 +397,9 @@ impl Renderer {
                 (&mesh.uniforms, &self.mesh_pipelines[mesh_pipeline_index(uniforms.filter_kind, uniforms.level_mode)])
             }
             DrawItem::Baseline(mesh) => (&mesh.uniforms, &self.baseline_pipeline),
+            DrawItem::Mct(mct) => {
+                (&mct.uniforms, &self.mct_pipelines[usize::from(uniforms.level_mode != FrameUniforms::LEVEL_FIXED)])
+            }
         };
         ctx.queue.write_buffer(uniform_buffer, 0, bytemuck::bytes_of(&uniforms));
         let [r, g, b, a] = settings.background.map(f64::from);
@@ -393,6 +428,13 @@ impl Renderer {
             DrawItem::MeshColors(mesh) => {
                 pass.set_bind_group(0, &mesh.bind_group, &[]);
                 let vertex_count = mesh.face_count.saturating_mul(3);
+                if vertex_count > 0 {
+                    pass.draw(0..vertex_count, 0..1);
+                }
+            }
+            DrawItem::Mct(mct) => {
+                pass.set_bind_group(0, &mct.bind_group, &[]);
+                let vertex_count = mct.face_count.saturating_mul(3);
                 if vertex_count > 0 {
                     pass.draw(0..vertex_count, 0..1);
                 }

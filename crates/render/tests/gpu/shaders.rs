@@ -5,10 +5,11 @@
 
 use std::path::Path;
 
-use meshpaint_render::{FRAME_WGSL, FrameUniforms, MESH_COLORS_WGSL, UV_BASELINE_WGSL};
+use meshpaint_render::{FRAME_WGSL, FrameUniforms, MCT_WGSL, MESH_COLORS_WGSL, UV_BASELINE_WGSL};
 
 /// The assembled sources, by the name of the file each one ends with.
-const SOURCES: [(&str, &str); 2] = [("mesh_colors.wgsl", MESH_COLORS_WGSL), ("uv_baseline.wgsl", UV_BASELINE_WGSL)];
+const SOURCES: [(&str, &str); 3] =
+    [("mesh_colors.wgsl", MESH_COLORS_WGSL), ("uv_baseline.wgsl", UV_BASELINE_WGSL), ("mct.wgsl", MCT_WGSL)];
 
 fn validate(name: &str, source: &str) -> (naga::Module, naga::valid::ModuleInfo) {
     let module = naga::front::wgsl::parse_str(source)
@@ -21,7 +22,7 @@ fn validate(name: &str, source: &str) -> (naga::Module, naga::valid::ModuleInfo)
 
 #[test]
 fn every_shader_parses_and_validates() {
-    // shaders/ holds the shared part and the two shaders the library assembles, nothing
+    // shaders/ holds the shared parts and the three shaders the library assembles, nothing
     // that would go unvalidated.
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
     let mut names: Vec<String> = std::fs::read_dir(&dir)
@@ -30,7 +31,7 @@ fn every_shader_parses_and_validates() {
         .filter(|name| name.ends_with(".wgsl"))
         .collect();
     names.sort();
-    assert_eq!(names, ["frame.wgsl", "mesh_colors.wgsl", "uv_baseline.wgsl"]);
+    assert_eq!(names, ["frame.wgsl", "mct.wgsl", "mesh_colors.wgsl", "mesh_common.wgsl", "uv_baseline.wgsl"]);
     for (name, source) in SOURCES {
         assert!(source.starts_with(FRAME_WGSL), "{name} does not start with shaders/frame.wgsl");
         validate(name, source);
@@ -42,7 +43,7 @@ fn every_shader_parses_and_validates() {
 
 #[test]
 fn shaders_have_the_entry_points_and_bindings_the_renderer_uses() {
-    for ((name, source), bindings) in SOURCES.into_iter().zip([0..6u32, 0..3u32]) {
+    for ((name, source), bindings) in SOURCES.into_iter().zip([0..6u32, 0..3u32, 0..8u32]) {
         let (module, _) = validate(name, source);
         let entry_points: Vec<&str> = module.entry_points.iter().map(|entry| entry.name.as_str()).collect();
         assert!(entry_points.contains(&"vs_main") && entry_points.contains(&"fs_main"), "{name}: {entry_points:?}");
@@ -59,7 +60,7 @@ fn shaders_have_the_entry_points_and_bindings_the_renderer_uses() {
         let uniform = module
             .global_variables
             .iter()
-            .find(|(_, global)| global.space == naga::AddressSpace::Uniform)
+            .find(|(_, global)| global.space == naga::AddressSpace::Uniform && global.name.as_deref() == Some("u"))
             .map(|(_, global)| global.ty)
             .unwrap();
         let size = module.types[uniform].inner.size(module.to_ctx());
@@ -151,4 +152,19 @@ fn the_smooth_shading_crease_matches_the_rust_constant() {
         }
         ref other => panic!("SMOOTH_CREASE_COSINE is not an f32 literal: {other:?}"),
     }
+}
+
+#[test]
+fn the_wgsl_mct_band_table_matches_the_rust_struct() {
+    let (module, _) = validate("mct.wgsl", MCT_WGSL);
+    let bands = module
+        .global_variables
+        .iter()
+        .find(|(_, global)| global.name.as_deref() == Some("mct_bands"))
+        .map(|(_, global)| global.ty)
+        .unwrap();
+    let size = module.types[bands].inner.size(module.to_ctx());
+    assert_eq!(size as usize, std::mem::size_of::<meshpaint_core::mct::MctBands>());
+    // The shader's group count is the core's.
+    assert!(MCT_WGSL.contains(&format!("const MCT_GROUPS: u32 = {}u;", meshpaint_core::mct::layout::GROUPS)));
 }

@@ -1,0 +1,183 @@
+//! A Mesh Color Texture on the GPU (crates/core/src/mct): the atlas as one filterable
+//! texture, the 4-byte face records as an R32Uint data texture, the band table as a
+//! uniform buffer; positions, vertex ids and normals are the [`GpuMesh`]'s own textures,
+//! so switching representation uploads only what MCT adds.
+
+use glam::DVec3;
+
+use super::layouts::BindLayouts;
+use super::mesh_gpu::{atlas_texture_format, data_texture};
+use super::{GpuContext, GpuMesh, RenderError};
+use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::mct::{MctBands, MctFaceRecord, MeshColorTexture};
+
+/// A Mesh Color Texture uploaded for the MCT pipeline, drawn with its mesh's geometry.
+#[derive(Debug)]
+pub struct GpuMct {
+    /// The mesh's render origin.
+    pub origin: DVec3,
+    /// Number of faces.
+    pub face_count: u32,
+    /// Number of vertices.
+    pub vertex_count: u32,
+    /// MIP levels of every face.
+    pub levels: u32,
+    /// Atlas encoding.
+    pub format: ColorFormat,
+    /// Atlas size in texels.
+    pub atlas_size: [u32; 2],
+    atlas: wgpu::Texture,
+    records: wgpu::Texture,
+    bands: wgpu::Buffer,
+    pub(crate) uniforms: wgpu::Buffer,
+    pub(crate) bind_group: wgpu::BindGroup,
+}
+
+impl GpuMct {
+    /// Uploads `mct` (built from the packed mesh `mesh` was uploaded from) against the
+    /// renderer's `layouts`. RGBA32F atlases need the adapter's `FLOAT32_FILTERABLE`.
+    pub fn upload(
+        ctx: &GpuContext,
+        layouts: &BindLayouts,
+        mesh: &GpuMesh,
+        mct: &MeshColorTexture,
+    ) -> Result<Self, RenderError> {
+        ctx.checked(|| Self::upload_unchecked(ctx, layouts, mesh, mct))
+    }
+
+    fn upload_unchecked(
+        ctx: &GpuContext,
+        layouts: &BindLayouts,
+        mesh: &GpuMesh,
+        mct: &MeshColorTexture,
+    ) -> Result<Self, RenderError> {
+        let (width, height) = (mct.layout.width, mct.layout.height);
+        let max_dimension = ctx.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max_dimension || height > max_dimension {
+            return Err(RenderError::InvalidTexture(format!(
+                "Mesh Color Texture atlas {width}×{height} is outside 1..={max_dimension} per side"
+            )));
+        }
+        if mct.layout.records.len() != mesh.face_count as usize {
+            return Err(RenderError::InvalidMesh(format!(
+                "{} MCT face records for {} faces",
+                mct.layout.records.len(),
+                mesh.face_count
+            )));
+        }
+        let bpp = mct.format.bytes_per_sample() as u64;
+        if mct.texels.len() as u64 != u64::from(width) * u64::from(height) * bpp {
+            return Err(RenderError::InvalidTexture(format!(
+                "{} atlas bytes for {width}×{height} texels of {bpp} bytes",
+                mct.texels.len()
+            )));
+        }
+        if mct.format == ColorFormat::Rgba32F && !ctx.device.features().contains(wgpu::Features::FLOAT32_FILTERABLE) {
+            return Err(RenderError::InvalidTexture(
+                "an RGBA32F Mesh Color Texture needs a GPU that filters 32-bit float textures \
+                 (FLOAT32_FILTERABLE); pack with RGBA16F or RGBA8"
+                    .into(),
+            ));
+        }
+        let atlas = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("mesh color texture atlas"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: atlas_texture_format(mct.format),
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        // Row bands so that no single write stages the whole atlas.
+        let row_bytes = u64::from(width) * bpp;
+        let band_rows = ((64u64 << 20) / row_bytes).max(1);
+        let mut y = 0u64;
+        while y < u64::from(height) {
+            let rows = band_rows.min(u64::from(height) - y);
+            let start = (y * row_bytes) as usize;
+            ctx.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &atlas,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x: 0, y: y as u32, z: 0 },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &mct.texels[start..start + (rows * row_bytes) as usize],
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row_bytes as u32),
+                    rows_per_image: Some(rows as u32),
+                },
+                wgpu::Extent3d { width, height: rows as u32, depth_or_array_layers: 1 },
+            );
+            y += rows;
+        }
+        let records = data_texture(
+            ctx,
+            "MCT face records",
+            wgpu::TextureFormat::R32Uint,
+            bytemuck::cast_slice::<MctFaceRecord, u8>(&mct.layout.records),
+        )?;
+        let bands = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("MCT band table"),
+            size: std::mem::size_of::<MctBands>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.queue.write_buffer(&bands, 0, bytemuck::bytes_of(&mct.layout.bands));
+        let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("MCT bilinear"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+            ..Default::default()
+        });
+        let uniforms = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("MCT uniforms"),
+            size: std::mem::size_of::<super::FrameUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let view = |texture: &wgpu::Texture| texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let [positions, indices, normals] = mesh.geometry_textures();
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("MCT bind group"),
+            layout: layouts.mct(),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view(positions)) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&view(indices)) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&view(&records)) },
+                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&view(&atlas)) },
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&view(normals)) },
+                wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(&sampler) },
+                wgpu::BindGroupEntry { binding: 7, resource: bands.as_entire_binding() },
+            ],
+        });
+        Ok(GpuMct {
+            origin: mesh.origin,
+            face_count: mesh.face_count,
+            vertex_count: mesh.vertex_count,
+            levels: mct.layout.levels,
+            format: mct.format,
+            atlas_size: [width, height],
+            atlas,
+            records,
+            bands,
+            uniforms,
+            bind_group,
+        })
+    }
+
+    /// GPU memory MCT adds to its mesh's geometry: the atlas, the records' data texture
+    /// and the band table, in bytes.
+    pub fn gpu_bytes(&self) -> u64 {
+        let atlas =
+            u64::from(self.atlas.width()) * u64::from(self.atlas.height()) * self.format.bytes_per_sample() as u64;
+        let records = u64::from(self.records.width()) * u64::from(self.records.height()) * 4;
+        atlas + records + self.bands.size()
+    }
+}
