@@ -119,6 +119,18 @@ pub(super) struct OutputArgs {
     pub(super) output: PathBuf,
 }
 
+/// `--representation` values: how a mesh's colours are laid out for the GPU.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub(super) enum Representation {
+    /// Mesh colors: face records and a colour buffer with MIP chains (the packed file,
+    /// docs/FORMAT.md).
+    #[default]
+    MeshColors,
+    /// A Mesh Color Texture: one 2D atlas whose texels duplicate the shared vertex and edge
+    /// colours, filtered by the GPU's own sampler (the MCT file, docs/MCT_FORMAT.md).
+    Mct,
+}
+
 /// What [`OutputArgs::write`] wrote.
 pub(super) enum Written {
     /// A tessellated binary glTF.

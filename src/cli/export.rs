@@ -1,19 +1,23 @@
-//! `meshpaint export`: a tessellated vertex-colour .glb, a packed file, or (`--texture`)
-//! the colours baked into the model's own UV texture, as a textured .glb or a plain PNG.
+//! `meshpaint export`: a tessellated vertex-colour .glb, a packed file, (`--texture`) the
+//! colours baked into the model's own UV texture, as a textured .glb or a plain PNG, or
+//! (`--representation mct`) a Mesh Color Texture file.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
+use meshpaint_core::colors::budget::ATLAS_MAX_WIDTH;
 use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::convert::bake_uv::{bake_uv_texture, default_padding};
 use meshpaint_core::io::document::{Document, SourceKind, import_scene};
 use meshpaint_core::io::export_fit::{FitOptions, write_fitted_glb};
 use meshpaint_core::io::export_gltf::ColorEncoding;
 use meshpaint_core::io::export_textured::{TexturedMesh, encode_png, textured_glb};
+use meshpaint_core::mct;
+use meshpaint_core::mct::file::write_mct;
 use meshpaint_core::mesh::weld::weld_scene;
 
-use super::args::{LOG_TARGET, OutputArgs, ResolutionArg, Written, budget, open, parse_format};
+use super::args::{LOG_TARGET, OutputArgs, Representation, ResolutionArg, Written, budget, open, parse_format};
 
 /// Arguments of `meshpaint export`.
 #[derive(Debug, clap::Args)]
@@ -43,6 +47,15 @@ pub(super) struct ExportArgs {
     /// default with --level / --max-vertices), float, u16 or u8.
     #[arg(long, value_enum, conflicts_with = "texture")]
     colors: Option<ColorsArg>,
+    /// What a non-.glb OUT holds: mesh-colors (a packed file) or mct (a Mesh Color Texture
+    /// file: mesh, face records, band table and one atlas in --format; docs/MCT_FORMAT.md).
+    #[arg(
+        long,
+        value_enum,
+        default_value_t = Representation::MeshColors,
+        conflicts_with_all = ["texture", "level", "max_vertices", "colors"]
+    )]
+    representation: Representation,
     #[command(flatten)]
     output: OutputArgs,
 }
@@ -57,6 +70,9 @@ enum ColorsArg {
 }
 
 pub(super) fn run(args: ExportArgs) -> Result<()> {
+    if args.representation == Representation::Mct {
+        return export_mct(&args);
+    }
     if let Some(size) = args.texture {
         return export_texture(&args, size);
     }
@@ -93,6 +109,40 @@ pub(super) fn run(args: ExportArgs) -> Result<()> {
             packed_format.name()
         ),
     }
+    Ok(())
+}
+
+/// `--representation mct`: the document packed in `--format` (rgba8 by default), its Mesh
+/// Color Texture built in an atlas of at most 16384 texels a side (the GPU atlas width of the
+/// budget module) within the memory budget, written as an MCT file.
+fn export_mct(args: &ExportArgs) -> Result<()> {
+    let (path, out) = (&args.file, &args.output.output);
+    let extension = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if matches!(extension.as_deref(), Some("glb" | "gltf")) {
+        anyhow::bail!(
+            "{}: --representation mct writes an MCT file, not glTF; name the output e.g. OUT.mct",
+            out.display()
+        );
+    }
+    let format = args.format.unwrap_or_default();
+    let budget = budget(Some(format));
+    let document = open(path, args.resolution, &budget)?;
+    let packed = document.pack(format).with_context(|| format!("packing {}", path.display()))?;
+    let texture = mct::build(&packed, ATLAS_MAX_WIDTH as u32, budget.memory_bytes)
+        .with_context(|| format!("building the Mesh Color Texture of {}", path.display()))?;
+    write_mct(out, &packed.positions, &packed.indices, &texture)?;
+    eprintln!(
+        "{} → {}: {} faces, {}×{} atlas in {}, {} levels, {} GPU bytes ({} ring texels clamped)",
+        path.display(),
+        out.display(),
+        texture.layout.records.len(),
+        texture.layout.width,
+        texture.layout.height,
+        format.name(),
+        texture.layout.levels,
+        texture.gpu_bytes(),
+        texture.stats.clamped_ring_texels
+    );
     Ok(())
 }
 

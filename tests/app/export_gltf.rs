@@ -728,6 +728,62 @@ fn cli_exports_glb_and_packed_files() {
     }
 }
 
+/// `--representation mct`: the Duck as an MCT file, read back with the core's reader and
+/// compared with the texture built in this process from the same document; the default is
+/// still the packed file, and glTF names are refused.
+#[test]
+fn cli_exports_a_mesh_color_texture_file() {
+    use meshpaint_core::colors::format::ColorFormat;
+    use meshpaint_core::mct::file::read_mct;
+    use meshpaint_core::mct::{self, MctStats, MeshColorTexture};
+    const BIN: &str = env!("CARGO_BIN_EXE_meshpaint");
+    let dir = TempDir::new("cli-mct");
+    let input = model("Duck/Duck.glb");
+    let export = |extra: &[&str], out: &std::path::Path| {
+        Command::new(BIN).arg("export").arg(&input).args(["-r", "4"]).args(extra).arg("-o").arg(out).output().unwrap()
+    };
+    let out = dir.join("duck.mct");
+    let output = export(&["--representation", "mct"], &out);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(stderr.contains("atlas in rgba8"), "{stderr}");
+    let file = read_mct(&out).unwrap();
+    let document = Document::open(&input, r(4)).unwrap();
+    let packed = document.pack(ColorFormat::Rgba8Srgb).unwrap();
+    let expected = mct::build(&packed, 16384, u64::MAX).unwrap();
+    assert_eq!(file.positions, packed.positions);
+    assert_eq!(file.indices, packed.indices);
+    assert_eq!(file.indices.len(), 4212, "the Duck's triangles");
+    assert_eq!(file.mct.layout.levels, 3, "R = 4: levels 0, 1, 2");
+    assert_eq!(file.mct, MeshColorTexture { stats: MctStats::default(), ..expected.clone() });
+    for face in (0..file.indices.len() as u32).step_by(97) {
+        for w in [[1.0, 0.0, 0.0], [0.25, 0.25, 0.5], [0.0, 0.5, 0.5]] {
+            assert_eq!(file.mct.sample_trilinear(face, w, 0.7), expected.sample_trilinear(face, w, 0.7));
+        }
+    }
+    // --format chooses the atlas's texel format.
+    let out16 = dir.join("duck16.mct");
+    assert!(export(&["--representation", "mct", "--format", "rgba16f"], &out16).status.success());
+    assert_eq!(read_mct(&out16).unwrap().mct.format, ColorFormat::Rgba16F);
+    // The default (and --representation mesh-colors) is still the packed file.
+    let (default, explicit) = (dir.join("default.mpk"), dir.join("explicit.mpk"));
+    assert!(export(&[], &default).status.success());
+    assert!(export(&["--representation", "mesh-colors"], &explicit).status.success());
+    assert_eq!(std::fs::read(&default).unwrap(), std::fs::read(&explicit).unwrap());
+    assert!(meshpaint_core::packing::file::read_file(&default).is_ok());
+    // Refusals: a glTF name, and flags of the glTF exports; nothing is written.
+    for (extra, name, message) in [
+        (&["--representation", "mct"][..], "x.glb", "--representation mct writes an MCT file"),
+        (&["--representation", "mct", "--level", "1"][..], "y.mct", "--representation"),
+        (&["--representation", "mct", "--texture", "64"][..], "z.mct", "--representation"),
+    ] {
+        let output = export(extra, &dir.join(name));
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success() && stderr.contains(message), "{stderr}");
+        assert!(!dir.join(name).exists());
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // COLOR_0 import
 

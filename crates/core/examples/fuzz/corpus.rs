@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::rng::Rng;
-use super::{gltf, packed};
+use super::{gltf, mct_file, packed};
 
 /// What is fuzzed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -12,6 +12,8 @@ pub enum Target {
     Packed,
     /// The glTF importer, then welding, colouring and packing.
     Gltf,
+    /// The MCT-file reader, then every block's texels, sampling and re-writing.
+    Mct,
     /// A target that panics, aborts, hangs and over-allocates on purpose, to test the
     /// supervisor itself.
     SelfTest,
@@ -23,13 +25,14 @@ impl Target {
         match self {
             Target::Packed => "packed",
             Target::Gltf => "gltf",
+            Target::Mct => "mct",
             Target::SelfTest => "selftest",
         }
     }
 
     /// The inverse of [`Target::name`].
     pub fn from_name(name: &str) -> Option<Self> {
-        [Target::Packed, Target::Gltf, Target::SelfTest].into_iter().find(|t| t.name() == name)
+        [Target::Packed, Target::Gltf, Target::Mct, Target::SelfTest].into_iter().find(|t| t.name() == name)
     }
 }
 
@@ -51,6 +54,8 @@ pub enum Corpus {
     Packed(Vec<Vec<u8>>),
     /// glTF seeds.
     Gltf(Vec<gltf::Seed>),
+    /// MCT seed files.
+    Mct(Vec<Vec<u8>>),
     /// The self-test target.
     SelfTest,
 }
@@ -70,6 +75,7 @@ impl Corpus {
         match target {
             Target::Packed => Corpus::Packed(packed::seeds(models)),
             Target::Gltf => Corpus::Gltf(gltf::seeds(models)),
+            Target::Mct => Corpus::Mct(mct_file::seeds()),
             Target::SelfTest => Corpus::SelfTest,
         }
     }
@@ -80,6 +86,9 @@ impl Corpus {
         match self {
             Corpus::Packed(seeds) => {
                 Input { bytes: packed::mutate(seeds, &mut rng), extension: "mpk", glb: false, resolution: 0 }
+            }
+            Corpus::Mct(seeds) => {
+                Input { bytes: mct_file::mutate(seeds, &mut rng), extension: "mct", glb: false, resolution: 0 }
             }
             Corpus::Gltf(seeds) => {
                 let resolution = rng.pick(&[1, 2, 4]);
@@ -97,6 +106,7 @@ impl Corpus {
         match self {
             Corpus::Packed(_) => packed::run(&input.bytes),
             Corpus::Gltf(_) => gltf::run(&input.bytes, input.glb, input.resolution),
+            Corpus::Mct(_) => mct_file::run(&input.bytes),
             Corpus::SelfTest => {
                 let behaviour = input.bytes.first().copied().map_or(0, u64::from);
                 match behaviour {

@@ -1,10 +1,11 @@
-//! A fuzz campaign against the packed-file reader or the glTF importer, on stable Rust.
+//! A fuzz campaign against the packed-file reader, the glTF importer or the MCT-file reader, on
+//! stable Rust.
 //!
 //! ```text
-//! cargo run --release -p meshpaint-core --example fuzz -- --iterations 10000000 [--seed 1] [--target packed|gltf]
+//! cargo run --release -p meshpaint-core --example fuzz -- --iterations 10000000 [--seed 1] [--target packed|gltf|mct]
 //! ```
 //!
-//! Inputs come from structure-aware mutators (`packed.rs`, `gltf.rs`); input `I` of seed `S`
+//! Inputs come from structure-aware mutators (`packed.rs`, `gltf.rs`, `mct_file.rs`); input `I` of seed `S`
 //! is a pure function of `(S, I)`, so `--replay I` reruns it alone. Workers are child
 //! processes (`supervisor.rs`): a panic is caught per input with `catch_unwind`, an abort
 //! or signal kills only the worker, each worker runs under an address-space limit
@@ -20,6 +21,7 @@ use clap::Parser;
 
 pub mod corpus;
 pub mod gltf;
+pub mod mct_file;
 pub mod packed;
 pub mod rng;
 pub mod supervisor;
@@ -31,7 +33,7 @@ use worker::WorkerArgs;
 
 /// Command line of the fuzz example.
 #[derive(Debug, Parser)]
-#[command(about = "Fuzz the packed-file reader or the glTF importer")]
+#[command(about = "Fuzz the packed-file reader, the glTF importer or the MCT-file reader")]
 pub struct Args {
     /// Number of inputs.
     #[arg(long, default_value_t = 100_000)]
@@ -39,7 +41,7 @@ pub struct Args {
     /// Campaign seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// What to fuzz: packed or gltf.
+    /// What to fuzz: packed, gltf or mct.
     #[arg(long, default_value = "packed", value_parser = parse_target)]
     pub target: Target,
     /// Per-input time limit in milliseconds.
@@ -62,7 +64,7 @@ pub struct Args {
 fn parse_target(name: &str) -> Result<Target, String> {
     match Target::from_name(name) {
         Some(target) => Ok(target),
-        None => Err(format!("unknown target {name:?}: packed or gltf")),
+        None => Err(format!("unknown target {name:?}: packed, gltf or mct")),
     }
 }
 

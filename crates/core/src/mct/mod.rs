@@ -5,8 +5,9 @@
 //! | file | holds |
 //! |---|---|
 //! | [`layout`] | block resolution per face, pairing, tents (level 0) and squares (levels ≥ 1), the 4-byte face record and the band table the shader reads |
-//! | [`build`] | packed mesh colors → atlas texels (reference sampler at every lattice point, `c₃ = c₁ + c₂ − c₀` rings), in parallel bands |
+//! | [`mod@build`] | packed mesh colors → atlas texels (reference sampler at every lattice point, `c₃ = c₁ + c₂ − c₀` rings), in parallel bands |
 //! | [`sample`] | the CPU evaluation of hardware bilinear / trilinear filtering of the atlas |
+//! | [`file`] | the MCT file (`docs/MCT_FORMAT.md`): mesh, records, band table and atlas in one checked, checksummed file |
 //!
 //! What is exact (tests in `crates/core/tests/core/mct.rs`): at level 0 every texel on a
 //! block lattice point is the reference sampler's value there; along every face edge the
@@ -17,6 +18,7 @@
 //! piecewise-linear filter; the difference is measured, not hidden.
 
 pub mod build;
+pub mod file;
 pub mod layout;
 pub mod sample;
 

@@ -1,12 +1,12 @@
 //! The fuzz harness (examples/fuzz) in the test suite: its supervisor must report every kind
 //! of crash with the input saved, and short campaigns (a fixed seed, a few thousand inputs)
-//! against the packed-file reader and the glTF importer must find nothing — while their
+//! against the packed-file reader, the glTF importer and the MCT-file reader must find nothing — while their
 //! inputs reach far into the reader (the mutators fix the checksum and the layout, so most
 //! mutants are refused by content checks, not by the checksum, and some are accepted).
 //!
 //! The workers are this test binary itself, started with `fuzz_worker_process` and the
 //! worker's arguments in `MESHPAINT_FUZZ_WORKER`. The long campaign is
-//! `cargo run --release -p meshpaint-core --example fuzz -- --iterations N [--seed S] [--target packed|gltf]`.
+//! `cargo run --release -p meshpaint-core --example fuzz -- --iterations N [--seed S] [--target packed|gltf|mct]`.
 
 use std::collections::BTreeMap;
 use std::process::Command;
@@ -143,6 +143,37 @@ fn a_short_gltf_campaign_finds_no_crash_and_reaches_the_mesh() {
     assert!(kinds >= 15, "only {kinds} kinds of refusal\n{}", report.text());
 }
 
+#[test]
+fn a_short_mct_campaign_finds_no_crash_and_reaches_the_content_checks() {
+    let report = run(&campaign(Target::Mct, 20_261_201, 4000, "mct"));
+    assert!(report.crashes.is_empty(), "{}", report.text());
+    let total: u64 = report.outcomes.values().sum();
+    assert_eq!(total, 4000, "{}", report.text());
+    let checksum = count(&report.outcomes, "refused: ChecksumMismatch");
+    let accepted = count(&report.outcomes, "accepted");
+    let kinds = report.outcomes.keys().filter(|label| label.starts_with("refused: ")).count();
+    assert!(checksum * 10 < total, "{checksum} of {total} mutants stop at the checksum\n{}", report.text());
+    assert!(accepted * 50 > total, "only {accepted} of {total} mutants are accepted\n{}", report.text());
+    // The content checks past the section table are reached, each of them.
+    for refusal in [
+        "NonFinitePosition",
+        "IndexOutOfRange",
+        "RecordCorner",
+        "RecordResolution",
+        "RecordLevels",
+        "PairIndex",
+        "BandReserved",
+        "EmptyBand",
+        "DuplicateSlot",
+        "MissingFirst",
+        "PairEdge",
+        "OutsideAtlas",
+    ] {
+        assert!(count(&report.outcomes, &format!("refused: {refusal}")) > 0, "no {refusal}\n{}", report.text());
+    }
+    assert!(kinds >= 20, "only {kinds} kinds of refusal\n{}", report.text());
+}
+
 /// Regression fixtures: inputs the fuzzer once crashed on (tests/fixtures/fuzz/), each
 /// run through its target's full oracle, with the outcome it must have now.
 #[test]
@@ -164,6 +195,7 @@ fn former_fuzz_crashes_are_handled() {
         let bytes = std::fs::read(dir.join(name)).unwrap();
         let found = match name.rsplit('.').next() {
             Some("mpk") => harness::packed::run(&bytes),
+            Some("mct") => harness::mct_file::run(&bytes),
             Some("glb") => harness::gltf::run(&bytes, true, 2),
             _ => harness::gltf::run(&bytes, false, 2),
         };

@@ -12,6 +12,7 @@ mod import;
 mod layout;
 mod least_squares;
 mod mct;
+mod mct_file;
 mod occlusion;
 mod optimize;
 mod packed_file;
