@@ -1,6 +1,8 @@
-//! `meshpaint bench render`: frame time of the UV-texture baseline and of every mesh-colors
-//! filter mode on the same mesh, view and image size, interleaved in one run, as ratios to
-//! the baseline; plus the GPU memory each path holds.
+//! `meshpaint bench render`: frame time of the UV-texture baseline, of every mesh-colors
+//! filter mode and of the Mesh Color Textures built from the same buffers (the
+//! representation axis: every row names its representation) on the same mesh, view and
+//! image size, interleaved in one run, as ratios to the baseline; plus the GPU memory each
+//! path holds and the MCT's build time.
 //!
 //! A frame is one render pass into an offscreen target, submitted and waited for
 //! (`poll(wait)`), so on lavapipe it measures the rasteriser's whole work. Modes are
@@ -28,8 +30,11 @@ use meshpaint_render::{
 /// One measured path.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeTiming {
-    /// `baseline-uv`, `nearest`, `linear`, `mip-1`, `trilinear`.
+    /// `baseline-uv`, `nearest`, `linear`, `mip-1`, `trilinear`, `mct-linear`, `mct-mip-1`,
+    /// `mct-trilinear`.
     pub name: String,
+    /// `uv-texture`, `mesh-colors` or `mct`.
+    pub representation: &'static str,
     /// Median frame time, seconds.
     pub median_seconds: f64,
     /// Fastest frame, seconds.
@@ -55,6 +60,8 @@ pub struct RenderBench {
     pub baseline: String,
     /// Baseline first, then each filter mode.
     pub modes: Vec<ModeTiming>,
+    /// Seconds to build the Mesh Color Texture from the packed buffers.
+    pub mct_build_seconds: f64,
 }
 
 impl RenderBench {
@@ -66,6 +73,7 @@ impl RenderBench {
             .iter()
             .map(|m| {
                 serde_json::json!({
+                    "representation": m.representation,
                     "mode": m.name,
                     "median_ms": m.median_seconds * 1e3,
                     "best_ms": m.best_seconds * 1e3,
@@ -82,6 +90,7 @@ impl RenderBench {
             "frames_per_mode": self.frames,
             "triangles": self.triangles,
             "baseline": self.baseline,
+            "mct_build_ms": self.mct_build_seconds * 1e3,
             "modes": modes,
         })
     }
@@ -162,44 +171,50 @@ pub fn bench_render(
     let mesh = gpu.upload(&packed)?;
 
     let (baseline_name, baseline) = baseline(&gpu, path, document)?;
+    let build_start = Instant::now();
+    let max_dimension = ctx.limits().max_texture_dimension_2d;
+    let texture = meshpaint_core::mct::build(&packed, max_dimension, u64::MAX)?;
+    let mct_build_seconds = build_start.elapsed().as_secs_f64();
+    let mct = meshpaint_render::GpuMct::upload(ctx, gpu.renderer.layouts(), &mesh, &texture)?;
 
     let camera: OrbitCamera = default_camera(mesh.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
     let timer = FrameTimer::new(&gpu, width, height);
 
-    let filters = [
-        ("nearest", FilterMode::Nearest),
-        ("linear", FilterMode::Linear),
-        ("mip-1", FilterMode::MipLevel(1)),
-        ("trilinear", FilterMode::Trilinear),
+    let geometry_bytes = mesh.gpu_bytes() - mesh.atlas_bytes() - mesh.face_record_bytes();
+    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 8] = [
+        ("baseline-uv", "uv-texture", DrawItem::Baseline(&baseline), FilterMode::Linear, baseline.gpu_bytes()),
+        ("nearest", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Nearest, mesh.gpu_bytes()),
+        ("linear", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Linear, mesh.gpu_bytes()),
+        ("mip-1", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::MipLevel(1), mesh.gpu_bytes()),
+        ("trilinear", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Trilinear, mesh.gpu_bytes()),
+        ("mct-linear", "mct", DrawItem::Mct(&mct), FilterMode::Linear, geometry_bytes + mct.gpu_bytes()),
+        ("mct-mip-1", "mct", DrawItem::Mct(&mct), FilterMode::MipLevel(1), geometry_bytes + mct.gpu_bytes()),
+        ("mct-trilinear", "mct", DrawItem::Mct(&mct), FilterMode::Trilinear, geometry_bytes + mct.gpu_bytes()),
     ];
-    let paths = 1 + filters.len();
-    let mut times: Vec<Vec<f64>> = vec![Vec::with_capacity(frames); paths];
-    let frame = |item: DrawItem<'_>, filter: FilterMode| timer.frame(item, filter, camera);
+    let mut times: Vec<Vec<f64>> = vec![Vec::with_capacity(frames); paths.len()];
     // One warm-up frame per path (pipeline and cache warm-up), then interleaved rounds.
-    frame(DrawItem::Baseline(&baseline), FilterMode::Linear);
-    for (_, filter) in filters {
-        frame(DrawItem::MeshColors(&mesh), filter);
+    for &(_, _, item, filter, _) in &paths {
+        timer.frame(item, filter, camera);
     }
     for _ in 0..frames.max(1) {
-        times[0].push(frame(DrawItem::Baseline(&baseline), FilterMode::Linear));
-        for (k, (_, filter)) in filters.iter().enumerate() {
-            times[k + 1].push(frame(DrawItem::MeshColors(&mesh), *filter));
+        for (k, &(_, _, item, filter, _)) in paths.iter().enumerate() {
+            times[k].push(timer.frame(item, filter, camera));
         }
     }
-    let summarise = |name: &str, mut samples: Vec<f64>, gpu_bytes: u64| {
-        samples.sort_by(f64::total_cmp);
-        ModeTiming {
-            name: name.to_owned(),
-            median_seconds: samples[samples.len() / 2],
-            best_seconds: samples[0],
-            gpu_bytes,
-        }
-    };
-    let mut times = times.into_iter();
-    let mut modes = vec![summarise("baseline-uv", times.next().unwrap_or_default(), baseline.gpu_bytes())];
-    for ((name, _), samples) in filters.iter().zip(times) {
-        modes.push(summarise(name, samples, mesh.gpu_bytes()));
-    }
+    let modes = paths
+        .iter()
+        .zip(times)
+        .map(|(&(name, representation, _, _, gpu_bytes), mut samples)| {
+            samples.sort_by(f64::total_cmp);
+            ModeTiming {
+                name: name.to_owned(),
+                representation,
+                median_seconds: samples.get(samples.len() / 2).copied().unwrap_or(f64::NAN),
+                best_seconds: samples.first().copied().unwrap_or(f64::NAN),
+                gpu_bytes,
+            }
+        })
+        .collect();
     Ok(RenderBench {
         adapter: ctx.describe(),
         width,
@@ -208,6 +223,7 @@ pub fn bench_render(
         triangles: mesh.face_count,
         baseline: baseline_name,
         modes,
+        mct_build_seconds,
     })
 }
 
@@ -272,6 +288,9 @@ pub enum BenchRenderError {
     /// Converting the scene into a document failed.
     #[error(transparent)]
     Document(#[from] meshpaint_core::io::document::DocumentError),
+    /// The Mesh Color Texture cannot be built.
+    #[error(transparent)]
+    Mct(#[from] meshpaint_core::mct::MctError),
     /// The measurement needs a reference the file does not have.
     #[error("{0}")]
     NoReference(String),

@@ -10,7 +10,7 @@ use meshpaint_core::io::display::{OpenOptions, open_for_display};
 use meshpaint_core::io::document::Source;
 use meshpaint_render::{DrawItem, FilterMode, Gpu, Overlays, RenderSettings, Shading};
 
-use super::args::{CameraArgs, LOG_TARGET, ResolutionArg};
+use super::args::{CameraArgs, LOG_TARGET, Representation, ResolutionArg};
 
 /// Arguments of `meshpaint render`.
 #[derive(Debug, clap::Args)]
@@ -52,6 +52,11 @@ pub(super) struct RenderArgs {
     /// shape and its samples; the document is unchanged).
     #[arg(long, conflicts_with = "baseline_uv")]
     position_colors: bool,
+    /// mesh-colors (software filter in the shader) or mct (Mesh Color Textures: the same
+    /// colours in a 2D atlas filtered by the GPU's sampler; docs/MCT.md). Nearest filters
+    /// draw bilinear with mct.
+    #[arg(long, value_enum, default_value_t = Representation::MeshColors, conflicts_with = "baseline_uv")]
+    representation: Representation,
 }
 
 /// `--filter` values.
@@ -124,16 +129,31 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
         for warning in &displayed.document.warnings {
             log::warn!(target: LOG_TARGET, "{}: {warning}", args.file.display());
         }
+        let document = &displayed.document;
+        let shown = if args.position_colors {
+            let store = meshpaint_core::io::document::position_colored(&document.store, &document.positions);
+            Some(meshpaint_core::io::document::Document { store, ..document.clone() })
+        } else {
+            None
+        };
+        let shown = shown.as_ref().unwrap_or(document);
         let mesh = match displayed.upload {
             Some(mesh) => mesh,
-            None => {
-                let document = &displayed.document;
-                let store = meshpaint_core::io::document::position_colored(&document.store, &document.positions);
-                let view = meshpaint_core::io::document::Document { store, ..document.clone() };
-                gpu.upload(&view.pack(document.display_format())?)?
+            None => gpu.upload(&shown.pack(document.display_format())?)?,
+        };
+        let image = match args.representation {
+            Representation::MeshColors => {
+                gpu.render_image(DrawItem::MeshColors(&mesh), &settings(mesh.bounds), args.width, args.height)?
+            }
+            Representation::Mct => {
+                let packed = shown.pack(document.display_format())?;
+                let max_dimension = gpu.ctx.limits().max_texture_dimension_2d;
+                let texture = meshpaint_core::mct::build(&packed, max_dimension, budget.memory_bytes)
+                    .with_context(|| format!("{}: building the Mesh Color Texture", args.file.display()))?;
+                let mct = meshpaint_render::GpuMct::upload(&gpu.ctx, gpu.renderer.layouts(), &mesh, &texture)?;
+                gpu.render_image(DrawItem::Mct(&mct), &settings(mesh.bounds), args.width, args.height)?
             }
         };
-        let image = gpu.render_image(DrawItem::MeshColors(&mesh), &settings(mesh.bounds), args.width, args.height)?;
         (image, mesh.face_count, mesh.atlas.samples)
     };
     image.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;

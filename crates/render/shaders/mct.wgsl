@@ -33,7 +33,7 @@ struct VertexOut {
     @location(0) bary: vec3<f32>,
     // rgb: heat-map colour of log2 R_b; a: dot(face normal, light direction).
     @location(1) @interpolate(flat) shade: vec4<f32>,
-    // Level 0: the texel-space point in the atlas (texel centres at integers).
+    // Level 0: the normalised atlas coordinate of the tent point, (point + 0.5) / size.
     @location(2) tent: vec2<f32>,
     // Levels ≥ 1: R_b · (w_α e_x + w_β e_y) of the square frame (see `square_point`).
     @location(3) square: vec2<f32>,
@@ -128,10 +128,11 @@ fn mct_bilinear(point: vec2<f32>) -> vec4<f32> {
     return textureSampleLevel(mct_atlas, mct_sampler, (point + 0.5) / size, 0.0);
 }
 
-// sample.rs `sample_level`: level 0 in the tent, levels ≥ 1 in the square.
-fn mct_level(record: u32, tent: vec2<f32>, square: vec2<f32>, level: u32) -> vec4<f32> {
+// sample.rs `sample_level`: level 0 in the tent (`tent_uv` normalised), levels ≥ 1 in the
+// square.
+fn mct_level(record: u32, tent_uv: vec2<f32>, square: vec2<f32>, level: u32) -> vec4<f32> {
     if level == 0u {
-        return mct_bilinear(tent);
+        return textureSampleLevel(mct_atlas, mct_sampler, tent_uv, 0.0);
     }
     return mct_bilinear(square_point(record, square, level));
 }
@@ -148,7 +149,7 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
     out.lod = pulled.lod;
     out.shade = vec4<f32>(heat_color(mct_log2_block(record)), pulled.face_dot);
     out.light_dot = pulled.light_dot;
-    out.tent = tent_corner(record, corner);
+    out.tent = (tent_corner(record, corner) + 0.5) / vec2<f32>(textureDimensions(mct_atlas));
     out.square = square_corner(record, corner);
     out.record = record;
     return out;

@@ -81,7 +81,7 @@ impl BindLayouts {
                 data(5, wgpu::TextureSampleType::Float { filterable: false }),
                 layout_entry(
                     4,
-                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::ShaderStages::VERTEX_FRAGMENT,
                     wgpu::BindingType::Texture {
                         sample_type: wgpu::TextureSampleType::Float { filterable: true },
                         view_dimension: wgpu::TextureViewDimension::D2,

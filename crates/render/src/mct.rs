@@ -51,34 +51,7 @@ impl GpuMct {
         mesh: &GpuMesh,
         mct: &MeshColorTexture,
     ) -> Result<Self, RenderError> {
-        let (width, height) = (mct.layout.width, mct.layout.height);
-        let max_dimension = ctx.limits().max_texture_dimension_2d;
-        if width == 0 || height == 0 || width > max_dimension || height > max_dimension {
-            return Err(RenderError::InvalidTexture(format!(
-                "Mesh Color Texture atlas {width}×{height} is outside 1..={max_dimension} per side"
-            )));
-        }
-        if mct.layout.records.len() != mesh.face_count as usize {
-            return Err(RenderError::InvalidMesh(format!(
-                "{} MCT face records for {} faces",
-                mct.layout.records.len(),
-                mesh.face_count
-            )));
-        }
-        let bpp = mct.format.bytes_per_sample() as u64;
-        if mct.texels.len() as u64 != u64::from(width) * u64::from(height) * bpp {
-            return Err(RenderError::InvalidTexture(format!(
-                "{} atlas bytes for {width}×{height} texels of {bpp} bytes",
-                mct.texels.len()
-            )));
-        }
-        if mct.format == ColorFormat::Rgba32F && !ctx.device.features().contains(wgpu::Features::FLOAT32_FILTERABLE) {
-            return Err(RenderError::InvalidTexture(
-                "an RGBA32F Mesh Color Texture needs a GPU that filters 32-bit float textures \
-                 (FLOAT32_FILTERABLE); pack with RGBA16F or RGBA8"
-                    .into(),
-            ));
-        }
+        let (width, height) = check(ctx, mesh, mct)?;
         let atlas = ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("mesh color texture atlas"),
             size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
@@ -89,30 +62,7 @@ impl GpuMct {
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
-        // Row bands so that no single write stages the whole atlas.
-        let row_bytes = u64::from(width) * bpp;
-        let band_rows = ((64u64 << 20) / row_bytes).max(1);
-        let mut y = 0u64;
-        while y < u64::from(height) {
-            let rows = band_rows.min(u64::from(height) - y);
-            let start = (y * row_bytes) as usize;
-            ctx.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &atlas,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d { x: 0, y: y as u32, z: 0 },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                &mct.texels[start..start + (rows * row_bytes) as usize],
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row_bytes as u32),
-                    rows_per_image: Some(rows as u32),
-                },
-                wgpu::Extent3d { width, height: rows as u32, depth_or_array_layers: 1 },
-            );
-            y += rows;
-        }
+        write_atlas(ctx, &atlas, mct);
         let records = data_texture(
             ctx,
             "MCT face records",
@@ -179,5 +129,67 @@ impl GpuMct {
             u64::from(self.atlas.width()) * u64::from(self.atlas.height()) * self.format.bytes_per_sample() as u64;
         let records = u64::from(self.records.width()) * u64::from(self.records.height()) * 4;
         atlas + records + self.bands.size()
+    }
+}
+
+/// The atlas size, or why `mct` cannot be drawn with `mesh` on this device.
+fn check(ctx: &GpuContext, mesh: &GpuMesh, mct: &MeshColorTexture) -> Result<(u32, u32), RenderError> {
+    let (width, height) = (mct.layout.width, mct.layout.height);
+    let max_dimension = ctx.limits().max_texture_dimension_2d;
+    if width == 0 || height == 0 || width > max_dimension || height > max_dimension {
+        return Err(RenderError::InvalidTexture(format!(
+            "Mesh Color Texture atlas {width}×{height} is outside 1..={max_dimension} per side"
+        )));
+    }
+    if mct.layout.records.len() != mesh.face_count as usize {
+        return Err(RenderError::InvalidMesh(format!(
+            "{} MCT face records for {} faces",
+            mct.layout.records.len(),
+            mesh.face_count
+        )));
+    }
+    let bpp = mct.format.bytes_per_sample() as u64;
+    if mct.texels.len() as u64 != u64::from(width) * u64::from(height) * bpp {
+        return Err(RenderError::InvalidTexture(format!(
+            "{} atlas bytes for {width}×{height} texels of {bpp} bytes",
+            mct.texels.len()
+        )));
+    }
+    if mct.format == ColorFormat::Rgba32F && !ctx.device.features().contains(wgpu::Features::FLOAT32_FILTERABLE) {
+        return Err(RenderError::InvalidTexture(
+            "an RGBA32F Mesh Color Texture needs a GPU that filters 32-bit float textures \
+             (FLOAT32_FILTERABLE); pack with RGBA16F or RGBA8"
+                .into(),
+        ));
+    }
+    Ok((width, height))
+}
+
+/// Uploads the atlas texels in bands of rows, so that no single write stages the whole atlas.
+fn write_atlas(ctx: &GpuContext, atlas: &wgpu::Texture, mct: &MeshColorTexture) {
+    let (width, height) = (mct.layout.width, mct.layout.height);
+    let bpp = mct.format.bytes_per_sample() as u64;
+    let row_bytes = u64::from(width) * bpp;
+    let band_rows = ((64u64 << 20) / row_bytes).max(1);
+    let mut y = 0u64;
+    while y < u64::from(height) {
+        let rows = band_rows.min(u64::from(height) - y);
+        let start = (y * row_bytes) as usize;
+        ctx.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: atlas,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: 0, y: y as u32, z: 0 },
+                aspect: wgpu::TextureAspect::All,
+            },
+            &mct.texels[start..start + (rows * row_bytes) as usize],
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row_bytes as u32),
+                rows_per_image: Some(rows as u32),
+            },
+            wgpu::Extent3d { width, height: rows as u32, depth_or_array_layers: 1 },
+        );
+        y += rows;
     }
 }

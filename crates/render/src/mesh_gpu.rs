@@ -403,6 +403,16 @@ impl GpuMesh {
         &self.face_records
     }
 
+    /// Bytes of the colour atlas texture.
+    pub fn atlas_bytes(&self) -> u64 {
+        u64::from(self.atlas.width) * u64::from(self.atlas.height) * self.format.bytes_per_sample() as u64
+    }
+
+    /// Bytes of the face-record data texture.
+    pub fn face_record_bytes(&self) -> u64 {
+        data_texture_bytes(&self.face_records)
+    }
+
     /// GPU memory of the mesh's data textures and atlas, in bytes.
     pub fn gpu_bytes(&self) -> u64 {
         let atlas = u64::from(self.atlas.width) * u64::from(self.atlas.height) * self.format.bytes_per_sample() as u64;

@@ -96,7 +96,7 @@ fn level_0_bilinear_is_the_linear_filter_along_every_edge() {
         ("uniform 2", |_| 2),
         ("uniform 8", |_| 8),
         ("uniform 64", |_| 64),
-        ("mixed 1..32", mixed),
+        ("mixed", mixed),
         ("mixed 1|64", |f| if f % 3 == 0 { 64 } else { 1 }),
     ] {
         let levels = if name.contains("64") { 1 } else { 2 };
