@@ -1,6 +1,6 @@
 //! An engine-side reader: a standalone wgpu program that loads a meshpaint packed file
 //! through the documented format (docs/FORMAT.md, "Use it in your renderer") and draws it
-//! with the shipped WGSL (shaders/frame.wgsl + shaders/mesh_colors.wgsl, unchanged),
+//! with the shipped WGSL (shaders/frame.wgsl + mesh_common.wgsl + mesh_colors.wgsl, unchanged),
 //! offscreen, into a PNG:
 //! `cargo run --example view_packed -- painted.mpk out.png [WIDTH HEIGHT [YAW PITCH]]`.
 //!
@@ -14,9 +14,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail, ensure};
 use glam::{DMat4, DVec3};
 
-/// The shader exactly as meshpaint compiles it: the uniform block first, then mesh colors.
+/// The shader exactly as meshpaint compiles it: the uniform block, the shared vertex pulling, mesh colors.
 const WGSL: &str = concat!(
     include_str!("../crates/render/shaders/frame.wgsl"),
+    "\n",
+    include_str!("../crates/render/shaders/mesh_common.wgsl"),
     "\n",
     include_str!("../crates/render/shaders/mesh_colors.wgsl")
 );
