@@ -51,6 +51,7 @@ use crate::colors::format::ColorFormat;
 use crate::mct::layout::{GROUPS, MctBands, MctFaceRecord, MctLayout};
 use crate::mct::{MctStats, MeshColorTexture};
 use crate::packing::file::Expected;
+use crate::packing::file::sections::{self, Fields, Section, align_up, checksum, le_words, section_bytes};
 
 mod check;
 mod error;
@@ -65,7 +66,7 @@ pub const VERSION: u32 = 1;
 /// Size of the version-1 header in bytes (zero-padded to [`SECTION_ALIGN`]).
 pub const HEADER_SIZE: usize = 144;
 /// Alignment of every section's offset in bytes.
-pub const SECTION_ALIGN: u64 = 256;
+pub const SECTION_ALIGN: u64 = sections::SECTION_ALIGN;
 /// Flag bits defined by this version (none); any set bit is refused.
 pub const KNOWN_FLAGS: u32 = 0;
 /// The largest atlas side in texels: the GPU colour atlas width meshpaint uses
@@ -102,13 +103,6 @@ pub struct MctFile {
     pub mct: MeshColorTexture,
 }
 
-/// One entry of the section table.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-struct Section {
-    offset: u64,
-    length: u64,
-}
-
 /// The decoded version-1 header.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 struct Header {
@@ -126,31 +120,6 @@ struct Header {
     sections: [Section; SECTION_COUNT],
     reserved_136: u32,
     checksum: u32,
-}
-
-/// A panic-free little-endian field reader over the fixed-size header.
-struct Fields<'a>(&'a [u8]);
-
-impl Fields<'_> {
-    fn u32(&mut self) -> u32 {
-        match self.0.split_first_chunk::<4>() {
-            Some((head, rest)) => {
-                self.0 = rest;
-                u32::from_le_bytes(*head)
-            }
-            None => 0,
-        }
-    }
-
-    fn u64(&mut self) -> u64 {
-        match self.0.split_first_chunk::<8>() {
-            Some((head, rest)) => {
-                self.0 = rest;
-                u64::from_le_bytes(*head)
-            }
-            None => 0,
-        }
-    }
 }
 
 impl Header {
@@ -221,22 +190,9 @@ impl Header {
     }
 }
 
-/// The CRC-32 of every byte of `bytes` except the checksum field (header bytes 140..144).
-fn checksum(bytes: &[u8]) -> u32 {
-    let mut hasher = crc32fast::Hasher::new();
-    hasher.update(bytes.get(..CHECKSUM_OFFSET).unwrap_or(bytes));
-    hasher.update(bytes.get(CHECKSUM_OFFSET + 4..).unwrap_or_default());
-    hasher.finalize()
-}
-
 /// Whether `bytes` starts with the MCT-file [`MAGIC`].
 pub fn looks_like_mct(bytes: &[u8]) -> bool {
     bytes.starts_with(&MAGIC)
-}
-
-/// `value` rounded up to a multiple of [`SECTION_ALIGN`], or `None` on overflow.
-fn align_up(value: u64) -> Option<u64> {
-    value.checked_add(SECTION_ALIGN - 1).map(|v| v / SECTION_ALIGN * SECTION_ALIGN)
 }
 
 /// Encodes a mesh and its Mesh Color Texture as an MCT file.
@@ -325,7 +281,7 @@ pub fn to_bytes(positions: &[[f32; 3]], indices: &[[u32; 3]], mct: &MeshColorTex
     pad_to(&mut out, sections[4]);
     out.extend_from_slice(&mct.texels);
 
-    let crc = checksum(&out);
+    let crc = checksum(&out, CHECKSUM_OFFSET);
     if let Some(slot) = out.get_mut(CHECKSUM_OFFSET..CHECKSUM_OFFSET + 4) {
         slot.copy_from_slice(&crc.to_le_bytes());
     }
@@ -390,13 +346,6 @@ fn check_sections(header: &Header, len: u64) -> Result<(), MctFileError> {
     Ok(())
 }
 
-/// The bytes of a section already checked to lie inside `bytes`.
-fn section_bytes(bytes: &[u8], section: Section) -> &[u8] {
-    let start = usize::try_from(section.offset).unwrap_or(usize::MAX);
-    let end = usize::try_from(section.offset.saturating_add(section.length)).unwrap_or(usize::MAX);
-    bytes.get(start..end).unwrap_or_default()
-}
-
 /// Checks that every byte outside the header fields and the sections is zero.
 fn check_padding(bytes: &[u8], header: &Header) -> Result<(), MctFileError> {
     let mut gap_start = HEADER_SIZE as u64;
@@ -431,21 +380,6 @@ fn check_length(
     Ok(())
 }
 
-/// Splits `bytes` into groups of `N` little-endian `u32` words (a partial group at the end
-/// is ignored; callers pass whole sections).
-fn le_words<const N: usize>(bytes: &[u8]) -> Vec<[u32; N]> {
-    bytes
-        .chunks_exact(4 * N)
-        .map(|chunk| {
-            let mut words = [0u32; N];
-            for (word, le) in words.iter_mut().zip(chunk.chunks_exact(4)) {
-                *word = u32::from_le_bytes(le.first_chunk::<4>().copied().unwrap_or_default());
-            }
-            words
-        })
-        .collect()
-}
-
 /// Decodes an MCT file, refusing anything truncated, corrupt or hostile.
 ///
 /// Never panics, and allocates at most about the size of `bytes`. See the module
@@ -472,7 +406,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
         return Err(MctFileError::HeaderSize(header.header_size));
     }
     check_sections(&header, len)?;
-    let computed = checksum(bytes);
+    let computed = checksum(bytes, CHECKSUM_OFFSET);
     if computed != header.checksum {
         return Err(MctFileError::ChecksumMismatch { stored: header.checksum, computed });
     }

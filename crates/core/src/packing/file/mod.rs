@@ -47,6 +47,9 @@ use crate::colors::layout::{MAX_LOG2_RESOLUTION, Resolution, edge_chain_len, int
 use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, unpack_word};
 
 mod error;
+pub(crate) mod sections;
+
+use sections::{Fields, Section, align_up, checksum, le_words, section_bytes};
 
 pub use error::{Expected, PackedFileError};
 
@@ -57,7 +60,7 @@ pub const VERSION: u32 = 1;
 /// Size of the version-1 header in bytes (the header is zero-padded to [`SECTION_ALIGN`]).
 pub const HEADER_SIZE: usize = 128;
 /// Alignment of every section's offset in bytes.
-pub const SECTION_ALIGN: u64 = 256;
+pub const SECTION_ALIGN: u64 = sections::SECTION_ALIGN;
 /// Flag bits defined by this version (none); any set bit is refused.
 pub const KNOWN_FLAGS: u32 = 0;
 
@@ -73,13 +76,6 @@ const RECORD_SIZE: u64 = 16;
 const SECTION_COUNT: usize = 4;
 /// Section names, in table and file order.
 const SECTION_NAMES: [&str; SECTION_COUNT] = ["positions", "indices", "face records", "colors"];
-
-/// One entry of the section table.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-struct Section {
-    offset: u64,
-    length: u64,
-}
 
 /// The decoded version-1 header.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -97,31 +93,6 @@ struct Header {
     sections: [Section; SECTION_COUNT],
     reserved_120: u32,
     checksum: u32,
-}
-
-/// A panic-free little-endian field reader over the fixed-size header.
-struct Fields<'a>(&'a [u8]);
-
-impl Fields<'_> {
-    fn u32(&mut self) -> u32 {
-        match self.0.split_first_chunk::<4>() {
-            Some((head, rest)) => {
-                self.0 = rest;
-                u32::from_le_bytes(*head)
-            }
-            None => 0,
-        }
-    }
-
-    fn u64(&mut self) -> u64 {
-        match self.0.split_first_chunk::<8>() {
-            Some((head, rest)) => {
-                self.0 = rest;
-                u64::from_le_bytes(*head)
-            }
-            None => 0,
-        }
-    }
 }
 
 impl Header {
@@ -184,22 +155,9 @@ impl Header {
     }
 }
 
-/// The CRC-32 of every byte of `bytes` except the checksum field (header bytes 124..128).
-fn checksum(bytes: &[u8]) -> u32 {
-    let mut hasher = crc32fast::Hasher::new();
-    hasher.update(bytes.get(..CHECKSUM_OFFSET).unwrap_or(bytes));
-    hasher.update(bytes.get(CHECKSUM_OFFSET + 4..).unwrap_or_default());
-    hasher.finalize()
-}
-
 /// Whether `bytes` starts with the packed-file [`MAGIC`] (to choose a loader by content).
 pub fn looks_like_packed(bytes: &[u8]) -> bool {
     bytes.starts_with(&MAGIC)
-}
-
-/// `value` rounded up to a multiple of [`SECTION_ALIGN`], or `None` on overflow.
-fn align_up(value: u64) -> Option<u64> {
-    value.checked_add(SECTION_ALIGN - 1).map(|v| v / SECTION_ALIGN * SECTION_ALIGN)
 }
 
 /// Checks the content of a mesh whose buffers have consistent sizes: the limits of the
@@ -386,7 +344,7 @@ pub fn to_bytes(mesh: &PackedMesh) -> Result<Vec<u8>, PackedFileError> {
     pad_to(&mut out, colors_at);
     out.extend_from_slice(&mesh.colors);
 
-    let crc = checksum(&out);
+    let crc = checksum(&out, CHECKSUM_OFFSET);
     if let Some(slot) = out.get_mut(CHECKSUM_OFFSET..CHECKSUM_OFFSET + 4) {
         for (dst, src) in slot.iter_mut().zip(crc.to_le_bytes()) {
             *dst = src;
@@ -474,28 +432,6 @@ fn check_length(
     Ok(())
 }
 
-/// The bytes of a section already checked to lie inside `bytes`.
-fn section_bytes(bytes: &[u8], section: Section) -> &[u8] {
-    let start = usize::try_from(section.offset).unwrap_or(usize::MAX);
-    let end = usize::try_from(section.offset.saturating_add(section.length)).unwrap_or(usize::MAX);
-    bytes.get(start..end).unwrap_or_default()
-}
-
-/// Splits `bytes` into groups of `N` little-endian `u32` words (a partial group at the
-/// end is ignored; callers pass whole sections).
-fn le_words<const N: usize>(bytes: &[u8]) -> Vec<[u32; N]> {
-    bytes
-        .chunks_exact(4 * N)
-        .map(|chunk| {
-            let mut words = [0u32; N];
-            for (word, le) in words.iter_mut().zip(chunk.chunks_exact(4)) {
-                *word = u32::from_le_bytes(le.first_chunk::<4>().copied().unwrap_or_default());
-            }
-            words
-        })
-        .collect()
-}
-
 /// Decodes a packed file, refusing anything truncated, corrupt or hostile.
 ///
 /// Never panics, and allocates at most about the size of `bytes`. See the module
@@ -524,7 +460,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<PackedMesh, PackedFileError> {
         return Err(PackedFileError::HeaderSize(header.header_size));
     }
     check_sections(&header, len)?;
-    let computed = checksum(bytes);
+    let computed = checksum(bytes, CHECKSUM_OFFSET);
     if computed != header.checksum {
         return Err(PackedFileError::ChecksumMismatch { stored: header.checksum, computed });
     }
