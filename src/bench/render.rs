@@ -175,7 +175,7 @@ pub fn bench_render(
     let max_dimension = ctx.limits().max_texture_dimension_2d;
     let texture = meshpaint_core::mct::build(&packed, max_dimension, u64::MAX)?;
     let mct_build_seconds = build_start.elapsed().as_secs_f64();
-    let mct = meshpaint_render::GpuMct::upload(ctx, gpu.renderer.layouts(), &mesh, &texture)?;
+    let mct = gpu.upload_mct(&mesh.geometry(), &texture)?;
 
     let camera: OrbitCamera = default_camera(mesh.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
     let timer = FrameTimer::new(&gpu, width, height);

@@ -150,7 +150,7 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
                 let max_dimension = gpu.ctx.limits().max_texture_dimension_2d;
                 let texture = meshpaint_core::mct::build(&packed, max_dimension, budget.memory_bytes)
                     .with_context(|| format!("{}: building the Mesh Color Texture", args.file.display()))?;
-                let mct = meshpaint_render::GpuMct::upload(&gpu.ctx, gpu.renderer.layouts(), &mesh, &texture)?;
+                let mct = gpu.upload_mct(&mesh.geometry(), &texture)?;
                 gpu.render_image(DrawItem::Mct(&mct), &settings(mesh.bounds), args.width, args.height)?
             }
         };

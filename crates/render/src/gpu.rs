@@ -9,9 +9,10 @@ use image::RgbaImage;
 use super::{
     BaselineMesh, BaselineSource, DrawItem, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderError,
 };
-use super::{RenderSettings, Renderer};
+use super::{GpuMct, MeshGeometry, RenderSettings, Renderer};
 use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::colors::store::ColorStore;
+use meshpaint_core::mct::MeshColorTexture;
 use meshpaint_core::mesh::scene::Scene;
 use meshpaint_core::mesh::weld::weld_scene;
 use meshpaint_core::packing::linear::PackedMesh;
@@ -52,6 +53,12 @@ impl Gpu {
     /// Uploads packed buffers (face records, positions, colour atlas with MIP chains).
     pub fn upload(&self, packed: &PackedMesh) -> Result<GpuMesh, RenderError> {
         GpuMesh::upload(&self.ctx, self.renderer.layouts(), packed, &MeshUploadOptions::default())
+    }
+
+    /// Uploads the Mesh Color Texture `mct`, built from the packed mesh whose GPU mesh has
+    /// the geometry `geometry` ([`GpuMesh::geometry`]).
+    pub fn upload_mct(&self, geometry: &MeshGeometry, mct: &MeshColorTexture) -> Result<GpuMct, RenderError> {
+        GpuMct::upload(&self.ctx, self.renderer.layouts(), geometry, mct)
     }
 
     /// Puts `store` on the GPU in its paint `layout`, encoded in `format` (the one path of

@@ -49,7 +49,7 @@ pub use context::{GpuContext, backends_from_env};
 pub use gpu::{Gpu, PaintUpload};
 pub use layouts::BindLayouts;
 pub use mct::GpuMct;
-pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshUploadOptions, atlas_texture_format, default_atlas_width};
+pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshGeometry, MeshUploadOptions, atlas_texture_format, default_atlas_width};
 pub use renderer::{
     DrawItem, FRAME_WGSL, FilterMode, MCT_WGSL, MESH_COLORS_WGSL, Overlays, RenderSettings, RenderTarget, Renderer,
     Shading, UV_BASELINE_WGSL,

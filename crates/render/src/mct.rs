@@ -7,7 +7,7 @@ use glam::DVec3;
 
 use super::layouts::BindLayouts;
 use super::mesh_gpu::{atlas_texture_format, data_texture};
-use super::{GpuContext, GpuMesh, RenderError};
+use super::{GpuContext, MeshGeometry, RenderError};
 use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::mct::{MctBands, MctFaceRecord, MeshColorTexture};
 
@@ -34,12 +34,13 @@ pub struct GpuMct {
 }
 
 impl GpuMct {
-    /// Uploads `mct` (built from the packed mesh `mesh` was uploaded from) against the
-    /// renderer's `layouts`. RGBA32F atlases need the adapter's `FLOAT32_FILTERABLE`.
+    /// Uploads `mct` (built from the packed mesh whose GPU mesh has the geometry `mesh`)
+    /// against the renderer's `layouts`. RGBA32F atlases need the adapter's
+    /// `FLOAT32_FILTERABLE`. [`super::Gpu::upload_mct`] is the short form.
     pub fn upload(
         ctx: &GpuContext,
         layouts: &BindLayouts,
-        mesh: &GpuMesh,
+        mesh: &MeshGeometry,
         mct: &MeshColorTexture,
     ) -> Result<Self, RenderError> {
         ctx.checked(|| Self::upload_unchecked(ctx, layouts, mesh, mct))
@@ -48,7 +49,7 @@ impl GpuMct {
     fn upload_unchecked(
         ctx: &GpuContext,
         layouts: &BindLayouts,
-        mesh: &GpuMesh,
+        mesh: &MeshGeometry,
         mct: &MeshColorTexture,
     ) -> Result<Self, RenderError> {
         let (width, height) = check(ctx, mesh, mct)?;
@@ -92,7 +93,7 @@ impl GpuMct {
             mapped_at_creation: false,
         });
         let view = |texture: &wgpu::Texture| texture.create_view(&wgpu::TextureViewDescriptor::default());
-        let [positions, indices, normals] = mesh.geometry_textures();
+        let (positions, indices, normals) = (&mesh.positions, &mesh.indices, &mesh.normals);
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("MCT bind group"),
             layout: layouts.mct(),
@@ -133,7 +134,7 @@ impl GpuMct {
 }
 
 /// The atlas size, or why `mct` cannot be drawn with `mesh` on this device.
-fn check(ctx: &GpuContext, mesh: &GpuMesh, mct: &MeshColorTexture) -> Result<(u32, u32), RenderError> {
+fn check(ctx: &GpuContext, mesh: &MeshGeometry, mct: &MeshColorTexture) -> Result<(u32, u32), RenderError> {
     let (width, height) = (mct.layout.width, mct.layout.height);
     let max_dimension = ctx.limits().max_texture_dimension_2d;
     if width == 0 || height == 0 || width > max_dimension || height > max_dimension {

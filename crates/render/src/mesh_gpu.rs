@@ -174,6 +174,22 @@ pub fn atlas_texture_format(format: ColorFormat) -> wgpu::TextureFormat {
     }
 }
 
+/// The geometry of a [`GpuMesh`] that the other representations share
+/// ([`GpuMesh::geometry`]): its render origin, counts, and the positions, vertex-id and
+/// normal textures.
+#[derive(Debug, Clone)]
+pub struct MeshGeometry {
+    /// The render origin ([`GpuMesh::origin`]).
+    pub origin: DVec3,
+    /// Number of faces.
+    pub face_count: u32,
+    /// Number of vertices.
+    pub vertex_count: u32,
+    pub(crate) positions: wgpu::Texture,
+    pub(crate) indices: wgpu::Texture,
+    pub(crate) normals: wgpu::Texture,
+}
+
 /// A packed mesh uploaded for the mesh-colors pipeline.
 #[derive(Debug)]
 pub struct GpuMesh {
@@ -389,10 +405,17 @@ impl GpuMesh {
         Ok(())
     }
 
-    /// The geometry textures the Mesh Color Textures pipeline shares: positions, vertex ids
-    /// and normals.
-    pub(super) fn geometry_textures(&self) -> [&wgpu::Texture; 3] {
-        [&self.positions, &self.indices, &self.normals]
+    /// The mesh's geometry on the GPU, which the other representations draw with (handles to
+    /// the same textures: nothing is copied, and the handle can go to a worker thread).
+    pub fn geometry(&self) -> MeshGeometry {
+        MeshGeometry {
+            origin: self.origin,
+            face_count: self.face_count,
+            vertex_count: self.vertex_count,
+            positions: self.positions.clone(),
+            indices: self.indices.clone(),
+            normals: self.normals.clone(),
+        }
     }
 
     pub(super) fn atlas_texture(&self) -> &wgpu::Texture {
