@@ -19,12 +19,13 @@ use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::convert::adaptive::ResolutionRule;
 use meshpaint_core::io::display::{Displayed, OpenOptions, open_for_display};
 use meshpaint_core::io::document::{Document, Source, SourceKind};
+use meshpaint_core::packing::linear::PackedMesh;
 use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::paint::picking::MeshBvh;
-use meshpaint_render::{BaselineMesh, DrawItem, Gpu, GpuMesh};
+use meshpaint_render::{BaselineMesh, DrawItem, Gpu, GpuMct, GpuMesh, MeshGeometry};
 
 use super::jobs::JobContext;
-use super::state::Shown;
+use super::state::{Representation, Shown};
 use super::text::{human_bytes, thousands};
 
 /// A document open in the editor.
@@ -61,6 +62,9 @@ pub struct OpenDocument {
     pub pack_cache: Option<PackCache>,
     /// The other views of the document, built the first time they are shown.
     pub alternates: AlternateViews,
+    /// Counts changes of the GPU mesh's colours or layout (a repack, paint mode): a Mesh
+    /// Color Texture built for an older generation is stale.
+    pub mesh_generation: u64,
 }
 
 /// The views of a document besides its mesh colors ([`super::state::Shown`]), each built on
@@ -71,6 +75,42 @@ pub struct AlternateViews {
     pub source_texture: Option<Result<BaselineMesh, String>>,
     /// The position colour field (the mesh at its own resolutions).
     pub position_colors: Option<Result<GpuMesh, String>>,
+    /// The Mesh Color Texture of the packed mesh, with the mesh generation it was built for
+    /// ([`OpenDocument::mesh_generation`]).
+    pub mct: Option<(u64, Result<BuiltMct, String>)>,
+}
+
+/// A Mesh Color Texture on the GPU and what building it cost.
+#[derive(Debug)]
+pub struct BuiltMct {
+    /// The atlas, records and band table, drawn with the document's GPU mesh geometry.
+    pub mct: GpuMct,
+    /// Store-independent build time (packed mesh → atlas), without the upload.
+    pub build: Duration,
+    /// Atlas, records and band table over the packed mesh's face records and colours.
+    pub bytes_over_mesh_colors: f64,
+}
+
+/// Builds the Mesh Color Texture of `packed` (the packed mesh of the GPU mesh with the
+/// geometry `geometry`) within `budget` and uploads it (a job's work).
+pub fn build_mct(
+    packed: &PackedMesh,
+    geometry: &MeshGeometry,
+    budget: &Budget,
+    gpu: &Gpu,
+    job: &JobContext,
+) -> Result<BuiltMct, String> {
+    job.progress(0.1, "laying out and filling the atlas");
+    let started = Instant::now();
+    let max_dimension = gpu.ctx.limits().max_texture_dimension_2d;
+    let texture = meshpaint_core::mct::build(packed, max_dimension, budget.memory_bytes)
+        .map_err(|error| format!("building the Mesh Color Texture: {error}"))?;
+    let build = started.elapsed();
+    job.progress(0.8, "uploading the atlas");
+    let mct =
+        gpu.upload_mct(geometry, &texture).map_err(|error| format!("uploading the Mesh Color Texture: {error}"))?;
+    let mesh_colors = (packed.face_record_bytes() + packed.color_bytes()).max(1);
+    Ok(BuiltMct { mct, build, bytes_over_mesh_colors: texture.gpu_bytes() as f64 / mesh_colors as f64 })
 }
 
 /// One alternate view, built by [`build_alternate`].
@@ -80,6 +120,8 @@ pub enum AlternateView {
     SourceTexture(Box<Result<BaselineMesh, String>>),
     /// [`AlternateViews::position_colors`].
     PositionColors(Box<Result<GpuMesh, String>>),
+    /// [`AlternateViews::mct`], built for this mesh generation.
+    Mct(u64, Box<Result<BuiltMct, String>>),
 }
 
 /// Builds the view `shown` of `document`, opened from `source`, on `gpu` (`None` for
@@ -148,11 +190,38 @@ impl OpenDocument {
         .map(String::as_str)
     }
 
-    /// What the 3D view draws for `shown`: that alternate view once it is built, else the
-    /// mesh colors (`None` without a GPU).
-    pub fn shown_item(&self, shown: Shown) -> Option<DrawItem<'_>> {
+    /// Whether the Mesh Color Texture of the current GPU mesh still has to be built.
+    pub fn mct_missing(&self) -> bool {
+        self.alternates.mct.as_ref().is_none_or(|(generation, _)| *generation != self.mesh_generation)
+    }
+
+    /// The Mesh Color Texture of the current GPU mesh, if it is built; `Err` says why it
+    /// cannot be.
+    pub fn current_mct(&self) -> Option<Result<&BuiltMct, &str>> {
+        match &self.alternates.mct {
+            Some((generation, built)) if *generation == self.mesh_generation => {
+                Some(built.as_ref().map_err(String::as_str))
+            }
+            _ => None,
+        }
+    }
+
+    /// The packed mesh and GPU geometry a Mesh Color Texture is built from (`None` without
+    /// a GPU mesh or while paint mode holds the packing).
+    pub fn mct_source(&self) -> Option<(PackedMesh, MeshGeometry)> {
+        let packed = self.pack_cache.as_ref()?.packed();
+        let geometry = self.gpu_mesh.as_ref()?.geometry();
+        Some((packed.clone(), geometry))
+    }
+
+    /// What the 3D view draws for `shown` in `representation`: that alternate view once it
+    /// is built, else the mesh colors (`None` without a GPU).
+    pub fn shown_item(&self, shown: Shown, representation: Representation) -> Option<DrawItem<'_>> {
         let alternate = match shown {
-            Shown::MeshColors => None,
+            Shown::MeshColors => match (representation, self.current_mct()) {
+                (Representation::MeshColorTexture, Some(Ok(built))) => Some(DrawItem::Mct(&built.mct)),
+                _ => None,
+            },
             Shown::SourceTexture => match &self.alternates.source_texture {
                 Some(Ok(mesh)) => Some(DrawItem::Baseline(mesh)),
                 _ => None,
@@ -203,6 +272,7 @@ pub fn load(
         last_repack: timings.pack,
         pack_cache: Some(cache),
         alternates: AlternateViews::default(),
+        mesh_generation: 0,
     })
 }
 

@@ -21,7 +21,7 @@ use meshpaint_render::{DrawItem, FilterMode, Gpu, RenderSettings, Shading};
 
 use super::autosave::{AutosaveTick, Autosaved, Restoring};
 use super::command::Command;
-use super::document;
+use super::document::{self, AlternateView};
 use super::file_dialog::DialogPurpose;
 use super::input;
 use super::job_output::JobOutput;
@@ -32,7 +32,7 @@ use super::panels::{
     LastStroke, PaintPanelContext, Panels, SIDE_PANEL_WIDTH, SceneContext, ViewContext, ViewportContext,
 };
 use super::session::{DocumentState, opened_text};
-use super::state::{Action, Mode, Severity, Shown, Status, ViewportState};
+use super::state::{Action, Mode, Representation, Severity, Shown, Status, ViewportState};
 use super::text::error_text;
 
 /// The editor.
@@ -327,16 +327,51 @@ impl Editor {
         }
     }
 
-    /// What the 3D view draws: the alternate view chosen in the view panel once it is
-    /// built, else the mesh colors.
-    pub fn shown_item(&self) -> Option<DrawItem<'_>> {
-        self.document.open.as_ref()?.shown_item(self.panels.view.settings.shown)
+    /// Builds the Mesh Color Texture of the open document's packed mesh on a job, when the
+    /// view shows that representation and it is missing (never in paint mode, which draws
+    /// the paint layout; leaving it repacks, and the texture is built again from the result).
+    pub fn prepare_mct(&mut self) {
+        let (Some(open), Some(gpu)) = (&self.document.open, &self.gpu) else {
+            return;
+        };
+        let wanted = self.panels.view.settings.representation == Representation::MeshColorTexture;
+        if !wanted || !open.mct_missing() || self.document.level0_only() || self.jobs.is_busy() {
+            return;
+        }
+        let Some((packed, geometry)) = open.mct_source() else {
+            return;
+        };
+        let (path, generation) = (open.path.clone(), open.mesh_generation);
+        let (gpu, budget) = (Arc::clone(gpu), self.budget());
+        let name = Representation::MeshColorTexture.name();
+        let started = self.jobs.start(JobKind::View, format!("Preparing {name}"), move |job| {
+            let built = document::build_mct(&packed, &geometry, &budget, &gpu, job);
+            Ok(JobOutput::View(path, Box::new(AlternateView::Mct(generation, Box::new(built)))))
+        });
+        if let Err(message) = started {
+            self.set_status(Severity::Error, message);
+        }
     }
 
-    /// GPU memory in use: the mesh's buffers and atlas plus the view's render targets.
+    /// The representation the 3D view draws the mesh colors in: the chosen one, except
+    /// while the GPU holds the paint layout (mesh colors at level 0).
+    pub fn shown_representation(&self) -> Representation {
+        if self.document.level0_only() { Representation::MeshColors } else { self.panels.view.settings.representation }
+    }
+
+    /// What the 3D view draws: the alternate view chosen in the view panel once it is
+    /// built, else the mesh colors, in the chosen representation once it is built.
+    pub fn shown_item(&self) -> Option<DrawItem<'_>> {
+        self.document.open.as_ref()?.shown_item(self.panels.view.settings.shown, self.shown_representation())
+    }
+
+    /// GPU memory in use: the mesh's buffers and atlas, a Mesh Color Texture built for it,
+    /// plus the view's render targets.
     pub fn gpu_bytes(&self) -> u64 {
-        let mesh = self.document.open.as_ref().and_then(|d| d.gpu_mesh.as_ref()).map_or(0, |m| m.gpu_bytes());
-        mesh + self.viewport.gpu_bytes
+        let open = self.document.open.as_ref();
+        let mesh = open.and_then(|d| d.gpu_mesh.as_ref()).map_or(0, |m| m.gpu_bytes());
+        let mct = open.and_then(|d| d.current_mct()).and_then(Result::ok).map_or(0, |b| b.mct.gpu_bytes());
+        mesh + mct + self.viewport.gpu_bytes
     }
 
     /// The window title.
@@ -392,6 +427,13 @@ impl Editor {
                     FilterMode::Linear | FilterMode::MipLevel(_) => FilterMode::Trilinear,
                     FilterMode::Trilinear => FilterMode::Nearest,
                 }
+            }
+            Action::ToggleRepresentation => {
+                view.representation = match view.representation {
+                    Representation::MeshColors => Representation::MeshColorTexture,
+                    Representation::MeshColorTexture => Representation::MeshColors,
+                };
+                self.prepare_mct();
             }
             Action::ToggleHelp => self.panels.help.open = !self.panels.help.open,
             Action::Quit => self.quit_requested = true,
@@ -541,6 +583,8 @@ impl Editor {
         self.apply_all(chosen);
         let chosen = self.panels.autosave.recovery_ui(&ctx, self.viewport.rect.center());
         self.apply_all(chosen);
+        // The Mesh Color Texture follows the packed mesh: built again after every repack.
+        self.prepare_mct();
         if self.jobs.is_busy() {
             // Animate the progress bar; a finished job wakes the UI by itself.
             ctx.request_repaint_after(Duration::from_millis(100));

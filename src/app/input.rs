@@ -140,6 +140,13 @@ pub const SHORTCUTS: &[Shortcut] = &[
     shortcut(Modifiers::NONE, Key::H, "H", Action::ToggleHeatmap, "Resolution heat map on / off"),
     shortcut(Modifiers::NONE, Key::L, "L", Action::ToggleShading, "Lit / unlit shading"),
     shortcut(Modifiers::NONE, Key::M, "M", Action::CycleFilter, "Next filter: nearest, linear, trilinear"),
+    shortcut(
+        Modifiers::NONE,
+        Key::T,
+        "T",
+        Action::ToggleRepresentation,
+        "Mesh colors (software filter) / Mesh Color Textures (hardware filter)",
+    ),
     shortcut(Modifiers::NONE, Key::F1, "F1", Action::ToggleHelp, "This help"),
 ];
 

@@ -80,6 +80,9 @@ impl DocumentState {
                 Ok(upload) => {
                     ctx.viewport.upload_bytes_this_frame += upload.bytes;
                     compact_gpu_mesh = open.gpu_mesh.replace(upload.mesh);
+                    // Paint mode draws mesh colors; the Mesh Color Texture is rebuilt after it.
+                    open.mesh_generation += 1;
+                    open.alternates.mct = None;
                     encoded = Some(upload.encoded);
                 }
                 Err(error) => {

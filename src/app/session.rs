@@ -14,7 +14,7 @@ use super::document::{AlternateView, OpenDocument, Written};
 use super::jobs::WriteKind;
 use super::paint_session::{PaintSession, Repacked};
 use super::state::{Mode, Severity, Status, ViewportState};
-use super::text::thousands;
+use super::text::{human_bytes, thousands};
 
 /// The open document and what editing it keeps: paint mode, undo history, edit generation.
 #[derive(Debug)]
@@ -113,6 +113,30 @@ impl DocumentState {
                 open.alternates.position_colors = Some(*built);
                 failed
             }
+            AlternateView::Mct(generation, built) => {
+                if generation != open.mesh_generation {
+                    log::info!("a Mesh Color Texture finished for colours that changed since; ignored");
+                    return;
+                }
+                let failed = match built.as_ref() {
+                    Ok(built) => {
+                        let [w, h] = built.mct.atlas_size;
+                        status.set(
+                            Severity::Info,
+                            format!(
+                                "Built the Mesh Color Texture: {w} × {h} atlas, {} ({:.2}× the mesh colors) in {:.0} ms",
+                                human_bytes(built.mct.gpu_bytes()),
+                                built.bytes_over_mesh_colors,
+                                built.build.as_secs_f64() * 1000.0
+                            ),
+                        );
+                        None
+                    }
+                    Err(message) => Some(message.clone()),
+                };
+                open.alternates.mct = Some((generation, *built));
+                failed
+            }
         };
         if let Some(message) = failed {
             status.set(Severity::Warning, format!("Cannot show it: {message}"));
@@ -140,6 +164,9 @@ impl DocumentState {
         if let Some(mesh) = repacked.gpu_mesh {
             open.gpu_mesh = Some(mesh);
         }
+        // The colours on the GPU changed: a Mesh Color Texture of the old ones is stale.
+        open.mesh_generation += 1;
+        open.alternates.mct = None;
         open.samples_with_mips = repacked.samples_with_mips;
         open.packed_bytes = repacked.packed_bytes;
         open.samples = open.document.store.sample_count();

@@ -91,11 +91,39 @@ impl Shown {
     }
 }
 
+/// How the 3D view draws the mesh colors: the one representation of the document, or one
+/// built from it for the GPU's own filtering.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Representation {
+    /// The packed mesh colors, filtered in the shader (exact: the reference sampler's filters).
+    #[default]
+    MeshColors,
+    /// Mesh Color Textures (Yuksel 2017): the packed colours laid out in one 2D atlas with
+    /// the shared vertex and edge colours duplicated, filtered by the GPU's bilinear sampler
+    /// (crates/core/src/mct; built from the packed mesh when shown, again after each repack).
+    MeshColorTexture,
+}
+
+impl Representation {
+    /// Every choice, in the order the view panel lists them.
+    pub const ALL: [Representation; 2] = [Representation::MeshColors, Representation::MeshColorTexture];
+
+    /// The name the view panel shows.
+    pub fn name(self) -> &'static str {
+        match self {
+            Representation::MeshColors => "Mesh colors (software filter)",
+            Representation::MeshColorTexture => "Mesh Color Textures (hardware filter)",
+        }
+    }
+}
+
 /// Everything that decides how the 3D view looks, besides the camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViewSettings {
     /// What is drawn: the mesh colors, or for comparison the source texture or position colours.
     pub shown: Shown,
+    /// How the mesh colors are drawn (paint mode always draws mesh colors at level 0).
+    pub representation: Representation,
     /// Mesh-colors reconstruction filter.
     pub filter: FilterMode,
     /// Lit or unlit.
@@ -108,6 +136,7 @@ impl Default for ViewSettings {
     fn default() -> Self {
         ViewSettings {
             shown: Shown::MeshColors,
+            representation: Representation::MeshColors,
             filter: FilterMode::Trilinear,
             shading: Shading::Smooth,
             overlays: Overlays::default(),
@@ -174,6 +203,8 @@ pub enum Action {
     ToggleShading,
     /// Cycle the filter: nearest, linear, trilinear.
     CycleFilter,
+    /// Switch the representation: mesh colors / Mesh Color Textures.
+    ToggleRepresentation,
     /// Show or hide the shortcut help window.
     ToggleHelp,
     /// Close the application.

@@ -24,9 +24,10 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::window::{Window, WindowId};
 
-use meshpaint_render::{DEPTH_FORMAT, GpuContext, OFFSCREEN_FORMAT, RenderTarget, Renderer};
+use meshpaint_render::{DEPTH_FORMAT, DrawItem, GpuContext, OFFSCREEN_FORMAT, RenderTarget, Renderer};
 
 use super::editor::Editor;
+use super::state::{Representation, Shown};
 use meshpaint_core::io::document::Source;
 use meshpaint_render::Gpu;
 
@@ -127,6 +128,10 @@ impl ViewTarget {
     }
 }
 
+/// What the 3D view's last drawing shows: render settings, what is shown and in which
+/// representation, view size, scene generation (drawn again only when it changes).
+type DrawnView = (meshpaint_render::RenderSettings, (Shown, Representation), [u32; 2], u64);
+
 /// Everything that exists while the window does.
 struct Running {
     window: Arc<Window>,
@@ -142,8 +147,10 @@ struct Running {
     view: ViewTarget,
     editor: Editor,
     last_logged_viewport: Option<([i32; 2], [u32; 2])>,
+    /// What the 3D view last drew (logged when it changes).
+    last_logged_pipeline: Option<&'static str>,
     /// What the 3D view's target holds: it is redrawn only when this changes.
-    drawn_view: Option<(meshpaint_render::RenderSettings, super::state::Shown, [u32; 2], u64)>,
+    drawn_view: Option<DrawnView>,
     /// UI passes run so far, and where to write that count after each one
     /// (`MESHPAINT_FRAME_COUNT_FILE`, for the idle test: at rest the count must not grow).
     frame_count: (u64, Option<std::path::PathBuf>),
@@ -230,6 +237,7 @@ impl Shell {
             view,
             editor,
             last_logged_viewport: None,
+            last_logged_pipeline: None,
             drawn_view: None,
             frame_count: (0, std::env::var_os("MESHPAINT_FRAME_COUNT_FILE").map(std::path::PathBuf::from)),
             title: "meshpaint".to_owned(),
@@ -357,11 +365,20 @@ impl Running {
             self.drawn_view = None;
         }
         let settings = self.editor.render_settings();
-        let view_key =
-            (settings, self.editor.panels.view.settings.shown, self.view.size, self.editor.viewport.scene_generation);
+        let shown = (self.editor.panels.view.settings.shown, self.editor.shown_representation());
+        let view_key = (settings, shown, self.view.size, self.editor.viewport.scene_generation);
         let item = self.editor.shown_item();
         if let (Some(item), Some(gpu)) = (item.filter(|_| self.drawn_view != Some(view_key)), &self.gpu) {
             self.drawn_view = Some(view_key);
+            let pipeline = match item {
+                DrawItem::MeshColors(_) => "mesh colors",
+                DrawItem::Baseline(_) => "the UV-textured source",
+                DrawItem::Mct(_) => "Mesh Color Textures",
+            };
+            if self.last_logged_pipeline != Some(pipeline) {
+                log::info!("3D view draws {pipeline}");
+                self.last_logged_pipeline = Some(pipeline);
+            }
             let target = RenderTarget {
                 color: &self.view.srgb_view,
                 depth: &self.view.depth_view,

@@ -846,3 +846,59 @@ fn comparing_an_untextured_mesh_says_why_and_shows_the_mesh_colors() {
     assert!(matches!(harness.state().shown_item(), Some(DrawItem::MeshColors(_))));
     assert!(harness.get_all_by_label_contains("no base-colour texture").count() >= 1);
 }
+
+/// "Representation: Mesh Color Textures" builds the texture from the packed mesh and draws it,
+/// with its cost and its PSNR against the mesh colors' own filter in this view (the Duck at
+/// R = 8: MCT's bilinear differs from mesh colors' piecewise-linear filter inside faces
+/// only — docs/MCT.md); paint mode draws mesh colors, and leaving it builds the texture again
+/// from the repacked colours. T switches back.
+#[test]
+fn the_view_switches_to_mesh_color_textures_and_back_live() {
+    use meshpaint::app::state::Representation;
+    use meshpaint_render::DrawItem;
+    // Tall enough that the view panel's last rows are on screen without scrolling.
+    let mut harness = Harness::builder()
+        .with_size([1280.0, 1100.0])
+        .build_ui_state(|ui, editor: &mut Editor| editor.ui(ui), editor_with_gpu_and_duck());
+    harness.run_steps(2);
+    harness.get_by_label("Representation:").click();
+    harness.run_steps(2);
+    harness.get_by_label(Representation::MeshColorTexture.name()).click();
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "building the Mesh Color Texture timed out");
+    harness.run_steps(3);
+    let first_atlas = match harness.state().shown_item() {
+        Some(DrawItem::Mct(mct)) => mct.atlas_size,
+        _ => panic!("the Mesh Color Texture is not shown: {:?}", harness.state().status),
+    };
+    harness.get_by_label_contains("the mesh colors' buffers");
+    let psnr = match &harness.state().panels.view.mct_psnr {
+        Some((_, Ok(db))) => *db,
+        other => panic!("no PSNR measured: {other:?}"),
+    };
+    assert!(psnr >= 35.0, "Duck R = 8, MCT vs mesh colors in the default view: {psnr} dB");
+    assert!(harness.state().gpu_bytes() > harness.state().document.open.as_ref().unwrap().packed_bytes);
+
+    // Paint mode draws the paint layout; a stroke, then leaving repacks and rebuilds.
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    assert!(matches!(harness.state().shown_item(), Some(DrawItem::MeshColors(_))), "paint mode draws mesh colors");
+    let rect = harness.state().viewport.rect;
+    left_drag(&mut harness, rect.center() - egui::vec2(30.0, 0.0), rect.center() + egui::vec2(30.0, 10.0));
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    for _ in 0..3 {
+        assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "repack or rebuild timed out");
+        harness.run_steps(2);
+    }
+    let open = harness.state().document.open.as_ref().unwrap();
+    assert!(open.mesh_generation >= 2, "entering and leaving paint mode changed the GPU mesh");
+    match harness.state().shown_item() {
+        Some(DrawItem::Mct(mct)) => assert_eq!(mct.atlas_size, first_atlas, "same resolutions, same layout"),
+        _ => panic!("the texture was not rebuilt after paint mode: {:?}", harness.state().status),
+    }
+    // T switches back to the mesh colors.
+    harness.key_press(egui::Key::T);
+    harness.run_steps(2);
+    assert!(matches!(harness.state().shown_item(), Some(DrawItem::MeshColors(_))));
+}

@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 use image::RgbImage;
 use meshpaint::app::editor::Editor;
 use meshpaint_core::io::document::Source;
-use meshpaint_render::{DrawItem, GpuMesh, MeshUploadOptions};
+use meshpaint_render::{DrawItem, GpuMct, GpuMesh, MeshUploadOptions};
 
 use crate::common;
 use common::gpu::Gpu;
@@ -276,8 +276,9 @@ fn dark_share(view: &RgbImage) -> f64 {
     dark as f64 / mesh.max(1) as f64
 }
 
-/// The 3D view as the editor would draw it at `size`, rendered offscreen.
-fn reference_view(file: &Path, size: (u32, u32)) -> RgbImage {
+/// The 3D view as the editor would draw it at `size`, rendered offscreen: the mesh colors,
+/// or (`mct`) the Mesh Color Texture built from the same packing.
+fn reference_view(file: &Path, size: (u32, u32), mct: bool) -> RgbImage {
     let mut editor = Editor::new(None, Arc::new(|| {}));
     editor.open(Source::File(file.to_owned()));
     assert!(editor.wait_for_job(Duration::from_secs(60)));
@@ -288,8 +289,14 @@ fn reference_view(file: &Path, size: (u32, u32)) -> RgbImage {
     let packed = open.document.pack(open.format).unwrap();
     let Gpu { ctx, renderer } = Gpu::create();
     let mesh = GpuMesh::upload(&ctx, renderer.layouts(), &packed, &MeshUploadOptions::default()).unwrap();
-    let image =
-        renderer.render_image(&ctx, DrawItem::MeshColors(&mesh), &editor.render_settings(), size.0, size.1).unwrap();
+    let settings = editor.render_settings();
+    let image = if mct {
+        let texture = meshpaint_core::mct::build(&packed, 16384, u64::MAX).unwrap();
+        let mct = GpuMct::upload(&ctx, renderer.layouts(), &mesh.geometry(), &texture).unwrap();
+        renderer.render_image(&ctx, DrawItem::Mct(&mct), &settings, size.0, size.1).unwrap()
+    } else {
+        renderer.render_image(&ctx, DrawItem::MeshColors(&mesh), &settings, size.0, size.1).unwrap()
+    };
     image::DynamicImage::ImageRgba8(image).to_rgb8()
 }
 
@@ -351,7 +358,7 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
         wait_for_screen(&display, &shots.join("app_duck.png"), rect, "the Duck", &|s| view_drawn(s, rect), app!());
     let view = crop(&first, rect);
     check_view_not_blank(&view, "default view");
-    let reference = reference_view(&asset, (rect.2, rect.3));
+    let reference = reference_view(&asset, (rect.2, rect.3), false);
     let (mean, off) = compare(&view, &reference);
     assert!(
         mean < 2.0 && off < 0.02,
@@ -359,6 +366,32 @@ fn the_editor_window_orbits_toggles_exports_and_survives_bad_files() {
         off * 100.0
     );
     update_screenshot(&shots.join("app_duck.png"), "app_duck.png");
+
+    // 1b. Mesh Color Textures (T): the window logs that it draws them, and the view must
+    // equal the offscreen MCT render of the same packing. (MCT and mesh colors' trilinear are
+    // within a step or two of each other by design — docs/MCT.md — so the image alone cannot
+    // tell which pipeline drew it; the log line can.) Then back to mesh colors (T).
+    let from = read_log(&log_path).len();
+    xdotool(&display, &["key", "t"]);
+    wait_for_log(&log_path, "3D view draws Mesh Color Textures", from, Duration::from_secs(120), app!());
+    // The side panel may have widened since (its texts): the view's latest rectangle.
+    let rect = view_rect(&read_log(&log_path));
+    let mct_reference = reference_view(&asset, (rect.2, rect.3), true);
+    let is_mct = |shot: &RgbImage| compare(&crop(shot, rect), &mct_reference).0 < 2.0;
+    let shot = wait_for_screen(&display, &shots.join("app_duck_mct.png"), rect, "the MCT view", &is_mct, app!());
+    let (mean, off) = compare(&crop(&shot, rect), &mct_reference);
+    assert!(
+        mean < 2.0 && off < 0.02,
+        "the MCT view differs from its offscreen render: mean {mean:.2}, {:.2}% off",
+        off * 100.0
+    );
+    let from = read_log(&log_path).len();
+    xdotool(&display, &["key", "t"]);
+    wait_for_log(&log_path, "3D view draws mesh colors", from, Duration::from_secs(60), app!());
+    let rect = view_rect(&read_log(&log_path));
+    let shot =
+        wait_for_screen(&display, &dir.join("back.png"), rect, "mesh colors again", &|s| view_drawn(s, rect), app!());
+    let view = crop(&shot, rect);
 
     // 2. Orbit with the middle button, toggle the wireframe with W.
     let (cx, cy) = (rect.0 + rect.2 / 2, rect.1 + rect.3 / 2);

@@ -1,13 +1,15 @@
-//! The view panel: filter, shading, overlays, the camera's angles, and what the 3D view
+//! The view panel: filter, shading, overlays, the camera's angles, what the 3D view
 //! shows (mesh colors, or for comparison the source texture or position colours) with its
-//! cost and, against the source texture, its PSNR.
+//! cost and, against the source texture, its PSNR, and the representation the mesh colors
+//! are drawn in (mesh colors, or Mesh Color Textures with their bytes, build time and PSNR
+//! against the mesh colors).
 
 use meshpaint_core::camera::OrbitCamera;
 use meshpaint_render::{DrawItem, FilterMode, Gpu, Shading};
 
 use crate::app::command::Command;
-use crate::app::document::OpenDocument;
-use crate::app::state::{Action, PsnrKey, Shown, ViewSettings};
+use crate::app::document::{BuiltMct, OpenDocument};
+use crate::app::state::{Action, PsnrKey, Representation, Shown, ViewSettings};
 use crate::app::text::{human_bytes, thousands};
 
 /// What the view panel reads of the editor.
@@ -39,6 +41,8 @@ pub struct ViewPanel {
     /// The last PSNR of the mesh colors against the source texture, with the view it was
     /// measured in (render settings, view size, scene generation).
     pub source_psnr: Option<(PsnrKey, Result<f64, String>)>,
+    /// The last PSNR of the Mesh Color Texture against the mesh colors, likewise.
+    pub mct_psnr: Option<(PsnrKey, Result<f64, String>)>,
 }
 
 impl ViewPanel {
@@ -77,6 +81,7 @@ impl ViewPanel {
             ui.label(egui::RichText::new(angles).weak());
         });
         commands.extend(self.shown_ui(ui, ctx));
+        self.representation_ui(ui, ctx);
         commands
     }
 
@@ -152,27 +157,129 @@ impl ViewPanel {
     fn psnr_ui(&mut self, ui: &mut egui::Ui, ctx: &ViewContext<'_>, open: &OpenDocument) {
         let settings = self.settings.render_settings(ctx.camera, ctx.level0_only);
         let key: PsnrKey = (settings, ctx.viewport_px, ctx.scene_generation);
-        let dragging = ui.input(|i| i.pointer.any_down());
-        if !dragging
-            && self.source_psnr.as_ref().is_none_or(|(measured, _)| *measured != key)
-            && let Some(result) = measure_source_psnr(ctx, open, &key)
-        {
-            self.source_psnr = Some((key, result));
+        let measure = || measure_source_psnr(ctx, open, &key);
+        let line = ("Mesh colors vs source texture", "preparing the source texture");
+        psnr_line(ui, &mut self.source_psnr, key, measure, line);
+    }
+
+    /// The representation the mesh colors are drawn in and, for Mesh Color Textures, what
+    /// the texture costs and how far this view is from the mesh colors' own filter.
+    fn representation_ui(&mut self, ui: &mut egui::Ui, ctx: &ViewContext<'_>) {
+        let view = &mut self.settings;
+        ui.horizontal(|ui| {
+            let label = ui.label("Representation:");
+            egui::ComboBox::from_id_salt("representation")
+                .selected_text(view.representation.name())
+                .show_ui(ui, |ui| {
+                    for representation in Representation::ALL {
+                        ui.selectable_value(&mut view.representation, representation, representation.name());
+                    }
+                })
+                .response
+                .labelled_by(label.id)
+                .on_hover_text(
+                    "T — how the GPU draws the painted colours: mesh colors filtered in the shader (exact), or \
+                     Mesh Color Textures, one 2D atlas the GPU's own sampler filters",
+                );
+        });
+        let Some(open) = ctx.document else {
+            return;
+        };
+        if view.representation != Representation::MeshColorTexture || view.shown != Shown::MeshColors {
+            return;
         }
-        match &self.source_psnr {
-            Some((_, Ok(db))) => {
-                let text = if db.is_finite() { format!("{db:.1} dB") } else { "identical".to_owned() };
-                ui.label(format!("Mesh colors vs source texture, this view: PSNR {text}"))
-                    .on_hover_text("Both rendered offscreen with the current camera, filter and shading");
-            }
-            Some((_, Err(message))) => {
-                ui.colored_label(ui.visuals().warn_fg_color, format!("PSNR not measured: {message}"));
-            }
+        if ctx.level0_only {
+            ui.label(egui::RichText::new("Paint mode draws mesh colors; the texture follows when it ends").weak());
+            return;
+        }
+        let built = match open.current_mct() {
             None => {
-                ui.label(egui::RichText::new("PSNR: preparing the source texture…").weak());
+                ui.label(egui::RichText::new("Building the Mesh Color Texture…").weak());
+                return;
             }
+            Some(Err(message)) => {
+                ui.colored_label(ui.visuals().warn_fg_color, format!("Showing the mesh colors: {message}"));
+                return;
+            }
+            Some(Ok(built)) => built,
+        };
+        let [w, h] = built.mct.atlas_size;
+        ui.label(
+            egui::RichText::new(format!(
+                "Atlas {w} × {h}: {} ({:.2}× the mesh colors' buffers), built in {:.0} ms",
+                human_bytes(built.mct.gpu_bytes()),
+                built.bytes_over_mesh_colors,
+                built.build.as_secs_f64() * 1000.0
+            ))
+            .weak(),
+        );
+        if matches!(view.filter, FilterMode::Nearest | FilterMode::NearestMipLevel(_)) {
+            ui.label(egui::RichText::new("No nearest filter in a Mesh Color Texture: drawn bilinear").weak());
+        }
+        let settings = view.render_settings(ctx.camera, ctx.level0_only);
+        let key: PsnrKey = (settings, ctx.viewport_px, ctx.scene_generation);
+        let measure = || measure_mct_psnr(ctx, open, built, &key);
+        let line = ("Mesh Color Texture vs mesh colors", "rendering both");
+        psnr_line(ui, &mut self.mct_psnr, key, measure, line);
+    }
+}
+
+/// One PSNR line: `slot` measured again by `measure` whenever the view `key` changes and no
+/// button is held (not while orbiting); `what` names the comparison and what a missing
+/// measurement waits for.
+fn psnr_line(
+    ui: &mut egui::Ui,
+    slot: &mut Option<(PsnrKey, Result<f64, String>)>,
+    key: PsnrKey,
+    measure: impl FnOnce() -> Option<Result<f64, String>>,
+    (what, pending): (&str, &str),
+) {
+    let dragging = ui.input(|i| i.pointer.any_down());
+    if !dragging
+        && slot.as_ref().is_none_or(|(measured, _)| *measured != key)
+        && let Some(result) = measure()
+    {
+        *slot = Some((key, result));
+    }
+    match slot {
+        Some((_, Ok(db))) => {
+            let text = if db.is_finite() { format!("{db:.1} dB") } else { "identical".to_owned() };
+            ui.label(format!("{what}, this view: PSNR {text}"))
+                .on_hover_text("Both rendered offscreen with the current camera, filter and shading");
+        }
+        Some((_, Err(message))) => {
+            ui.colored_label(ui.visuals().warn_fg_color, format!("PSNR not measured: {message}"));
+        }
+        None => {
+            ui.label(egui::RichText::new(format!("PSNR: {pending}…")).weak());
         }
     }
+}
+
+/// PSNR (dB, RGB of covered pixels) of the Mesh Color Texture `built` of `open` against the
+/// mesh colors' own filter, both as the 3D view shows them in `key`'s view (offscreen, at
+/// most 512 px on the long side).
+fn measure_mct_psnr(
+    ctx: &ViewContext<'_>,
+    open: &OpenDocument,
+    built: &BuiltMct,
+    key: &PsnrKey,
+) -> Option<Result<f64, String>> {
+    let (Some(gpu), Some(mesh)) = (ctx.gpu, open.gpu_mesh.as_ref()) else {
+        return None;
+    };
+    Some(compare_renders(gpu, key, DrawItem::Mct(&built.mct), DrawItem::MeshColors(mesh)))
+}
+
+/// PSNR of `ours` against `theirs`, both rendered with `key`'s settings at the view's aspect
+/// (at most 512 px on the long side).
+fn compare_renders(gpu: &Gpu, key: &PsnrKey, ours: DrawItem<'_>, theirs: DrawItem<'_>) -> Result<f64, String> {
+    let (settings, [w, h], _) = key;
+    let scale = (512.0 / f64::from((*w).max(*h).max(1))).min(1.0);
+    let (w, h) = (((f64::from(*w) * scale) as u32).max(16), ((f64::from(*h) * scale) as u32).max(16));
+    let render = |item| gpu.render_image(item, settings, w, h).map_err(|error| error.to_string());
+    let ours = render(ours)?;
+    render(theirs).map(|theirs| meshpaint_core::colors::psnr::psnr(&ours, &theirs))
 }
 
 /// PSNR (dB, RGB of covered pixels) of the mesh colors of `open` against its source texture
@@ -184,13 +291,7 @@ fn measure_source_psnr(ctx: &ViewContext<'_>, open: &OpenDocument, key: &PsnrKey
     else {
         return None;
     };
-    let (settings, [w, h], _) = key;
-    let scale = (512.0 / f64::from((*w).max(*h).max(1))).min(1.0);
-    let (w, h) = (((f64::from(*w) * scale) as u32).max(16), ((f64::from(*h) * scale) as u32).max(16));
-    let render = |item| gpu.render_image(item, settings, w, h).map_err(|error| error.to_string());
-    Some(render(DrawItem::MeshColors(mesh)).and_then(|ours| {
-        render(DrawItem::Baseline(baseline)).map(|theirs| meshpaint_core::colors::psnr::psnr(&ours, &theirs))
-    }))
+    Some(compare_renders(gpu, key, DrawItem::MeshColors(mesh), DrawItem::Baseline(baseline)))
 }
 
 /// The name of a filter in the view panel.
