@@ -17,7 +17,7 @@ use meshpaint_core::mct::{self, MeshColorTexture};
 use meshpaint_core::packing::linear::PackedMesh;
 use meshpaint_core::packing::sampler::{Filter, sample};
 use meshpaint_core::paint::picking::{BvhPreset, MeshBvh};
-use meshpaint_render::{DrawItem, FilterMode, GpuMesh, MeshUploadOptions, RenderSettings, Shading};
+use meshpaint_render::{DrawItem, FilterMode, GpuMct, GpuMesh, MeshUploadOptions, RenderSettings, Shading};
 
 use crate::common;
 use crate::common::WriteThrough;
@@ -44,7 +44,7 @@ fn compare(packed: &PackedMesh, camera: OrbitCamera, level: u32) -> Comparison {
     let gpu = common::gpu::shared();
     let mesh = GpuMesh::upload(&gpu.ctx, gpu.renderer.layouts(), packed, &MeshUploadOptions::default()).unwrap();
     let texture: MeshColorTexture = mct::build(packed, 16384, u64::MAX).unwrap();
-    let gpu_mct = gpu.upload_mct(&mesh.geometry(), &texture).unwrap();
+    let gpu_mct = GpuMct::upload(&gpu.ctx, gpu.renderer.layouts(), &mesh.geometry(), &texture).unwrap();
     let mut settings = RenderSettings::new(camera);
     settings.filter = if level == 0 { FilterMode::Linear } else { FilterMode::MipLevel(level) };
     settings.shading = Shading::Unlit;
