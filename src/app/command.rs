@@ -8,6 +8,7 @@ use meshpaint_core::colors::layout::Resolution;
 
 use super::jobs::WriteKind;
 use super::state::{Action, Shown};
+use super::unsaved::UnsavedChoice;
 
 /// A request from a panel, a dialog or the input to the editor.
 #[derive(Debug, Clone, PartialEq)]
@@ -31,6 +32,8 @@ pub enum Command {
     SetUndoCap(usize),
     /// Build the alternate view `Shown` for the open document, if it is missing.
     PrepareView(Shown),
+    /// The answer to "save changes first?".
+    Unsaved(UnsavedChoice),
     /// Restore the offered recovery file.
     RestoreRecovery,
     /// Delete the offered recovery file.

@@ -34,6 +34,7 @@ use super::panels::{
 use super::session::{DocumentState, opened_text};
 use super::state::{Action, Mode, Representation, Severity, Shown, Status, ViewportState};
 use super::text::error_text;
+use super::unsaved::{Pending, UnsavedChoice};
 
 /// The editor.
 pub struct Editor {
@@ -51,8 +52,10 @@ pub struct Editor {
     pub status: Status,
     /// Background work.
     pub jobs: Jobs<JobOutput>,
-    /// Set when the user asked to quit.
+    /// Set when the user asked to quit (and answered the unsaved-changes prompt).
     pub quit_requested: bool,
+    /// What carries on once the running save succeeds ([`super::unsaved`]).
+    pub(crate) after_save: Option<Pending>,
     /// A memory budget that replaces the machine's (tests set a small one; `None`:
     /// [`Budget::from_environment`]).
     pub budget_override: Option<Budget>,
@@ -85,6 +88,7 @@ impl Editor {
             status: Status { text: "Welcome to meshpaint. F1 lists the shortcuts.".into(), severity: Severity::Info },
             jobs: Jobs::new(waker),
             quit_requested: false,
+            after_save: None,
             budget_override: None,
             fallback_error: None,
         }
@@ -151,6 +155,9 @@ impl Editor {
         };
         let document = Arc::clone(&open.document);
         self.panels.file.remember_directory_of(&path);
+        if kind == WriteKind::Save {
+            self.document.saving_generation = Some(self.document.edit_generation);
+        }
         let label = match kind {
             WriteKind::Save => format!("Saving {}", path.display()),
             WriteKind::ExportPacked => format!("Exporting packed buffers to {}", path.display()),
@@ -199,7 +206,9 @@ impl Editor {
             JobOutput::Written(written, kind) => {
                 self.document.written(&written, kind);
                 if kind == WriteKind::Save {
-                    self.panels.autosave.state.saved(self.document.open.as_ref(), self.document.edit_generation);
+                    let generation = self.document.saving_generation.take().unwrap_or(self.document.edit_generation);
+                    self.document.saved_generation = generation;
+                    self.panels.autosave.state.saved(self.document.open.as_ref(), generation);
                 }
                 let verb = match kind {
                     WriteKind::Save => "Saved",
@@ -209,6 +218,9 @@ impl Editor {
                     Severity::Info,
                     format!("{verb} {}: {} ({:.2} s)", written.path.display(), written.summary, elapsed.as_secs_f64()),
                 );
+                if kind == WriteKind::Save {
+                    self.after_save_finished(true);
+                }
             }
             JobOutput::Repacked(repacked) => {
                 self.document.finish_repack(*repacked, elapsed, &mut self.viewport, &mut self.status);
@@ -234,8 +246,11 @@ impl Editor {
         // resolution follows the brush there; textured ones keep the chosen R.
         self.panels.paint.brush.follow_resolution =
             (!document.document.textured).then_some(meshpaint_core::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
+        // A restored recovery file holds colours no file holds yet: unsaved until saved.
+        let restored = self.panels.autosave.state.restoring.is_some();
         self.panels.autosave.state.document_opened(&mut document, self.document.edit_generation);
         self.document.replace(document, history_budget);
+        self.document.saved_generation = if restored { u64::MAX } else { self.document.edit_generation };
         self.viewport.scene_generation += 1;
         self.frame_all();
         match self.fallback_error.take() {
@@ -246,6 +261,10 @@ impl Editor {
 
     /// A job failed: reported; a failed start-up file falls back to the built-in scene.
     fn finish_failed(&mut self, kind: JobKind, message: String) {
+        if kind == JobKind::Write(WriteKind::Save) {
+            self.document.saving_generation = None;
+            self.after_save_finished(false);
+        }
         if kind == JobKind::Autosave {
             self.panels.autosave.state.failed();
             self.set_status(Severity::Warning, format!("Autosave failed: {message}"));
@@ -377,6 +396,7 @@ impl Editor {
     /// The window title.
     pub fn window_title(&self) -> String {
         match &self.document.open {
+            Some(open) if self.document.is_modified() => format!("*{} — meshpaint", open.title),
             Some(open) => format!("{} — meshpaint", open.title),
             None => "meshpaint".to_owned(),
         }
@@ -387,6 +407,59 @@ impl Editor {
         let Editor { gpu, document, camera, panels, viewport, status, jobs, .. } = self;
         let ctx = PaintContext { gpu: gpu.as_ref(), camera, viewport, brush: &mut panels.paint.brush, status, jobs };
         (document, ctx)
+    }
+
+    /// Carries out `pending` at once when nothing is unsaved, else asks first.
+    pub fn replace_or_close(&mut self, pending: Pending) {
+        if !self.document.is_modified() {
+            self.carry_on(pending);
+            return;
+        }
+        log::info!("Unsaved changes: asking before {}", pending.describe());
+        self.panels.unsaved.pending = Some(pending);
+    }
+
+    /// Applies the answer to the prompt.
+    pub fn answer_unsaved(&mut self, choice: UnsavedChoice) {
+        let Some(pending) = self.panels.unsaved.pending.take() else {
+            return;
+        };
+        match choice {
+            UnsavedChoice::Save => {
+                self.after_save = Some(pending);
+                self.perform(Action::Save);
+            }
+            UnsavedChoice::DontSave => self.carry_on(pending),
+            UnsavedChoice::Cancel => self.set_status(Severity::Info, format!("Cancelled {}.", pending.describe())),
+        }
+    }
+
+    /// A save finished (`saved`: successfully): the action that waited for it goes on, or is
+    /// dropped with a message.
+    pub(crate) fn after_save_finished(&mut self, saved: bool) {
+        if let Some(pending) = self.after_save.take() {
+            if saved {
+                self.carry_on(pending);
+            } else {
+                let text = format!("Not {}: the document was not saved.", pending.describe());
+                self.set_status(Severity::Warning, text);
+            }
+        }
+    }
+
+    /// Drops the action that waited for a save when no save is coming: the "Save as" dialog
+    /// was closed without a name (called every frame).
+    pub(crate) fn drop_abandoned_save(&mut self) {
+        if self.after_save.is_some() && self.panels.file.dialog.is_none() && !self.jobs.is_busy() {
+            self.after_save_finished(false);
+        }
+    }
+
+    fn carry_on(&mut self, pending: Pending) {
+        match pending {
+            Pending::Open(source) => self.open(source),
+            Pending::Quit => self.quit_requested = true,
+        }
     }
 
     /// Carries out `action`: the one place every menu entry, button and shortcut ends.
@@ -436,7 +509,7 @@ impl Editor {
                 self.prepare_mct();
             }
             Action::ToggleHelp => self.panels.help.open = !self.panels.help.open,
-            Action::Quit => self.quit_requested = true,
+            Action::Quit => self.replace_or_close(Pending::Quit),
             Action::TogglePaintMode => {
                 let budget = self.budget();
                 self.with_paint_parts(|document, ctx| document.toggle_paint_mode(ctx, budget));
@@ -463,7 +536,8 @@ impl Editor {
     pub fn apply(&mut self, command: Command) {
         match command {
             Command::Action(action) => self.perform(action),
-            Command::Open(path) => self.open(Source::File(path)),
+            Command::Open(path) => self.replace_or_close(Pending::Open(Source::File(path))),
+            Command::Unsaved(choice) => self.answer_unsaved(choice),
             Command::Write(path, format, kind) => self.write(path, format, kind),
             Command::Fill { connected } => self.with_paint_parts(|document, ctx| document.fill(ctx, connected)),
             Command::SetResolutionAll(resolution) => {
@@ -583,6 +657,10 @@ impl Editor {
         self.apply_all(chosen);
         let chosen = self.panels.autosave.recovery_ui(&ctx, self.viewport.rect.center());
         self.apply_all(chosen);
+        let title = self.document.open.as_ref().map_or_else(String::new, |open| open.title.clone());
+        let chosen = self.panels.unsaved.ui(&ctx, &title);
+        self.apply_all(chosen);
+        self.drop_abandoned_save();
         // The Mesh Color Texture follows the packed mesh: built again after every repack.
         self.prepare_mct();
         if self.jobs.is_busy() {
@@ -597,7 +675,7 @@ impl Editor {
     /// Dropped files, a running brush gesture, and the keyboard shortcuts.
     fn global_input(&mut self, ctx: &egui::Context) {
         if let Some(path) = input::dropped_file(ctx) {
-            self.open(Source::File(path));
+            self.replace_or_close(Pending::Open(Source::File(path)));
         }
         if self.with_paint_parts(|document, paint| document.gesture_input(paint, ctx)) {
             return;

@@ -11,12 +11,12 @@
 //! | layer | file | role |
 //! |---|---|---|
 //! | 6 | [`window`] | winit event loop, surface, egui-winit / egui-wgpu, offscreen 3D view, redraw scheduling |
-//! | 5 | [`editor`] | [`Editor`]: the document, camera, panels, 3D view state, status, jobs; one frame of UI ([`Editor::ui`]); every [`Action`] ([`Editor::perform`]) and [`command::Command`] ([`Editor::apply`]) carried out; finished jobs applied by [`jobs::JobKind`] |
+//! | 5 | [`editor`] | [`Editor`]: the document, camera, panels, 3D view state, status, jobs; one frame of UI ([`Editor::ui`]); every [`Action`] ([`Editor::perform`]) and [`command::Command`] ([`Editor::apply`]) carried out; finished jobs applied by [`jobs::JobKind`]; open and quit ask Save / Don't save / Cancel while changes are unsaved |
 //! | 4 | [`paint`] | paint-mode commands on the document: strokes, live GPU upload, undo / redo, eyedropper, fill, resolution, Optimize, radius / strength gestures, brush cursor |
 //! | 3 | [`panels`], [`job_output`] | each panel a type that owns its state and draws itself, returning commands (menu, status line, file, import settings, autosave, view, paint, optimize, undo, scene, help, 3D view area); what jobs produce |
 //! | 2 | [`session`], [`input`], [`autosave`], [`file_dialog`] | the document being edited ([`session::DocumentState`]: open document, paint session, undo history); all input (shortcuts [`input::SHORTCUTS`], 3D-view navigation, the brush's pointer); autosave state; an egui file browser |
 //! | 1 | [`document`], [`command`], [`import_settings`] | the open document (store and GPU mesh side by side; open, save, export work); the commands panels return; the import settings panel (the open dialog's resolution choice) |
-//! | 0 | [`state`], [`jobs`], [`text`], [`widgets`], [`paint_session`] | shared small types and [`Action`]s; one background job at a time with progress; number / error text; the resolution combo box; paint-mode state |
+//! | 0 | [`state`], [`jobs`], [`text`], [`widgets`], [`paint_session`], [`unsaved`] | shared small types and [`Action`]s; one background job at a time with progress; number / error text; the resolution combo box; paint-mode state; the actions that wait for "save changes first?" |
 //!
 //! Paint mode is [`Mode::Paint`] (Tab, [`input::SHORTCUTS`]): its tools get the pointer in
 //! [`input::paint_input`], edit the store through `Arc::make_mut` on
@@ -40,6 +40,7 @@ pub mod panels;
 pub mod session;
 pub mod state;
 pub mod text;
+pub mod unsaved;
 pub mod widgets;
 pub mod window;
 

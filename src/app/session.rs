@@ -27,6 +27,11 @@ pub struct DocumentState {
     pub history: UndoHistory,
     /// Counts edits of the colours (autosave and Optimize compare it).
     pub edit_generation: u64,
+    /// The edit generation the document's file holds: set when it opens and when a save
+    /// finishes ([`u64::MAX`] for a restored recovery file, whose colours no file holds yet).
+    pub saved_generation: u64,
+    /// The edit generation a running save writes.
+    pub saving_generation: Option<u64>,
     /// The GPU mesh holds the paint layout (level 0 only): the filter is limited to level 0.
     pub gpu_paint_layout: bool,
 }
@@ -38,6 +43,8 @@ impl Default for DocumentState {
             paint: None,
             history: UndoHistory::new(DEFAULT_CAP_BYTES),
             edit_generation: 0,
+            saved_generation: 0,
+            saving_generation: None,
             gpu_paint_layout: false,
         }
     }
@@ -52,6 +59,11 @@ impl DocumentState {
     /// Whether the 3D view shows level 0 only (the paint layout is, or is still, on the GPU).
     pub fn level0_only(&self) -> bool {
         self.gpu_paint_layout || self.paint.is_some()
+    }
+
+    /// Whether the colours changed since the document was opened or last saved.
+    pub fn is_modified(&self) -> bool {
+        self.open.is_some() && self.edit_generation != self.saved_generation
     }
 
     /// Whether a paint stroke is in progress.

@@ -454,7 +454,11 @@ impl ApplicationHandler<UserEvent> for Shell {
             running.window.request_redraw();
         }
         match event {
-            WindowEvent::CloseRequested => event_loop.exit(),
+            // Closing the window is quitting: it asks first when changes are unsaved.
+            WindowEvent::CloseRequested => {
+                running.editor.perform(crate::app::Action::Quit);
+                running.window.request_redraw();
+            }
             WindowEvent::Resized(_) => {
                 running.configure();
                 running.window.request_redraw();

@@ -902,3 +902,139 @@ fn the_view_switches_to_mesh_color_textures_and_back_live() {
     harness.run_steps(2);
     assert!(matches!(harness.state().shown_item(), Some(DrawItem::MeshColors(_))));
 }
+
+/// The prompt's button `label` (the File panel has a "Save" too; the prompt is drawn last).
+fn prompt_button<'a>(harness: &'a Harness<'static, Editor>, label: &'a str) -> egui_kittest::Node<'a> {
+    harness.get_all_by_label(label).last().expect("no such button")
+}
+
+/// A painted Duck in paint mode: one stroke, unsaved.
+fn duck_with_a_stroke() -> Harness<'static, Editor> {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    assert_eq!(harness.state().window_title(), "Duck (built-in) — meshpaint", "just opened: not modified");
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    let center = harness.state().viewport.rect.center();
+    left_drag(&mut harness, center - egui::vec2(60.0, 0.0), center + egui::vec2(60.0, 0.0));
+    assert_eq!(harness.state().document.history.undo_len(), 1);
+    assert!(harness.state().window_title().starts_with('*'), "{}", harness.state().window_title());
+    harness
+}
+
+/// Opening another file (dialog or drop) or quitting (Ctrl+Q, menu, window close — the
+/// window sends Action::Quit) with a stroke unsaved asks first: Cancel keeps the document,
+/// its colours and undo history; Don't save carries on.
+#[test]
+fn open_drop_and_quit_ask_before_losing_unsaved_work() {
+    let mut harness = duck_with_a_stroke();
+    let painted = colors_of(harness.state());
+    let box_glb = workspace_path("assets/models/BoxTextured/BoxTextured.glb");
+    let replacing: [(&str, Box<dyn Fn(&mut Harness<'static, Editor>)>); 3] = [
+        ("open", Box::new(|h| h.state_mut().apply(meshpaint::app::Command::Open(box_glb.clone())))),
+        ("drop", Box::new(|h| h.input_mut().dropped_files.push(Arc::new(Dropped(box_glb.clone()))))),
+        ("quit", Box::new(|h| h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q))),
+    ];
+    for (what, start) in &replacing {
+        start(&mut harness);
+        harness.run_steps(2);
+        assert!(harness.query_by_label_contains("Save changes to Duck").is_some(), "{what}: no prompt");
+        harness.get_by_label("Cancel").click();
+        harness.run_steps(2);
+        assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+        harness.run_steps(1);
+        let editor = harness.state();
+        assert!(!editor.quit_requested, "{what}: cancelled, yet quitting");
+        assert_eq!(editor.document.open.as_ref().unwrap().title, "Duck (built-in)", "{what}: cancelled, yet replaced");
+        assert_eq!(colors_of(editor), painted, "{what}: the colours changed");
+        assert_eq!(editor.document.history.undo_len(), 1, "{what}: the undo history was lost");
+        assert!(harness.query_by_label_contains("Save changes to").is_none(), "{what}: the prompt stayed");
+    }
+    // Esc cancels too.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q);
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Escape);
+    harness.run_steps(2);
+    assert!(!harness.state().quit_requested && harness.query_by_label_contains("Save changes to").is_none());
+    // Don't save: the drop opens the box; then nothing is unsaved and quitting asks nothing.
+    harness.input_mut().dropped_files.push(Arc::new(Dropped(box_glb.clone())));
+    harness.run_steps(2);
+    harness.get_by_label("Don't save").click();
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.run_steps(2);
+    assert_eq!(harness.state().document.open.as_ref().unwrap().triangles(), 12);
+    assert!(!harness.state().document.is_modified());
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q);
+    harness.run_steps(2);
+    assert!(harness.state().quit_requested, "nothing unsaved: quit at once");
+}
+
+/// "Save" in the prompt saves (asking for a name: a glTF has no project file yet) and only
+/// then carries on; the title's modified mark goes with the save and comes back with the
+/// next stroke. Cancelling the name dialog cancels the quit.
+#[test]
+fn save_in_the_prompt_saves_then_quits_and_the_title_follows() {
+    let dir = std::env::temp_dir().join(format!("meshpaint_unsaved_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut harness = duck_with_a_stroke();
+    // Save, then Esc in the name dialog: no save, no quit.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q);
+    harness.run_steps(2);
+    prompt_button(&harness, "Save").click();
+    harness.run_steps(2);
+    assert!(harness.state().panels.file.dialog.is_some(), "no project file yet: the name is asked");
+    assert!(harness.state().panels.file.dialog.as_ref().unwrap().file_name.ends_with(".mpk"));
+    harness.state_mut().panels.file.dialog = None; // the dialog closed without a name
+    harness.run_steps(2);
+    assert!(!harness.state().quit_requested);
+    assert!(harness.state().status.text.contains("Not quitting"), "{:?}", harness.state().status);
+    // Save with a name: saved first, then quit.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q);
+    harness.run_steps(2);
+    prompt_button(&harness, "Save").click();
+    harness.run_steps(2);
+    let path = dir.join("saved duck.mpk");
+    let format = meshpaint_core::colors::format::ColorFormat::Rgba8Srgb;
+    harness.state_mut().panels.file.dialog = None;
+    harness.state_mut().apply(meshpaint::app::Command::Write(
+        path.clone(),
+        format,
+        meshpaint::app::jobs::WriteKind::Save,
+    ));
+    harness.run_steps(1);
+    assert!(!harness.state().quit_requested, "not before the save has finished");
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.run_steps(1);
+    assert!(path.is_file(), "not saved");
+    assert!(harness.state().quit_requested, "saved: the quit carries on");
+    assert_eq!(harness.state().window_title(), "saved duck.mpk — meshpaint");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The recovery prompt says when the file was written (ago, and the UTC time: 1796653800 s
+/// after the epoch is 2026-12-07 14:30:00 UTC) and what it holds, from its header.
+#[test]
+fn the_recovery_prompt_says_when_and_what() {
+    use meshpaint::app::panels::autosave::describe_recovery;
+    use meshpaint_core::io::autosave::RecoveryInfo;
+    use meshpaint_core::packing::file::PackedSummary;
+    use std::time::{Duration, UNIX_EPOCH};
+    let written = UNIX_EPOCH + Duration::from_secs(1_796_653_800);
+    let holds = PackedSummary { face_count: 4212, vertex_count: 2108, sample_count: 154_176, file_size: 2_500_000 };
+    let info = RecoveryInfo {
+        path: "duck.recovery.mpk".into(),
+        modified: Some(written),
+        newer_than_document: true,
+        holds: Some(holds),
+    };
+    let text = describe_recovery(&info, written + Duration::from_secs(5 * 60 + 10));
+    assert!(text.starts_with("Written 5 min ago (14:30 UTC): 4,212 triangles, 154,176 samples,"), "{text}");
+    let text = describe_recovery(&info, written + Duration::from_secs(3 * 86_400));
+    assert!(text.starts_with("Written 3 days ago"), "{text}");
+    let unknown = RecoveryInfo { modified: None, holds: None, ..info };
+    assert_eq!(
+        describe_recovery(&unknown, written),
+        "Written at an unknown time; its header cannot be read (restoring will say why)."
+    );
+}

@@ -646,6 +646,24 @@ fn paint_mode_stroke_lands_under_the_cursor_and_is_saved() {
     let stroke = paint_a_stroke(&display, &log_path, rect, app!());
     update_screenshot(&output_dir().join("app_paint.png"), "app_paint.png");
 
+    // Ctrl+Q with the stroke unsaved asks first (the modal prompt dims the view); Esc
+    // cancels it and the editor runs on with the stroke.
+    let brightness = |shot: &RgbImage| {
+        let view = crop(shot, rect);
+        view.pixels().map(|p| u64::from(p[0]) + u64::from(p[1]) + u64::from(p[2])).sum::<u64>() as f64
+            / (3 * view.width() * view.height()) as f64
+    };
+    let before = brightness(&screenshot(&display, &dir.join("before_quit.png")));
+    let from = read_log(&log_path).len();
+    xdotool(&display, &["key", "ctrl+q"]);
+    wait_for_log(&log_path, "Unsaved changes: asking before quitting", from, Duration::from_secs(30), app!());
+    let dimmed = |shot: &RgbImage| brightness(shot) < before - 10.0;
+    wait_for_screen(&display, &output_dir().join("app_unsaved_prompt.png"), rect, "the prompt", &dimmed, app!());
+    xdotool(&display, &["key", "Escape"]);
+    let clear = |shot: &RgbImage| (brightness(shot) - before).abs() < 2.0;
+    wait_for_screen(&display, &dir.join("prompt_cancelled.png"), rect, "the view without the prompt", &clear, app!());
+    assert!(app!().try_wait().unwrap().is_none(), "the editor quit although the prompt was cancelled");
+
     // Tab leaves (repack), Ctrl+S saves through the dialog.
     let from = read_log(&log_path).len();
     xdotool(&display, &["key", "Tab"]);

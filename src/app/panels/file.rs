@@ -64,7 +64,8 @@ impl FilePanel {
             .unwrap_or_else(|| "duck".to_owned());
         let file_name = match purpose {
             DialogPurpose::Open => String::new(),
-            DialogPurpose::SaveAs | DialogPurpose::ExportPacked => format!("{stem}.mpk"),
+            DialogPurpose::SaveAs => format!("{stem}.mpk"),
+            DialogPurpose::ExportPacked => format!("{stem}_export.mpk"),
             DialogPurpose::ExportGltf => format!("{stem}_meshcolors.glb"),
         };
         let format = document.map_or_else(ColorFormat::default, |d| d.format);

@@ -16,6 +16,7 @@
 //! | [`UndoPanel`] | [`undo`] | nothing (shows the document's history) |
 //! | [`ScenePanel`] | [`scene`] | "Redraw continuously" |
 //! | [`HelpWindow`] | [`help`] | whether it is open |
+//! | [`UnsavedPrompt`] | [`unsaved`] | the action waiting for "save changes first?" |
 //! | [`ViewportArea`] | [`viewport`] | nothing (the editor records its area) |
 
 pub mod autosave;
@@ -27,6 +28,7 @@ pub mod paint;
 pub mod scene;
 pub mod status_line;
 pub mod undo;
+pub mod unsaved;
 pub mod view;
 pub mod viewport;
 
@@ -40,6 +42,7 @@ pub use paint::{PaintPanel, PaintPanelContext};
 pub use scene::{SceneContext, ScenePanel};
 pub use status_line::StatusLine;
 pub use undo::{LastStroke, UndoPanel};
+pub use unsaved::UnsavedPrompt;
 pub use view::{ViewContext, ViewPanel};
 pub use viewport::{ViewportArea, ViewportContext};
 
@@ -71,6 +74,8 @@ pub struct Panels {
     pub scene: ScenePanel,
     /// The shortcut help window.
     pub help: HelpWindow,
+    /// "Save changes first?"
+    pub unsaved: UnsavedPrompt,
     /// The 3D view's area.
     pub viewport: ViewportArea,
 }

@@ -26,7 +26,7 @@ use thiserror::Error;
 
 use crate::colors::format::ColorFormat;
 use crate::io::document::Document;
-use crate::packing::file::{self as packed_file, PackedFileError};
+use crate::packing::file::{self as packed_file, PackedFileError, PackedSummary};
 use crate::packing::linear::PackedMesh;
 use crate::packing::packer::PackError;
 
@@ -132,6 +132,9 @@ pub struct RecoveryInfo {
     /// Whether it is newer than the document file (`true` when the document is gone or
     /// either time is unknown: offering recovery is the safe side).
     pub newer_than_document: bool,
+    /// What it holds, from its header (`None` when the header cannot be read: restoring
+    /// then reports why).
+    pub holds: Option<PackedSummary>,
 }
 
 /// The recovery file of the document at `document_path`, if one exists (its content is not
@@ -150,7 +153,8 @@ pub fn find_recovery_at(path: &Path, document_path: Option<&Path>) -> Option<Rec
         (Some(recovery), Some(document)) => recovery > document,
         _ => true,
     };
-    Some(RecoveryInfo { path: path.to_path_buf(), modified, newer_than_document })
+    let holds = packed_file::read_summary(path).ok();
+    Some(RecoveryInfo { path: path.to_path_buf(), modified, newer_than_document, holds })
 }
 
 /// Opens a recovery file as a document (fully validated by the packed-file reader and the

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::colors::layout::{Resolution, edge_chain_len, interior_chain_len};
 use meshpaint_core::packing::file::{
-    MAGIC, PackedFileError, VERSION, from_bytes, looks_like_packed, read_file, to_bytes, write_file,
+    MAGIC, PackedFileError, VERSION, from_bytes, looks_like_packed, read_file, read_summary, to_bytes, write_file,
 };
 use meshpaint_core::packing::linear::{FaceRecord, PackedMesh, pack_word};
 
@@ -532,4 +532,35 @@ fn writer_refuses_meshes_the_reader_would_refuse() {
     );
     // The writer's refusal and the reader's refusal agree: nothing refused is writable.
     assert!(from_bytes(&to_bytes(&good).unwrap()).is_ok());
+}
+
+/// The header summary (what the recovery prompt shows) states what the file holds — the
+/// mesh's own counts and the file's length on disk — from the 128-byte header; it refuses what is
+/// not a packed file of this version, a truncated header, and a missing file, naming it.
+#[test]
+fn the_header_summary_states_what_the_file_holds() {
+    let dir = unique_temp_dir("summary");
+    let path = dir.join("tetra.mpk");
+    for format in ColorFormat::ALL {
+        let mesh = tetrahedron(format);
+        write_file(&path, &mesh).unwrap();
+        let summary = read_summary(&path).unwrap();
+        assert_eq!(summary.face_count as usize, mesh.face_records.len());
+        assert_eq!(summary.vertex_count as usize, mesh.positions.len());
+        assert_eq!(summary.sample_count, mesh.sample_count());
+        assert_eq!(summary.file_size, std::fs::metadata(&path).unwrap().len());
+    }
+    let bytes = std::fs::read(&path).unwrap();
+    std::fs::write(&path, &bytes[..100]).unwrap();
+    assert!(matches!(read_summary(&path), Err(PackedFileError::Truncated { .. })));
+    std::fs::write(&path, b"glTF....").unwrap();
+    assert!(matches!(read_summary(&path), Err(PackedFileError::NotPacked { .. })));
+    let mut other_version = bytes.clone();
+    put_u32(&mut other_version, 8, VERSION + 1);
+    std::fs::write(&path, &other_version).unwrap();
+    assert!(matches!(read_summary(&path), Err(PackedFileError::UnsupportedVersion(v)) if v == VERSION + 1));
+    let missing = dir.join("missing.mpk");
+    let message = read_summary(&missing).unwrap_err().to_string();
+    assert!(message.contains("missing.mpk"), "{message}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -155,6 +155,47 @@ impl Header {
     }
 }
 
+/// What a packed file holds, from its header alone ([`read_summary`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PackedSummary {
+    /// Triangles.
+    pub face_count: u32,
+    /// Vertices.
+    pub vertex_count: u32,
+    /// Samples in the colour buffer (MIP chains included).
+    pub sample_count: u64,
+    /// The file's length as its header states it.
+    pub file_size: u64,
+}
+
+/// What the packed file at `path` holds, read from its first [`HEADER_SIZE`] bytes only
+/// (for a prompt about a large file; [`read_file`] checks everything). Refuses what is not a
+/// packed file of this version.
+pub fn read_summary(path: &Path) -> Result<PackedSummary, PackedFileError> {
+    use std::io::Read;
+    let io = |source| PackedFileError::Io { path: path.to_path_buf(), action: "read the header", source };
+    let mut bytes = Vec::with_capacity(HEADER_SIZE);
+    let file = std::fs::File::open(path).map_err(io)?;
+    file.take(HEADER_SIZE as u64).read_to_end(&mut bytes).map_err(io)?;
+    if !looks_like_packed(&bytes) {
+        return Err(PackedFileError::NotPacked { found: bytes[..bytes.len().min(MAGIC.len())].to_vec() });
+    }
+    let Some(bytes) = bytes.first_chunk::<HEADER_SIZE>() else {
+        let len = bytes.len() as u64;
+        return Err(PackedFileError::Truncated { what: "the header ends".to_owned(), end: HEADER_SIZE as u64, len });
+    };
+    let header = Header::parse(bytes);
+    if header.version != VERSION {
+        return Err(PackedFileError::UnsupportedVersion(header.version));
+    }
+    Ok(PackedSummary {
+        face_count: header.face_count,
+        vertex_count: header.vertex_count,
+        sample_count: header.sample_count,
+        file_size: header.file_size,
+    })
+}
+
 /// Whether `bytes` starts with the packed-file [`MAGIC`] (to choose a loader by content).
 pub fn looks_like_packed(bytes: &[u8]) -> bool {
     bytes.starts_with(&MAGIC)
