@@ -242,10 +242,12 @@ impl Editor {
         let text = opened_text(&document, elapsed);
         self.camera = OrbitCamera::framing(document.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES);
         let history_budget = (self.budget(), document.format);
-        // Untextured documents start at the lowest R where nothing is painted, and
-        // resolution follows the brush there; textured ones keep the chosen R.
-        self.panels.paint.brush.follow_resolution =
-            (!document.document.textured).then_some(meshpaint_core::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
+        // Untextured meshes start at the lowest R where nothing is painted, and resolution
+        // follows the brush there; textured ones keep the chosen R, and a project (packed
+        // file) keeps the resolutions it was saved with.
+        let project = matches!(document.document.source, meshpaint_core::io::document::SourceKind::Packed(_));
+        self.panels.paint.brush.follow_resolution = (!document.document.textured && !project)
+            .then_some(meshpaint_core::paint::brush::FOLLOW_BRUSH_MAX_RESOLUTION);
         // A restored recovery file holds colours no file holds yet: unsaved until saved.
         let restored = self.panels.autosave.state.restoring.is_some();
         self.panels.autosave.state.document_opened(&mut document, self.document.edit_generation);

@@ -463,3 +463,46 @@ fn obj_texture_maps_are_baked_and_unreadable_ones_reported() {
         });
     }
 }
+
+/// A binary PLY whose faces are one `tristrips` list (Stanford / VRIP style: `int` ids,
+/// strips separated by `-1`) of the `n × m` torus, one strip of `2(m + 1)` ids per ring.
+fn ply_tristrips(positions: &[[f32; 3]], n: usize, m: usize, separator: i32) -> Vec<u8> {
+    let id = |i: usize, j: usize| ((i % n) * m + j % m) as i32;
+    let mut list = Vec::new();
+    for i in 0..n {
+        if i > 0 {
+            list.push(separator);
+        }
+        for j in 0..=m {
+            list.extend([id(i, j), id(i + 1, j)]);
+        }
+    }
+    let header = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\nproperty float y\n\
+         property float z\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n",
+        positions.len()
+    );
+    let mut out = header.into_bytes();
+    positions.iter().flatten().for_each(|x| out.extend(x.to_le_bytes()));
+    out.extend((list.len() as i32).to_le_bytes());
+    list.iter().for_each(|v| out.extend(v.to_le_bytes()));
+    out
+}
+
+/// Triangle strips (older scan archives) read to the torus's closed-form counts — every
+/// quad two triangles, closed, manifold and consistently wound (no boundary, no non-manifold
+/// edge) — and a strip id other than the `-1` separator is refused with exit 1.
+#[test]
+fn tristrip_ply_reads_to_the_closed_form_or_is_refused() {
+    let dir = TempDir::new("tristrips");
+    let (n, m) = (6u64, 4u64);
+    let (positions, _) = torus(n as usize, m as usize);
+    let (v, f, e) = (n * m, 2 * n * m, 3 * n * m);
+    let path = dir.join("strips.ply");
+    std::fs::write(&path, ply_tristrips(&positions, n as usize, m as usize, -1)).unwrap();
+    assert_eq!(counts(&path, 4), [f, v, e, 0, 0, samples(v, e, f, 4)]);
+    let bad = dir.join("bad_separator.ply");
+    std::fs::write(&bad, ply_tristrips(&positions, n as usize, m as usize, -2)).unwrap();
+    let stderr = refused(&bad);
+    assert!(stderr.contains("tristrips") && stderr.contains("-2"), "{stderr}");
+}

@@ -115,6 +115,26 @@ fn f1_opens_the_help_window_listing_every_shortcut() {
     assert!(harness.query_by_label("Keyboard and mouse").is_none());
 }
 
+/// In a window shorter than the help, the help still fits: its title bar (with the close
+/// button) is on screen, the lists scroll, and Esc closes it.
+#[test]
+fn the_help_fits_a_short_window_and_esc_closes_it() {
+    let mut harness = Harness::builder()
+        .with_size([1000.0, 420.0])
+        .build_ui_state(|ui, editor: &mut Editor| editor.ui(ui), new_editor());
+    harness.run_steps(2);
+    harness.key_press(egui::Key::F1);
+    harness.run_steps(3);
+    let title = harness.get_by_label("Keyboard and mouse").rect();
+    assert!(title.min.y >= 0.0 && title.max.y <= 420.0, "the title bar is off screen: {title:?}");
+    let last = meshpaint::app::input::SHORTCUTS.last().unwrap();
+    let row = harness.get_by_label(last.description).rect();
+    assert!(row.min.y > 420.0, "the test needs a help taller than the window ({row:?})");
+    harness.key_press(egui::Key::Escape);
+    harness.run_steps(2);
+    assert!(!harness.state().panels.help.open);
+}
+
 #[test]
 fn every_shortcut_performs_a_distinct_action() {
     let shortcuts = meshpaint::app::input::SHORTCUTS;
@@ -1037,4 +1057,22 @@ fn the_recovery_prompt_says_when_and_what() {
         describe_recovery(&unknown, written),
         "Written at an unknown time; its header cannot be read (restoring will say why)."
     );
+}
+
+/// Resolution follows the brush for an untextured mesh (R grows where it is painted), never
+/// silently for a project: a packed file opens with the resolutions it was saved with.
+#[test]
+fn opening_a_project_leaves_resolution_following_off() {
+    let dir = std::env::temp_dir().join(format!("meshpaint_follow_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut editor = new_editor();
+    open_and_wait(&mut editor, &workspace_path("assets/models/AssimpTestModels/sphereWithHole.stl"));
+    assert!(editor.panels.paint.brush.follow_resolution.is_some(), "an untextured mesh follows the brush");
+    let path = dir.join("sphere.mpk");
+    editor.save_to(path.clone(), meshpaint_core::colors::format::ColorFormat::Rgba8Srgb);
+    assert!(editor.wait_for_job(JOB_TIMEOUT) && path.is_file(), "{:?}", editor.status);
+    open_and_wait(&mut editor, &path);
+    assert_eq!(editor.document.open.as_ref().unwrap().path.as_deref(), Some(path.as_path()));
+    assert!(editor.panels.paint.brush.follow_resolution.is_none(), "a project opened with following on");
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -4,7 +4,10 @@
 //! Read: the `vertex` element (`x y z` of any scalar type, rounded to f32; `nx ny nz`;
 //! `u v`, `s t` or `texture_u texture_v`; `red green blue [alpha]` or `diffuse_red ...`) and
 //! the `face` element (`vertex_indices` or `vertex_index`, a list of any integer type),
-//! polygons fanned. Other elements (edges, materials, ...) are read past and named in a warning.
+//! polygons fanned, and the `tristrips` element of older scan archives (`vertex_indices`
+//! lists of triangle strips separated by `-1`, winding alternating along a strip as in the
+//! Stanford and VRIP tools; degenerate joining triangles dropped). Other elements (edges,
+//! materials, ...) are read past and named in a warning.
 //!
 //! Before the payload is read, the element counts of the header are checked against the
 //! bytes that follow it (each element needs at least its fixed binary size, or two bytes
@@ -61,6 +64,19 @@ pub(super) fn read(bytes: &[u8]) -> Result<ReadMesh, String> {
                     if !push_fan(corners, &mut mesh.triangles) {
                         short_faces += 1;
                     }
+                }
+            }
+            "tristrips" => {
+                if element.count > 0 && !element.properties.keys().any(|k| is_index_list(k)) {
+                    return Err("the tristrips element has no 'vertex_indices' list".to_owned());
+                }
+                let strips = Parser::<PlyStrip>::new()
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(read_error)?;
+                let vertex_count = mesh.positions.len();
+                for (strip, PlyStrip { indices }) in strips.iter().enumerate() {
+                    push_strips(indices, vertex_count, &mut mesh.triangles)
+                        .map_err(|problem| format!("tristrips {strip}: {problem}"))?;
                 }
             }
             _ => {
@@ -294,6 +310,61 @@ impl PropertyAccess for PlyFace {
         };
         PropertyAccessResult::Set
     }
+}
+
+/// One entry of a `tristrips` element: vertex ids, `-1` between strips.
+#[derive(Debug)]
+struct PlyStrip {
+    indices: Vec<i64>,
+}
+
+impl PropertyAccess for PlyStrip {
+    fn new() -> Self {
+        PlyStrip { indices: Vec::new() }
+    }
+
+    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
+        if !is_index_list(name) {
+            return PropertyAccessResult::Ignored;
+        }
+        fn widen<T: Copy + Into<i64>>(values: &[T]) -> Vec<i64> {
+            values.iter().map(|&v| v.into()).collect()
+        }
+        self.indices = match &property {
+            Property::ListChar(v) => widen(v),
+            Property::ListUChar(v) => widen(v),
+            Property::ListShort(v) => widen(v),
+            Property::ListUShort(v) => widen(v),
+            Property::ListInt(v) => widen(v),
+            Property::ListUInt(v) => widen(v),
+            _ => return PropertyAccessResult::UnsupportedType,
+        };
+        PropertyAccessResult::Set
+    }
+}
+
+/// Appends the triangles of the strips in `indices` (separated by `-1`): triangle `k` of a
+/// strip is `(s[k], s[k+1], s[k+2])` for even `k` and `(s[k+1], s[k], s[k+2])` for odd `k`, so
+/// every triangle keeps the first one's winding; triangles with a repeated vertex (the
+/// joins between strips) are dropped. Refuses an id outside `0..vertex_count` other than
+/// the `-1` separator.
+fn push_strips(indices: &[i64], vertex_count: usize, triangles: &mut Vec<[u32; 3]>) -> Result<(), String> {
+    for strip in indices.split(|&v| v == -1) {
+        let mut ids = Vec::with_capacity(strip.len());
+        for &v in strip {
+            match u32::try_from(v) {
+                Ok(id) if (id as usize) < vertex_count => ids.push(id),
+                _ => return Err(format!("vertex {v} outside 0..{vertex_count} (only -1 separates strips)")),
+            }
+        }
+        for (k, w) in ids.windows(3).enumerate() {
+            let triangle = if k % 2 == 0 { [w[0], w[1], w[2]] } else { [w[1], w[0], w[2]] };
+            if triangle[0] != triangle[1] && triangle[1] != triangle[2] && triangle[0] != triangle[2] {
+                triangles.push(triangle);
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Any other element: every property read past and dropped.
