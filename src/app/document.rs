@@ -57,6 +57,8 @@ pub struct OpenDocument {
     pub packed_bytes: u64,
     /// How long the last repack (store → linear buffers) took.
     pub last_repack: Duration,
+    /// How the last repack after paint mode went (`None` before the first).
+    pub last_repack_how: Option<super::paint_session::Repack>,
     /// The compact packing with its `f32` chains, for an incremental repack when paint mode
     /// ends (`None` until a repack made one, or while paint mode holds it).
     pub pack_cache: Option<PackCache>,
@@ -270,6 +272,7 @@ pub fn load(
         },
         title: source.title(),
         last_repack: timings.pack,
+        last_repack_how: None,
         pack_cache: Some(cache),
         alternates: AlternateViews::default(),
         mesh_generation: 0,

@@ -22,7 +22,7 @@ use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::packing::paint_layout::PaintLayout;
 use meshpaint_core::paint::brush::{self, BrushRadius, BrushSettings, FillScope, PaintView, Painter, StrokeUpdate};
 use meshpaint_core::paint::optimize;
-use meshpaint_core::paint::undo::UndoHistory;
+use meshpaint_core::paint::undo::{StepSummary, UndoHistory};
 use meshpaint_render::Gpu;
 
 use super::job_output::{JobOutput, Optimized};
@@ -259,16 +259,8 @@ impl DocumentState {
         let summary = session.painter.end_stroke(history);
         let (bytes, changed) = (session.stroke_upload_bytes, session.stroke_samples_changed);
         if let Some(summary) = summary {
-            let kept = if summary.kept { "" } else { " (too large for the undo memory cap: not undoable)" };
-            ctx.status.set(
-                Severity::Info,
-                format!(
-                    "{}: {} sample updates, {} uploaded{kept}",
-                    summary.label,
-                    thousands(changed),
-                    human_bytes(bytes)
-                ),
-            );
+            log::info!("{}: {} sample updates, {} uploaded", summary.label, thousands(changed), human_bytes(bytes));
+            ctx.status.set(Severity::Info, stroke_message(&summary, changed));
         }
     }
 
@@ -617,4 +609,26 @@ pub fn radius_text(radius: BrushRadius) -> String {
         BrushRadius::Pixels { radius_px } => format!("{radius_px:.0} px"),
         BrushRadius::World { radius_world } => format!("{radius_world:.4} (world)"),
     }
+}
+
+/// What the status line says after a stroke: what changed, in plain words, and whether it
+/// can be undone.
+pub fn stroke_message(summary: &StepSummary, samples_changed: u64) -> String {
+    let mut label = summary.label.clone();
+    if let Some(first) = label.get(..1) {
+        label.replace_range(..1, &first.to_uppercase());
+    }
+    if summary.samples == 0 && summary.resolution_changes == 0 {
+        return format!("{label}: nothing changed (the stroke missed the mesh, or the colour was already there)");
+    }
+    let mut parts = Vec::new();
+    if summary.resolution_changes > 0 {
+        let faces = summary.resolution_changes;
+        parts.push(format!("resolution changed on {} {}", thousands(faces), if faces == 1 { "face" } else { "faces" }));
+    }
+    if samples_changed > 0 {
+        parts.push(format!("{} samples changed", thousands(samples_changed)));
+    }
+    let undo = if summary.kept { "" } else { "; too large for the undo memory, so it cannot be undone" };
+    format!("{label}: {}{undo}", parts.join(", "))
 }

@@ -186,15 +186,17 @@ impl DocumentState {
         open.pack_cache = Some(repacked.cache);
         self.gpu_paint_layout = false;
         viewport.scene_generation += 1;
+        open.last_repack_how = Some(repacked.how);
+        log::info!(
+            "Repacked{}: {} samples with MIP chains in {:.1} ms ({:.2} s with the upload)",
+            repacked.how.note(),
+            thousands(repacked.samples_with_mips),
+            repacked.pack_time.as_secs_f64() * 1000.0,
+            elapsed.as_secs_f64()
+        );
         status.set(
             Severity::Info,
-            format!(
-                "Repacked{}: {} samples with MIP chains in {:.1} ms ({:.2} s with the upload)",
-                repacked.how.note(),
-                thousands(repacked.samples_with_mips),
-                repacked.pack_time.as_secs_f64() * 1000.0,
-                elapsed.as_secs_f64()
-            ),
+            format!("Left paint mode: the colours are ready to view ({:.2} s)", elapsed.as_secs_f64()),
         );
     }
 }

@@ -59,7 +59,7 @@ impl UndoPanel {
         if let Some(stroke) = last_stroke {
             ui.label(
                 egui::RichText::new(format!(
-                    "Last stroke: {} sample updates, {} uploaded",
+                    "Last stroke: {} samples changed, {} uploaded to the GPU",
                     thousands(stroke.samples_changed),
                     human_bytes(stroke.upload_bytes)
                 ))
