@@ -759,7 +759,8 @@ impl Editor {
             }
         }
         let open = self.document.open.as_ref();
-        input::navigate(ui, &response, &mut self.camera, open, &self.viewport, &mut self.status);
+        let zoom_to_cursor = self.panels.view.settings.zoom_to_cursor;
+        input::navigate(ui, &response, &mut self.camera, open, &self.viewport, zoom_to_cursor, &mut self.status);
         if let Some(session) = &self.document.paint {
             draw_brush_cursor(&painter, session, &self.panels.paint.brush, &self.viewport, &self.camera);
         }

@@ -202,14 +202,16 @@ pub fn shortcuts(ctx: &egui::Context, mode: Mode, dialog_open: bool) -> Vec<Acti
 }
 
 /// Navigation in the 3D view from `response` (the view's area, sensing clicks and drags):
-/// orbit, pan and zoom `camera`; Alt + middle click frames the surface of `document` under
-/// the pointer (a miss is reported on `status`).
+/// orbit, pan and zoom `camera` (the wheel and pinch towards the pointer when
+/// `zoom_to_cursor`, else towards the orbit centre); Alt + middle click frames the surface of
+/// `document` under the pointer (a miss is reported on `status`).
 pub fn navigate(
     ui: &egui::Ui,
     response: &egui::Response,
     camera: &mut OrbitCamera,
     document: Option<&OpenDocument>,
     viewport: &ViewportState,
+    zoom_to_cursor: bool,
     status: &mut Status,
 ) {
     let modifiers = ui.input(|i| i.modifiers);
@@ -250,12 +252,21 @@ pub fn navigate(
                 .sum()
         });
         let pinch = ui.input(|i| i.zoom_delta());
+        let pointer = ui.input(|i| i.pointer.hover_pos()).filter(|_| zoom_to_cursor);
+        let mut zoom = |factor: f64| match pointer {
+            Some(pos) => {
+                let [x, y] = viewport.view_px(pos);
+                let [w, h] = viewport.size_px();
+                camera.zoom_towards_pixel(factor, x, y, w, h);
+            }
+            None => camera.zoom(factor),
+        };
         if lines != 0.0 {
-            camera.zoom(ZOOM_PER_WHEEL_LINE.powf(f64::from(lines)));
+            zoom(ZOOM_PER_WHEEL_LINE.powf(f64::from(lines)));
             moved = true;
         }
         if pinch != 1.0 && pinch.is_finite() && pinch > 0.0 {
-            camera.zoom(1.0 / f64::from(pinch));
+            zoom(1.0 / f64::from(pinch));
             moved = true;
         }
     }

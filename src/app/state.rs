@@ -130,6 +130,9 @@ pub struct ViewSettings {
     pub shading: Shading,
     /// Wireframe and resolution heat map.
     pub overlays: Overlays,
+    /// The wheel zooms towards the pointer (Blender's "zoom to mouse position"), else
+    /// towards the orbit centre.
+    pub zoom_to_cursor: bool,
 }
 
 impl Default for ViewSettings {
@@ -140,6 +143,7 @@ impl Default for ViewSettings {
             filter: FilterMode::Trilinear,
             shading: Shading::Smooth,
             overlays: Overlays::default(),
+            zoom_to_cursor: true,
         }
     }
 }

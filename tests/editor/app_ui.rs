@@ -210,6 +210,44 @@ fn middle_drag_orbits_shift_pans_and_the_wheel_zooms() {
     assert_eq!(framed.target, bounds.center, "Home did not frame the mesh");
 }
 
+/// The wheel zooms towards the pointer by default: the point of the orbit centre's view
+/// plane under the pointer stays under it (forward projection as the truth); with "Zoom to
+/// the pointer" off it zooms towards the orbit centre, which stays put.
+#[test]
+fn the_wheel_zooms_towards_the_pointer_unless_turned_off() {
+    for zoom_to_cursor in [true, false] {
+        let mut harness = harness(editor_with_duck());
+        harness.run_steps(2);
+        harness.state_mut().panels.view.settings.zoom_to_cursor = zoom_to_cursor;
+        let rect = harness.state().viewport.rect;
+        let pointer = rect.min + egui::vec2(rect.width() * 0.25, rect.height() * 0.3);
+        let before = harness.state().camera;
+        let [x, y] = harness.state().viewport.view_px(pointer);
+        let [w, h] = harness.state().viewport.size_px();
+        let (origin, direction) = before.ray_through_pixel(x, y, w, h);
+        let target = glam::DVec3::from_array(before.target);
+        let normal = before.eye_direction();
+        let point = origin + direction * ((target - origin).dot(normal) / direction.dot(normal));
+        harness.event(egui::Event::PointerMoved(pointer));
+        harness.event(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Line,
+            delta: egui::vec2(0.0, 2.0),
+            phase: egui::TouchPhase::Move,
+            source: egui::MouseWheelSource::Wheel,
+            modifiers: egui::Modifiers::NONE,
+        });
+        harness.run_steps(2);
+        let after = harness.state().camera;
+        assert!(after.distance < before.distance * 0.8, "the wheel did not zoom in");
+        if zoom_to_cursor {
+            let (px, py) = after.project(point, w, h).unwrap();
+            assert!((px - x).abs() < 1e-3 && (py - y).abs() < 1e-3, "the point under the pointer moved to {px},{py}");
+        } else {
+            assert_eq!(after.target, before.target, "zoom towards the orbit centre moved it");
+        }
+    }
+}
+
 #[test]
 fn frame_under_cursor_centres_on_the_surface() {
     let mut harness = harness(editor_with_duck());

@@ -76,6 +76,8 @@ impl ViewPanel {
             if ui.button("Frame all").on_hover_text("Home").clicked() {
                 commands.push(Command::Action(Action::FrameAll));
             }
+            ui.checkbox(&mut view.zoom_to_cursor, "Zoom to pointer")
+                .on_hover_text("The wheel zooms towards the point under the pointer, else towards the orbit centre");
             let camera = &ctx.camera;
             let angles = format!("yaw {:.0}°  pitch {:.0}°", camera.yaw_degrees, camera.pitch_degrees);
             ui.label(egui::RichText::new(angles).weak());
