@@ -989,7 +989,8 @@ fn open_drop_and_quit_ask_before_losing_unsaved_work() {
     let mut harness = duck_with_a_stroke();
     let painted = colors_of(harness.state());
     let box_glb = workspace_path("assets/models/BoxTextured/BoxTextured.glb");
-    let replacing: [(&str, Box<dyn Fn(&mut Harness<'static, Editor>)>); 3] = [
+    type Start<'a> = Box<dyn Fn(&mut Harness<'static, Editor>) + 'a>;
+    let replacing: [(&str, Start<'_>); 3] = [
         ("open", Box::new(|h| h.state_mut().apply(meshpaint::app::Command::Open(box_glb.clone())))),
         ("drop", Box::new(|h| h.input_mut().dropped_files.push(Arc::new(Dropped(box_glb.clone()))))),
         ("quit", Box::new(|h| h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q))),

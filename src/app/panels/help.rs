@@ -27,7 +27,7 @@ impl HelpWindow {
             .constrain(true)
             .max_height((ctx.content_rect().height() - 80.0).max(120.0))
             .show(ctx, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| Self::lists(ui));
+                egui::ScrollArea::vertical().show(ui, Self::lists);
             });
         if ctx.input(|i| i.key_pressed(egui::Key::Escape)) {
             open = false;
