@@ -1,5 +1,7 @@
 //! The plots of `bench trade`: error against a cost (GPU bytes, frame time), one point per
-//! configuration, the Pareto front drawn through the points no other beats on both axes.
+//! configuration of either representation (colour = filter, shape = representation, fill =
+//! colour format), the Pareto front drawn through the points no other beats on both axes,
+//! whichever representation they belong to.
 //!
 //! Drawn with `plotters` into PNGs (bitmap backend, no system libraries): text uses the
 //! Ubuntu Light font egui already ships (`epaint_default_fonts`), registered with plotters'
@@ -18,8 +20,11 @@ pub struct PlotPoint {
     pub quality: f64,
     /// Colour group (the filter).
     pub filter: String,
-    /// Marker group (the colour format).
+    /// Fill of the marker (the colour format: rgba8 filled, rgba16f hollow, rgba32f hollow
+    /// with a dot).
     pub format: String,
+    /// Shape of the marker (`mesh-colors`: circle, `mct`: square).
+    pub representation: String,
     /// Short name written next to Pareto points.
     pub label: String,
 }
@@ -123,6 +128,17 @@ pub fn plot_tradeoff(
     root.fill(&WHITE).map_err(|e| draw_error(e.to_string()))?;
     let front_points: Vec<(f64, f64)> = finite.iter().map(|p| (p.cost, p.quality)).collect();
     let front = pareto_front(&front_points);
+    // One label per front position: exact duplicates (e.g. every filter of R = 1, which has
+    // one level) are named once, with how many more share the point.
+    let mut front_labels: Vec<(&PlotPoint, String)> = Vec::new();
+    for &i in &front {
+        let p = finite[i];
+        let same = front.iter().filter(|&&j| finite[j].cost == p.cost && finite[j].quality == p.quality).count();
+        if !front_labels.iter().any(|(q, _)| q.cost == p.cost && q.quality == p.quality) {
+            let label = if same > 1 { format!("{} (+{} more)", p.label, same - 1) } else { p.label.clone() };
+            front_labels.push((p, label));
+        }
+    }
 
     macro_rules! draw {
         ($chart:expr) => {{
@@ -137,29 +153,51 @@ pub fn plot_tradeoff(
                 .axis_desc_style((FONT, 20))
                 .draw()
                 .map_err(|e| draw_error(e.to_string()))?;
-            let formats = ["rgba8", "rgba16f", "rgba32f"];
             for filter in ["nearest", "linear", "mip-1", "mip-2", "trilinear"] {
                 let color = filter_color(filter);
-                for format in formats {
-                    let group: Vec<&&PlotPoint> =
-                        finite.iter().filter(|p| p.filter == filter && p.format == format).collect();
+                // Filled rgba8, hollow rgba16f, hollow with a dot rgba32f.
+                let style =
+                    |p: &PlotPoint| if p.format == "rgba8" { color.mix(0.85).filled() } else { color.stroke_width(2) };
+                let dot =
+                    |p: &PlotPoint| Circle::new((0, 0), if p.format == "rgba32f" { 2 } else { 0 }, color.filled());
+                let mut labelled = false;
+                for representation in ["mesh-colors", "mct"] {
+                    let group: Vec<&PlotPoint> = finite
+                        .iter()
+                        .copied()
+                        .filter(|p| p.filter == filter && p.representation == representation)
+                        .collect();
                     if group.is_empty() {
                         continue;
                     }
-                    let style = color.mix(0.85).filled();
-                    let series: Vec<DynElement<'_, BitMapBackend<'_>, (f64, f64)>> = group
-                        .iter()
-                        .map(|p| match format {
-                            "rgba8" => Circle::new((p.cost, p.quality), 5, style).into_dyn(),
-                            "rgba16f" => TriangleMarker::new((p.cost, p.quality), 7, style).into_dyn(),
-                            _ => Cross::new((p.cost, p.quality), 5, color.stroke_width(2)).into_dyn(),
-                        })
-                        .collect();
-                    let drawn = chart.draw_series(series).map_err(|e| draw_error(e.to_string()))?;
-                    if format == "rgba8" {
+                    let at = |p: &PlotPoint| EmptyElement::at((p.cost, p.quality));
+                    let drawn = if representation == "mct" {
+                        chart.draw_series(
+                            group.iter().map(|p| at(p) + Rectangle::new([(-5, -5), (5, 5)], style(p)) + dot(p)),
+                        )
+                    } else {
+                        chart.draw_series(group.iter().map(|p| at(p) + Circle::new((0, 0), 5, style(p)) + dot(p)))
+                    }
+                    .map_err(|e| draw_error(e.to_string()))?;
+                    if !labelled {
                         drawn.label(filter).legend(move |(x, y)| Circle::new((x, y), 5, color.filled()));
+                        labelled = true;
                     }
                 }
+            }
+            if finite.iter().any(|p| p.representation == "mesh-colors") {
+                chart
+                    .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                    .map_err(|e| draw_error(e.to_string()))?
+                    .label("mesh colors (software filter)")
+                    .legend(|(x, y)| Circle::new((x, y), 5, BLACK.filled()));
+            }
+            if finite.iter().any(|p| p.representation == "mct") {
+                chart
+                    .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                    .map_err(|e| draw_error(e.to_string()))?
+                    .label("Mesh Color Texture (hardware filter)")
+                    .legend(|(x, y)| Rectangle::new([(x - 5, y - 5), (x + 5, y + 5)], BLACK.filled()));
             }
             let line: Vec<(f64, f64)> = front.iter().map(|&i| (finite[i].cost, finite[i].quality)).collect();
             chart
@@ -168,14 +206,13 @@ pub fn plot_tradeoff(
                 .label("Pareto front")
                 .legend(|(x, y)| PathElement::new(vec![(x - 10, y), (x + 10, y)], BLACK.stroke_width(2)));
             chart
-                .draw_series(front.iter().enumerate().map(|(k, &i)| {
-                    let p = finite[i];
+                .draw_series(front_labels.iter().enumerate().map(|(k, (p, label))| {
                     // Labels alternate above and below the point: neighbours on the front
                     // are often close.
                     let dy = if k % 2 == 0 { -20 } else { 6 };
                     EmptyElement::at((p.cost, p.quality))
                         + Circle::new((0, 0), 8, BLACK.stroke_width(1))
-                        + Text::new(p.label.clone(), (10, dy), (FONT, 15).into_font())
+                        + Text::new(label.clone(), (10, dy), (FONT, 15).into_font())
                 }))
                 .map_err(|e| draw_error(e.to_string()))?;
             if let Some((x, y, name)) = reference
@@ -217,7 +254,8 @@ pub fn plot_tradeoff(
         );
     }
     root.draw(&Text::new(
-        "circle rgba8 · triangle rgba16f · cross rgba32f; labelled points: the Pareto front",
+        "colour: filter · circle: mesh colors, square: MCT · filled rgba8, hollow rgba16f, hollow with a dot rgba32f · \
+         labelled: the Pareto front of both",
         (90, 872),
         (FONT, 17).into_font(),
     ))

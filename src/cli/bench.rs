@@ -109,40 +109,13 @@ pub(super) enum BenchCommand {
         #[arg(long, value_enum, value_delimiter = ',', default_values_t = [BakeArg::LeastSquares, BakeArg::Point])]
         bake: Vec<BakeArg>,
     },
-    /// What every choice costs and buys: filter × resolution (uniform R 1…32 and --error
-    /// bounds) × colour format, per view at several distances — PSNR, max error, FLIP against a
-    /// 4×4-supersampled reference, samples, GPU bytes, pack time, frame-time ratio to the UV
-    /// baseline (interleaved), dab throughput; plus seam jumps and BVH presets. One JSON object
+    /// What every choice costs and buys: representation (mesh colors, Mesh Color Texture) ×
+    /// filter × resolution (uniform R 1…32 and --error bounds) × colour format, per view at
+    /// several distances — PSNR, max error, FLIP against a 4×4-supersampled reference, samples,
+    /// GPU bytes, pack and MCT build time, frame-time ratio to the UV baseline (interleaved),
+    /// dab throughput; plus seam jumps of both representations and BVH presets. One JSON object
     /// per line; with --out, error-vs-cost plots (PNG).
-    Trade {
-        /// A .glb / .gltf file (textured: the UV render is the reference) or a packed file.
-        file: PathBuf,
-        /// View directions around the model (each at near, mid, far and tiny distances).
-        #[arg(long, default_value_t = 1)]
-        views: u32,
-        /// Write the plots trade_<name>_bytes.png and trade_<name>_frame.png into DIR.
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// The largest R the --error bounds give a face.
-        #[arg(long, default_value_t = 64)]
-        max_resolution: u64,
-        /// Image side in pixels (the reference is rendered at 4× and box-filtered).
-        #[arg(long, default_value_t = 256)]
-        size: u32,
-        /// Largest uniform R measured (powers of two from 1).
-        #[arg(long, default_value_t = 32)]
-        max_uniform: u64,
-        /// Interleaved timing rounds per view.
-        #[arg(long, default_value_t = 5)]
-        frames: usize,
-        /// The --error bounds measured (comma-separated; textured glTF only).
-        #[arg(long, value_delimiter = ',', default_values_t = [0.05f32, 0.02, 0.01, 0.005])]
-        errors: Vec<f32>,
-        /// Leave out the numerical extremes (`bench extremes`), which the report includes
-        /// after the configurations (`"bench": "extremes"` rows).
-        #[arg(long)]
-        no_extremes: bool,
-    },
+    Trade(TradeArgs),
     /// Picking and painting: BVH presets, pick latency, dab time and samples/s for brushes
     /// covering ~1k / 10k / 100k samples, upload bytes per dab, repack time.
     Paint {
@@ -180,13 +153,70 @@ pub(super) enum BenchCommand {
     },
 }
 
+/// `bench trade`'s arguments.
+#[derive(Debug, clap::Args)]
+pub(super) struct TradeArgs {
+    /// A .glb / .gltf file (textured: the UV render is the reference) or a packed file.
+    pub(super) file: PathBuf,
+    /// View directions around the model (each at near, mid, far and tiny distances).
+    #[arg(long, default_value_t = 1)]
+    pub(super) views: u32,
+    /// Write the plots trade_<name>_bytes.png and trade_<name>_frame.png into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub(super) out: Option<PathBuf>,
+    /// The largest R the --error bounds give a face.
+    #[arg(long, default_value_t = 64)]
+    pub(super) max_resolution: u64,
+    /// Image side in pixels (the reference is rendered at 4× and box-filtered).
+    #[arg(long, default_value_t = 256)]
+    pub(super) size: u32,
+    /// Largest uniform R measured (powers of two from 1).
+    #[arg(long, default_value_t = 32)]
+    pub(super) max_uniform: u64,
+    /// Interleaved timing rounds per view.
+    #[arg(long, default_value_t = 5)]
+    pub(super) frames: usize,
+    /// The --error bounds measured (comma-separated; textured glTF only).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.05f32, 0.02, 0.01, 0.005])]
+    pub(super) errors: Vec<f32>,
+    /// Leave out the numerical extremes (`bench extremes`), which the report includes
+    /// after the configurations (`"bench": "extremes"` rows).
+    #[arg(long)]
+    pub(super) no_extremes: bool,
+    /// Colour formats measured (comma-separated; default: rgba8, rgba16f, rgba32f).
+    #[arg(long, value_parser = parse_format, value_delimiter = ',')]
+    pub(super) formats: Vec<ColorFormat>,
+    /// Leave out the Mesh Color Texture rows (mesh colors only).
+    #[arg(long)]
+    pub(super) no_mct: bool,
+}
+
+impl TradeArgs {
+    /// The study these flags ask for.
+    fn options(&self) -> Result<meshpaint::bench::trade::TradeOptions> {
+        use meshpaint_core::colors::layout::Resolution;
+        anyhow::ensure!(self.size >= 8, "--size must be at least 8");
+        anyhow::ensure!(self.errors.iter().all(|e| e.is_finite() && *e >= 0.0), "--errors must be numbers ≥ 0");
+        let max_uniform = Resolution::new(self.max_uniform).context("--max-uniform")?;
+        Ok(meshpaint::bench::trade::TradeOptions {
+            views: self.views,
+            size: self.size,
+            max_resolution: Resolution::new(self.max_resolution).context("--max-resolution")?,
+            uniform: (0..=max_uniform.log2()).filter_map(|l| Resolution::from_log2(l).ok()).collect(),
+            formats: if self.formats.is_empty() { ColorFormat::ALL.to_vec() } else { self.formats.clone() },
+            mct: !self.no_mct,
+            frames: self.frames,
+            error_bounds: self.errors.clone(),
+            ..Default::default()
+        })
+    }
+}
+
 /// Runs one benchmark command.
 pub(super) fn run(what: BenchCommand) -> Result<()> {
     match what {
         BenchCommand::Extremes { json } => extremes(json),
-        BenchCommand::Trade { file, views, out, max_resolution, size, max_uniform, frames, errors, no_extremes } => {
-            trade(file, views, out, max_resolution, size, max_uniform, frames, errors, no_extremes)
-        }
+        BenchCommand::Trade(args) => trade(&args),
         BenchCommand::Adaptive { file, max_resolution, size, views, supersample, bake } => {
             adaptive(file, max_resolution, size, views, supersample, bake)
         }
@@ -206,46 +236,24 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
 }
 
 /// `bench trade`: every choice's cost and error side by side, the extremes, the plots.
-#[allow(clippy::too_many_arguments)] // one parameter per command-line flag
-fn trade(
-    file: PathBuf,
-    views: u32,
-    out: Option<PathBuf>,
-    max_resolution: u64,
-    size: u32,
-    max_uniform: u64,
-    frames: usize,
-    errors: Vec<f32>,
-    no_extremes: bool,
-) -> Result<()> {
-    use meshpaint_core::colors::layout::Resolution;
-    anyhow::ensure!(size >= 8, "--size must be at least 8");
-    anyhow::ensure!(errors.iter().all(|e| e.is_finite() && *e >= 0.0), "--errors must be numbers ≥ 0");
-    let max_uniform = Resolution::new(max_uniform).context("--max-uniform")?;
-    let options = meshpaint::bench::trade::TradeOptions {
-        views,
-        size,
-        max_resolution: Resolution::new(max_resolution).context("--max-resolution")?,
-        uniform: (0..=max_uniform.log2()).filter_map(|l| Resolution::from_log2(l).ok()).collect(),
-        frames,
-        error_bounds: errors,
-        ..Default::default()
-    };
-    let rows = meshpaint::bench::trade::bench_trade(&file, &options)?;
+fn trade(args: &TradeArgs) -> Result<()> {
+    let options = args.options()?;
+    let file = &args.file;
+    let rows = meshpaint::bench::trade::bench_trade(file, &options)?;
     for row in &rows {
         println!("{row}");
     }
-    if !no_extremes {
+    if !args.no_extremes {
         let gpu = meshpaint_render::Gpu::new_headless()?;
         for mut row in meshpaint::bench::extremes::extremes_rows(&gpu)? {
             row["bench"] = "extremes".into();
             println!("{row}");
         }
     }
-    if let Some(dir) = out {
-        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         let stem = file.file_stem().map_or("mesh".to_owned(), |s| s.to_string_lossy().to_lowercase());
-        for written in meshpaint::bench::trade::write_plots(&rows, &dir, &stem)? {
+        for written in meshpaint::bench::trade::write_plots(&rows, dir, &stem)? {
             eprintln!("wrote {}", written.display());
         }
     }
