@@ -103,30 +103,34 @@ struct PulledCorner {
 }
 
 fn pull_corner(face: u32, corner: u32, with_lod: bool) -> PulledCorner {
+    return pull_corner_with(face, corner, with_lod, u.flags, true);
+}
+
+// `pull_corner` for the FLAG_* bits `flags` (the uniform's, or a pipeline's constant, which
+// removes the code of every disabled feature: software rasterisers run both sides of a
+// branch). Without `with_face_normal` only the corner's own position is read and
+// `face_dot` is that of +Z.
+fn pull_corner_with(face: u32, corner: u32, with_lod: bool, flags: u32, with_face_normal: bool) -> PulledCorner {
     var out: PulledCorner;
     let c = face_corners(face);
-    let p0 = load_position(c.x);
-    let p1 = load_position(c.y);
-    let p2 = load_position(c.z);
-    var p = p0;
-    var v = c.x;
-    var bary = vec3<f32>(1.0, 0.0, 0.0);
-    if corner == 1u {
-        p = p1;
-        v = c.y;
-        bary = vec3<f32>(0.0, 1.0, 0.0);
-    } else if corner == 2u {
-        p = p2;
-        v = c.z;
-        bary = vec3<f32>(0.0, 0.0, 1.0);
-    }
-    // Face normal from the three positions (counter-clockwise front); a degenerate
-    // face gets +Z instead of NaN.
-    let n = cross(p1 - p0, p2 - p0);
-    let len = length(n);
+    let v = select(select(c.x, c.y, corner == 1u), c.z, corner == 2u);
+    let bary = vec3<f32>(f32(corner == 0u), f32(corner == 1u), f32(corner == 2u));
+    var p: vec3<f32>;
     var normal = vec3<f32>(0.0, 0.0, 1.0);
-    if len > 0.0 && is_finite(len) {
-        normal = n / len;
+    if with_face_normal {
+        let p0 = load_position(c.x);
+        let p1 = load_position(c.y);
+        let p2 = load_position(c.z);
+        p = select(select(p0, p1, corner == 1u), p2, corner == 2u);
+        // Face normal from the three positions (counter-clockwise front); a degenerate
+        // face gets +Z instead of NaN.
+        let n = cross(p1 - p0, p2 - p0);
+        let len = length(n);
+        if len > 0.0 && is_finite(len) {
+            normal = n / len;
+        }
+    } else {
+        p = load_position(v);
     }
     out.corners = c;
     out.vertex = v;
@@ -140,7 +144,7 @@ fn pull_corner(face: u32, corner: u32, with_lod: bool) -> PulledCorner {
     // The fragment stage flips the sign for back faces: dot(−n, l) = −dot(n, l) exactly.
     out.face_dot = dot(normal, u.light.xyz);
     out.light_dot = out.face_dot;
-    if (u.flags & FLAG_SMOOTH) != 0u {
+    if (flags & FLAG_SMOOTH) != 0u {
         // The vertex normal is stored in f16; it is renormalised here. A face wound against
         // its neighbours (mixed winding) sees it more than 45° away and stays flat.
         let vn = textureLoad(normals, data_texel(v), 0).xyz;
@@ -162,18 +166,32 @@ fn finish_fragment(
     bary: vec3<f32>,
     bary_width: vec3<f32>,
 ) -> vec4<f32> {
+    return finish_fragment_with(u.flags, color, heat, face_dot, light_dot, front_facing, bary, bary_width);
+}
+
+// `finish_fragment` for the FLAG_* bits `flags` (see `pull_corner_with`).
+fn finish_fragment_with(
+    flags: u32,
+    color: vec4<f32>,
+    heat: vec3<f32>,
+    face_dot: f32,
+    light_dot: f32,
+    front_facing: bool,
+    bary: vec3<f32>,
+    bary_width: vec3<f32>,
+) -> vec4<f32> {
     var rgb = color.rgb * u.tint.rgb;
     let alpha = color.a * u.tint.a;
-    if (u.flags & FLAG_HEATMAP) != 0u {
+    if (flags & FLAG_HEATMAP) != 0u {
         rgb = heat;
     }
-    if (u.flags & FLAG_LIT) != 0u {
+    if (flags & FLAG_LIT) != 0u {
         let ambient = u.light.w;
-        let d = select(face_dot, light_dot, (u.flags & FLAG_SMOOTH) != 0u);
+        let d = select(face_dot, light_dot, (flags & FLAG_SMOOTH) != 0u);
         let diffuse = max(select(-d, d, front_facing), 0.0);
         rgb = rgb * (ambient + (1.0 - ambient) * diffuse);
     }
-    if (u.flags & FLAG_WIREFRAME) != 0u {
+    if (flags & FLAG_WIREFRAME) != 0u {
         rgb = wireframe_overlay(rgb, bary, bary_width, u.wire_color, u.wire_width);
     }
     return vec4<f32>(rgb, alpha);

@@ -9,6 +9,7 @@ use super::layouts::BindLayouts;
 use super::mesh_gpu::{atlas_texture_format, data_texture};
 use super::{GpuContext, MeshGeometry, RenderError};
 use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::mct::layout::GROUPS;
 use meshpaint_core::mct::{MctBands, MctFaceRecord, MeshColorTexture};
 
 /// A Mesh Color Texture uploaded for the MCT pipeline, drawn with its mesh's geometry.
@@ -76,7 +77,7 @@ impl GpuMct {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        ctx.queue.write_buffer(&bands, 0, bytemuck::bytes_of(&mct.layout.bands));
+        ctx.queue.write_buffer(&bands, 0, bytemuck::bytes_of(&gpu_bands(&mct.layout.bands, mct.layout.levels)));
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("MCT bilinear"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -133,10 +134,29 @@ impl GpuMct {
     }
 }
 
+/// The band table as shaders/mct.wgsl reads it (`mct_bands`, the size of [`MctBands`]): at
+/// index `g · GROUPS + l`, the bands of group `g` at level `l` and at the next level
+/// `min(l + 1, levels − 1)`, each `y | per_row << 16` (`per_row` at least 1), so that one
+/// lookup gives a fragment both of its levels. `check` keeps both below 2^16.
+fn gpu_bands(bands: &MctBands, levels: u32) -> MctBands {
+    let last = levels.saturating_sub(1) as usize;
+    let packed = |index: usize| {
+        let [y, per_row, ..] = bands.bands[index];
+        y | (per_row.max(1) << 16)
+    };
+    MctBands {
+        bands: std::array::from_fn(|index| {
+            let next = if index % GROUPS < last { index + 1 } else { index };
+            [packed(index), packed(next), 0, 0]
+        }),
+    }
+}
+
 /// The atlas size, or why `mct` cannot be drawn with `mesh` on this device.
 fn check(ctx: &GpuContext, mesh: &MeshGeometry, mct: &MeshColorTexture) -> Result<(u32, u32), RenderError> {
     let (width, height) = (mct.layout.width, mct.layout.height);
-    let max_dimension = ctx.limits().max_texture_dimension_2d;
+    // The band table packs rows and blocks per row in 16 bits (`gpu_bands`).
+    let max_dimension = ctx.limits().max_texture_dimension_2d.min(u32::from(u16::MAX));
     if width == 0 || height == 0 || width > max_dimension || height > max_dimension {
         return Err(RenderError::InvalidTexture(format!(
             "Mesh Color Texture atlas {width}×{height} is outside 1..={max_dimension} per side"

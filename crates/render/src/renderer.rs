@@ -1,5 +1,7 @@
 //! Pipelines, render settings, drawing into any colour view, and offscreen readback.
 
+use std::sync::OnceLock;
+
 use glam::DVec3;
 use image::RgbaImage;
 
@@ -186,8 +188,25 @@ pub struct Renderer {
     /// One mesh-colors pipeline per `(filter_kind, level_mode)`, see [`mesh_pipeline_index`].
     mesh_pipelines: Vec<wgpu::RenderPipeline>,
     baseline_pipeline: wgpu::RenderPipeline,
-    /// The MCT pipelines for `LEVEL_MODE` fixed (0) and automatic (1).
-    mct_pipelines: [wgpu::RenderPipeline; 2],
+    /// The MCT shader and its pipelines, one per `LEVEL_MODE` and set of `FLAG_*` bits (see
+    /// [`mct_pipeline_index`]), each built the first time it draws.
+    mct_module: wgpu::ShaderModule,
+    mct_pipelines: [OnceLock<wgpu::RenderPipeline>; MCT_PIPELINES],
+}
+
+/// The `FLAG_*` bits the MCT shader is specialised for (its pipeline-overridable constant
+/// `MCT_FLAGS`), so that lighting and overlays that are off cost nothing: a software
+/// rasteriser runs the code of a uniform branch for every fragment. Other bits are ignored.
+const MCT_FLAG_BITS: u32 =
+    FrameUniforms::FLAG_LIT | FrameUniforms::FLAG_WIREFRAME | FrameUniforms::FLAG_HEATMAP | FrameUniforms::FLAG_SMOOTH;
+
+/// MCT pipelines: `LEVEL_MODE` fixed or automatic, times every set of [`MCT_FLAG_BITS`].
+const MCT_PIPELINES: usize = 2 * (MCT_FLAG_BITS as usize + 1);
+
+/// The index of the MCT pipeline for `level_mode` (automatic unless fixed) and `flags`.
+fn mct_pipeline_index(level_mode: u32, flags: u32) -> usize {
+    usize::from(level_mode != FrameUniforms::LEVEL_FIXED) * (MCT_FLAG_BITS as usize + 1)
+        + (flags & MCT_FLAG_BITS) as usize
 }
 
 /// The `(filter_kind, level_mode)` combinations the mesh-colors shader is specialised for,
@@ -241,12 +260,30 @@ impl Renderer {
             color_format,
         );
         let mct_module = Self::module(ctx, "mesh color textures", MCT_WGSL);
-        let mct_pipelines = [FrameUniforms::LEVEL_FIXED, FrameUniforms::LEVEL_AUTO].map(|level_mode| {
-            let constants = [("LEVEL_MODE", f64::from(level_mode))];
-            let label = format!("mesh color textures (level mode {level_mode})");
-            Self::pipeline(ctx, &label, &mct_module, &constants, layouts.mct(), &[], color_format)
-        });
-        Renderer { color_format, layouts, mesh_pipelines, baseline_pipeline, mct_pipelines }
+        let renderer = Renderer {
+            color_format,
+            layouts,
+            mesh_pipelines,
+            baseline_pipeline,
+            mct_module,
+            mct_pipelines: std::array::from_fn(|_| OnceLock::new()),
+        };
+        // The unlit ones now, so that shader errors surface here.
+        for level_mode in [FrameUniforms::LEVEL_FIXED, FrameUniforms::LEVEL_AUTO] {
+            renderer.mct_pipeline(ctx, level_mode, 0);
+        }
+        renderer
+    }
+
+    /// The MCT pipeline for `level_mode` and `flags`, built on first use.
+    fn mct_pipeline(&self, ctx: &GpuContext, level_mode: u32, flags: u32) -> &wgpu::RenderPipeline {
+        let flags = flags & MCT_FLAG_BITS;
+        let level_mode = if level_mode == FrameUniforms::LEVEL_FIXED { level_mode } else { FrameUniforms::LEVEL_AUTO };
+        self.mct_pipelines[mct_pipeline_index(level_mode, flags)].get_or_init(|| {
+            let constants = [("LEVEL_MODE", f64::from(level_mode)), ("MCT_FLAGS", f64::from(flags))];
+            let label = format!("mesh color textures (level mode {level_mode}, flags {flags})");
+            Self::pipeline(ctx, &label, &self.mct_module, &constants, self.layouts.mct(), &[], self.color_format)
+        })
     }
 
     fn module(ctx: &GpuContext, label: &str, source: &str) -> wgpu::ShaderModule {
@@ -397,9 +434,7 @@ impl Renderer {
                 (&mesh.uniforms, &self.mesh_pipelines[mesh_pipeline_index(uniforms.filter_kind, uniforms.level_mode)])
             }
             DrawItem::Baseline(mesh) => (&mesh.uniforms, &self.baseline_pipeline),
-            DrawItem::Mct(mct) => {
-                (&mct.uniforms, &self.mct_pipelines[usize::from(uniforms.level_mode != FrameUniforms::LEVEL_FIXED)])
-            }
+            DrawItem::Mct(mct) => (&mct.uniforms, self.mct_pipeline(ctx, uniforms.level_mode, uniforms.flags)),
         };
         ctx.queue.write_buffer(uniform_buffer, 0, bytemuck::bytes_of(&uniforms));
         let [r, g, b, a] = settings.background.map(f64::from);

@@ -88,8 +88,9 @@ impl MctFaceRecord {
 
 /// Where the band of group `g` (`log2 R_b`) at `level` starts and how many blocks a row
 /// holds: `[y, per_row, 0, 0]` at index `g · GROUPS + level` (level 0: tent *periods*
-/// per row, two pairs each; levels ≥ 1: squares per row). Keep in sync with `MctBands`
-/// in crates/render/shaders/mct.wgsl (a uniform array of 169 `vec4<u32>`).
+/// per row, two pairs each; levels ≥ 1: squares per row). The renderer uploads it repacked
+/// for crates/render/shaders/mct.wgsl (`gpu_bands` in crates/render/src/mct.rs: per entry the
+/// band of this level and of the next, each `y | per_row << 16`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct MctBands {
