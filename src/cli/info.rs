@@ -9,7 +9,7 @@ use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::colors::layout::Resolution;
 use meshpaint_core::colors::stats::MeshStats;
 use meshpaint_core::convert::adaptive::ResolutionRule;
-use meshpaint_core::io::document::SourceKind;
+use meshpaint_core::io::document::{Document, SourceKind};
 use meshpaint_core::mesh::orientation::Orientation;
 use meshpaint_core::mesh::topology::Topology;
 use meshpaint_core::packing::file as packed_file;
@@ -108,12 +108,22 @@ fn gltf_info(path: &Path, resolution_arg: ResolutionArg, json: bool) -> Result<(
             (SampleCounts::uniform_on(&topology, resolution), format!("R = {resolution} on every face"))
         }
         rule => {
-            // Content-driven resolutions, as `pack` would choose them with its default bake: the
-            // fit runs, the document's store is not allocated (a budget's calibration stores are
-            // bounded by `least_squares::MAX_SAMPLES`).
+            // Content-driven resolutions, as `pack` chooses them with its default bake: the
+            // fit runs; the document's store is allocated only for the error rule (a budget's
+            // calibration stores are bounded by `least_squares::MAX_SAMPLES`).
             let face_count = topology.face_count() as usize;
-            let fit = meshpaint_core::convert::least_squares::BakeFit::default();
-            let resolutions = meshpaint_core::convert::adaptive::face_resolutions(&mesh, &scene, face_count, rule, fit);
+            let resolutions = match rule {
+                // The error rule raises the faces still over the bound after the bake
+                // (`adaptive::bake_and_verify`), so only the conversion itself gives its count.
+                ResolutionRule::ErrorBound { .. } => {
+                    let document = Document::from_scene_within(scene.clone(), rule, path, &budget)?;
+                    (0..face_count as u32).filter_map(|face| document.store.face_resolution(face)).collect()
+                }
+                rule => {
+                    let fit = meshpaint_core::convert::least_squares::BakeFit::default();
+                    meshpaint_core::convert::adaptive::face_resolutions(&mesh, &scene, face_count, rule, fit)
+                }
+            };
             let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);
             stats.samples = counts.samples;
             stats.samples_with_mips = counts.samples_with_mips;

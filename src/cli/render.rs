@@ -123,7 +123,7 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
         (image, mesh.vertex_count / 3, 0)
     } else {
         let source = Source::File(args.file.clone());
-        let options = OpenOptions::new(args.resolution.get()?, budget);
+        let options = OpenOptions::new(args.resolution.rule()?, budget);
         let upload = |packed: &_| if args.position_colors { Ok(None) } else { gpu.upload(packed).map(Some) };
         let displayed = open_for_display(&source, &options, &|_, _| {}, upload)?;
         for warning in &displayed.document.warnings {

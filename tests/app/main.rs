@@ -18,6 +18,7 @@ mod export_gltf;
 mod extremes;
 mod formats;
 mod gpu_render;
+mod rule_flags;
 mod trade;
 mod validator;
 mod winding;
