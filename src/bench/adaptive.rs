@@ -80,6 +80,8 @@ pub struct AdaptiveRow {
     pub packed_bytes: u64,
     /// Seconds to convert (fit + bake) the scene.
     pub convert_seconds: f64,
+    /// Where the conversion's time went.
+    pub phases: OpenPhases,
     /// PSNR per view against the UV-textured render, dB.
     pub psnr_db: Vec<f64>,
     /// Face resolutions: smallest and largest.
@@ -115,6 +117,15 @@ impl AdaptiveRow {
             "samples_with_mips": self.samples_with_mips,
             "packed_bytes": self.packed_bytes,
             "convert_seconds": self.convert_seconds,
+            "phase_seconds": {
+                "weld": self.phases.weld.as_secs_f64(),
+                "topology": self.phases.topology.as_secs_f64(),
+                "calibrate": self.phases.rule.calibrate.as_secs_f64(),
+                "predict": self.phases.rule.predict.as_secs_f64(),
+                "allocate": self.phases.rule.allocate.as_secs_f64(),
+                "bake": self.phases.bake.as_secs_f64(),
+                "store": self.phases.store.as_secs_f64(),
+            },
             "psnr_db": mean,
             "psnr_db_worst_view": worst,
             "psnr_db_per_view": self.psnr_db,
@@ -129,12 +140,14 @@ impl AdaptiveRow {
 /// `path`), `size`² images supersampled `supersample`² (module docs), `views` cameras, the
 /// budget rows of [`AdaptiveOptions::budget_max`]. Fails when the scene has no base-colour
 /// texture (no reference).
-/// Long: references, then one conversion, pack, upload and render per row.
+/// Long: references, then one conversion, pack, upload and render per row; `on_row` sees
+/// each row as soon as it is measured (the CLI prints it then).
 pub fn bench_adaptive(
     path: &Path,
     scene: &Scene,
     rules: &[ResolutionRule],
     options: &AdaptiveOptions,
+    on_row: &mut dyn FnMut(&AdaptiveRow),
 ) -> Result<Vec<AdaptiveRow>, BenchRenderError> {
     let AdaptiveOptions { budget_max, size, views, supersample, ref fits } = *options;
     let gpu = Gpu::new_headless()?;
@@ -163,13 +176,14 @@ pub fn bench_adaptive(
         rules.iter().flat_map(|&rule| fits.iter().map(move |&fit| (rule, fit))).collect();
     while let Some((rule, fit)) = queue.pop_front() {
         let started = Instant::now();
+        let mut phases = OpenPhases::default();
         let document = Document::from_scene_phased(
             scene.clone(),
             rule,
             fit,
             path,
             &meshpaint_core::colors::budget::Budget::from_environment(),
-            &mut OpenPhases::default(),
+            &mut phases,
         )?;
         let convert_seconds = started.elapsed().as_secs_f64();
         let packed = document.pack(ColorFormat::Rgba8Srgb)?;
@@ -198,10 +212,14 @@ pub fn bench_adaptive(
             samples_with_mips: packed.sample_count(),
             packed_bytes: packed.face_record_bytes() + packed.color_bytes(),
             convert_seconds,
+            phases,
             psnr_db,
             resolution_range: range,
             supersample: supersample.max(1),
         });
+        if let Some(row) = rows.last() {
+            on_row(row);
+        }
     }
     Ok(rows)
 }
@@ -214,6 +232,29 @@ pub fn default_rules(max: Resolution) -> Vec<ResolutionRule> {
     rules.push(ResolutionRule::TexelDensity { max });
     rules.extend([0.05f32, 0.02, 0.01, 0.005, 0.0025].map(|bound| ResolutionRule::ErrorBound { bound, max }));
     rules
+}
+
+/// Parses one rule of `bench adaptive --rules`: `uniform:R`, `texel-density`, `error:E` or
+/// `samples:N` (a budget), the adaptive ones capped at `max`.
+pub fn parse_rule(text: &str, max: Resolution) -> Result<ResolutionRule, String> {
+    let (name, value) = text.split_once(':').unwrap_or((text, ""));
+    let number =
+        |what: &str| value.parse::<f64>().map_err(|_| format!("{text:?}: {what} needs a number, e.g. {what}:8"));
+    match name {
+        "uniform" => Resolution::new(number("uniform")? as u64)
+            .map(ResolutionRule::Uniform)
+            .map_err(|err| format!("{text:?}: {err}")),
+        "texel-density" if value.is_empty() => Ok(ResolutionRule::TexelDensity { max }),
+        "error" => match number("error")? {
+            bound if bound.is_finite() && bound >= 0.0 => Ok(ResolutionRule::ErrorBound { bound: bound as f32, max }),
+            bound => Err(format!("{text:?}: an error bound is a number ≥ 0, got {bound}")),
+        },
+        "samples" => match value.parse::<u64>() {
+            Ok(samples) if samples > 0 => Ok(ResolutionRule::Budget { samples, max }),
+            _ => Err(format!("{text:?}: a budget is a whole number of samples > 0, e.g. samples:20000")),
+        },
+        _ => Err(format!("{text:?}: a rule is uniform:R, texel-density, error:E or samples:N")),
+    }
 }
 
 /// A render supersampled [`SUPERSAMPLE`]² and box-filtered to its size, with the pixels all of

@@ -108,6 +108,11 @@ pub(super) enum BenchCommand {
         /// (the conversion's default) and the point bake it starts from.
         #[arg(long, value_enum, value_delimiter = ',', default_values_t = [BakeArg::LeastSquares, BakeArg::Point])]
         bake: Vec<BakeArg>,
+        /// Measure only these rules (comma-separated `uniform:R`, `texel-density`, `error:E`,
+        /// `samples:N`; no budget rows are added) instead of uniform R = 1…32 with a budget
+        /// row beside each R ≥ 4, texel density and error bounds 0.05…0.0025.
+        #[arg(long, value_delimiter = ',')]
+        rules: Vec<String>,
     },
     /// What every choice costs and buys: representation (mesh colors, Mesh Color Texture) ×
     /// filter × resolution (uniform R 1…32 and --error bounds) × colour format, per view at
@@ -217,8 +222,8 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
     match what {
         BenchCommand::Extremes { json } => extremes(json),
         BenchCommand::Trade(args) => trade(&args),
-        BenchCommand::Adaptive { file, max_resolution, size, views, supersample, bake } => {
-            adaptive(file, max_resolution, size, views, supersample, bake)
+        BenchCommand::Adaptive { file, max_resolution, size, views, supersample, bake, rules } => {
+            adaptive(file, max_resolution, size, views, supersample, bake, rules)
         }
         BenchCommand::Pack { file, resolution, format, runs, subdivide, stroke_samples } => {
             pack(file, resolution, format, runs, subdivide, stroke_samples)
@@ -268,25 +273,31 @@ fn adaptive(
     views: u32,
     supersample: u32,
     bake: Vec<BakeArg>,
+    rules: Vec<String>,
 ) -> Result<()> {
     let max = meshpaint_core::colors::layout::Resolution::new(max_resolution).context("--max-resolution")?;
+    let chosen = rules
+        .iter()
+        .map(|rule| meshpaint::bench::adaptive::parse_rule(rule, max).map_err(|err| anyhow::anyhow!("--rules {err}")))
+        .collect::<Result<Vec<_>>>()?;
     let scene = meshpaint_core::mesh::import::import_gltf(&file)?;
-    let rules = meshpaint::bench::adaptive::default_rules(max);
     let fits: Vec<BakeFit> = bake.iter().map(|&b| b.into()).collect();
     let options = meshpaint::bench::adaptive::AdaptiveOptions {
-        budget_max: Some(max),
+        budget_max: chosen.is_empty().then_some(max),
         size,
         views,
         supersample,
         fits: fits.clone(),
     };
-    let rows = meshpaint::bench::adaptive::bench_adaptive(&file, &scene, &rules, &options)?;
-    for row in &rows {
+    // One line per row as soon as it is measured: a large asset takes minutes per row.
+    let mut print_row = |row: &meshpaint::bench::adaptive::AdaptiveRow| {
         let mut value = row.to_json();
         value["bench"] = "adaptive".into();
         value["file"] = file.display().to_string().into();
         println!("{value}");
-    }
+    };
+    let rules = if chosen.is_empty() { meshpaint::bench::adaptive::default_rules(max) } else { chosen };
+    let rows = meshpaint::bench::adaptive::bench_adaptive(&file, &scene, &rules, &options, &mut print_row)?;
     let texels = meshpaint::bench::adaptive::uv_island_texels(&scene);
     for fit in fits {
         let mut summary = meshpaint::bench::adaptive::summary(&rows, fit, texels);

@@ -204,7 +204,16 @@ fn a_third_of_uniform_r4_samples_by_budget_beats_uniform_r4_on_the_fox_in_the_re
         supersample: ADAPTIVE_SUPERSAMPLE,
         fits: vec![BakeFit::LeastSquares],
     };
-    let rows = bench_adaptive(&path, &scene, &[ResolutionRule::Uniform(r(4))], &options).unwrap();
+    let mut streamed = Vec::new();
+    let rows =
+        bench_adaptive(&path, &scene, &[ResolutionRule::Uniform(r(4))], &options, &mut |row| streamed.push(row.rule))
+            .unwrap();
+    // Each row reaches the caller as it is measured (the CLI prints it then), in order.
+    assert_eq!(streamed, rows.iter().map(|row| row.rule).collect::<Vec<_>>());
+    // The budget row's phases: the rule's own phases took part of the conversion, never more.
+    let phases = rows[1].phases;
+    let rule_phases = phases.rule.calibrate + phases.rule.predict + phases.rule.allocate;
+    assert!(rule_phases > std::time::Duration::ZERO && rule_phases + phases.bake <= phases.store, "{phases:?}");
     let [budget, uniform] = [ResolutionRule::Budget { samples: 4610 / 3, max: r(64) }, ResolutionRule::Uniform(r(4))]
         .map(|rule| rows.iter().find(|row| row.rule == rule).unwrap());
     let mean = |psnr: &[f64]| psnr.iter().sum::<f64>() / psnr.len() as f64;
@@ -268,5 +277,21 @@ fn texel_density_follows_the_closed_form_and_untextured_faces_stay_at_one() {
     ] {
         let document = convert(&flat, rule);
         assert!(document.store.face_resolutions().iter().all(|x| x.get() == 1), "{rule:?}");
+    }
+}
+
+#[test]
+fn bench_adaptive_rules_parse_as_the_cli_documents_them() {
+    use meshpaint::bench::adaptive::parse_rule;
+    let max = r(256);
+    assert_eq!(parse_rule("uniform:16", max), Ok(ResolutionRule::Uniform(r(16))));
+    assert_eq!(parse_rule("texel-density", max), Ok(ResolutionRule::TexelDensity { max }));
+    assert_eq!(parse_rule("error:0.01", max), Ok(ResolutionRule::ErrorBound { bound: 0.01, max }));
+    assert_eq!(parse_rule("samples:20000", max), Ok(ResolutionRule::Budget { samples: 20_000, max }));
+    for bad in
+        ["uniform:3", "uniform:x", "error:-1", "error:nan", "samples:0", "samples:1.5", "texel-density:2", "blur"]
+    {
+        let err = parse_rule(bad, max).unwrap_err();
+        assert!(err.contains(bad), "{bad}: {err}");
     }
 }

@@ -150,7 +150,13 @@ pub struct OpenPhases {
     pub weld: Duration,
     /// Building the topology (edges, incidence).
     pub topology: Duration,
-    /// Allocating and colouring the store (budget check, bake or fill, vertex colours).
+    /// Choosing the face resolutions of a content-driven rule, by phase.
+    pub rule: crate::convert::adaptive::RulePhases,
+    /// Baking the texture into the store (and fitting it; an error bound's verification
+    /// rounds included).
+    pub bake: Duration,
+    /// Allocating and colouring the store (budget check, resolutions, bake or fill, vertex
+    /// colours): the phases above and the rest.
     pub store: Duration,
 }
 
@@ -474,12 +480,13 @@ impl Document {
             rule => {
                 // The budget rule stays within the packed limit by construction; every rule's
                 // result is checked before the store is allocated.
-                let resolutions = crate::convert::adaptive::face_resolutions(
+                let resolutions = crate::convert::adaptive::face_resolutions_phased(
                     &welded,
                     &scene,
                     topology.face_count() as usize,
                     rule,
                     fit,
+                    &mut phases.rule,
                 );
                 let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);
                 budget.check(&rule.describe(), &counts, ColorFormat::default()).map_err(budget_error)?;
@@ -494,7 +501,9 @@ impl Document {
         let mut store = ColorStore::with_resolutions(topology, resolutions, uniform.unwrap_or([1.0; 4]))
             .map_err(|source| DocumentError::Store { path: name.to_owned(), source })?;
         if has_base_color {
+            let baking = Instant::now();
             crate::convert::adaptive::bake_and_verify(&mut store, &welded, &scene, rule, fit);
+            phases.bake = baking.elapsed();
         } else if neutral && uniform.is_none() {
             fill_neutral(&mut store, &welded.triangle_materials, &scene);
         }

@@ -507,3 +507,30 @@ fn the_mip_level_follows_the_lattice_spacing_of_a_right_triangle() {
         assert!(worst < 1e-5, "R = {resolution}: largest difference {worst} from level {}", 64 / size - 1);
     }
 }
+
+/// The table encode the error measures use, against the IEC 61966-2-1 formula in f64 written
+/// here: every 61st float in [0, 1] (a stride that visits every interval at many offsets),
+/// both ends and the knee; within 2·10⁻⁷ and never decreasing.
+#[test]
+fn the_table_srgb_encode_is_within_2e_7_of_the_formula_and_monotonic() {
+    use meshpaint_core::colors::format::linear_to_srgb_table;
+    let formula = |x: f64| if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
+    let (mut worst, mut previous) = (0.0f64, f32::NEG_INFINITY);
+    let mut check = |x: f32| {
+        let y = linear_to_srgb_table(x);
+        worst = worst.max((f64::from(y) - formula(f64::from(x))).abs());
+        y
+    };
+    for bits in (0..=1.0f32.to_bits()).step_by(61).chain([1.0f32.to_bits()]) {
+        let y = check(f32::from_bits(bits));
+        assert!(y >= previous, "decreasing at {}", f32::from_bits(bits));
+        previous = y;
+    }
+    for x in [0.0, 0.003_130_8, 1.0 / 512.0, 0.5, 1.0] {
+        check(x);
+    }
+    assert!(worst <= 2e-7, "worst {worst:e}");
+    assert_eq!(linear_to_srgb_table(f32::NAN), 0.0);
+    assert_eq!(linear_to_srgb_table(-1.0), 0.0);
+    assert_eq!(linear_to_srgb_table(7.0), linear_to_srgb_table(1.0));
+}

@@ -58,13 +58,18 @@
 //! and the budget is allocated again; the allocation whose store showed the least
 //! area-weighted squared error is kept (the first one included).
 
+use std::time::{Duration, Instant};
+
 use rayon::prelude::*;
 
+mod face_fit;
+
+use face_fit::{FaceFit, SharedUvs, TestPoint, dense_lattice, shared_uvs};
+
 use crate::colors::budget::SampleCounts;
-use crate::colors::format::{Rgba, linear_to_srgb};
-use crate::colors::layout::{self, Resolution};
+use crate::colors::layout::Resolution;
 use crate::colors::store::ColorStore;
-use crate::convert::bake::{FaceMaterial, bake_texture, face_materials, interpolate_uv, material_color, world_area};
+use crate::convert::bake::{FaceMaterial, bake_texture, face_materials, world_area};
 use crate::convert::least_squares::{self, BakeFit};
 use crate::mesh::scene::Scene;
 use crate::mesh::topology::Topology;
@@ -127,6 +132,18 @@ impl ResolutionRule {
     }
 }
 
+/// How long the phases of choosing the face resolutions took ([`face_resolutions_phased`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RulePhases {
+    /// A budget's calibration: the whole mesh baked and fitted at each uniform `R` it measures.
+    pub calibrate: Duration,
+    /// Each face's error at each `R` (the predictions; for an error bound or texel density,
+    /// the whole choice).
+    pub predict: Duration,
+    /// A budget's allocations, and its refinement rounds (bake, fit and measure each).
+    pub allocate: Duration,
+}
+
 /// Each face's resolution under `rule` (`face_count` faces of `mesh`).
 /// A budget's allocation predicts the error of the bake `fit` will make (module docs).
 pub fn face_resolutions(
@@ -135,6 +152,32 @@ pub fn face_resolutions(
     face_count: usize,
     rule: ResolutionRule,
     fit: BakeFit,
+) -> Vec<Resolution> {
+    face_resolutions_phased(mesh, scene, face_count, rule, fit, &mut RulePhases::default())
+}
+
+/// [`face_resolutions`], recording how long each phase took in `phases`.
+pub fn face_resolutions_phased(
+    mesh: &WeldedMesh,
+    scene: &Scene,
+    face_count: usize,
+    rule: ResolutionRule,
+    fit: BakeFit,
+    phases: &mut RulePhases,
+) -> Vec<Resolution> {
+    let started = Instant::now();
+    let resolutions = choose_resolutions(mesh, scene, face_count, rule, fit, phases);
+    phases.predict += started.elapsed().saturating_sub(phases.calibrate + phases.allocate);
+    resolutions
+}
+
+fn choose_resolutions(
+    mesh: &WeldedMesh,
+    scene: &Scene,
+    face_count: usize,
+    rule: ResolutionRule,
+    fit: BakeFit,
+    phases: &mut RulePhases,
 ) -> Vec<Resolution> {
     if let ResolutionRule::Uniform(r) = rule {
         return vec![r; face_count];
@@ -145,11 +188,18 @@ pub fn face_resolutions(
         return vec![Resolution::ONE; face_count];
     }
     if let ResolutionRule::Budget { samples, max } = rule {
-        let faces = Faces { mesh, materials: &materials, shared: &shared, pyramids: &pyramids, max };
+        let faces = Faces::new(mesh, &materials, &shared, &pyramids, max);
         // The calibration stores are dropped before the refinement allocates its own.
-        let mut distortion = faces.predicted_distortions(&calibration_stores(mesh, scene, samples, max, fit));
+        let started = Instant::now();
+        let calibration = calibration_stores(mesh, scene, samples, max, fit);
+        phases.calibrate = started.elapsed();
+        let mut distortion = faces.predicted_distortions(&calibration);
+        drop(calibration);
+        let started = Instant::now();
         let first = allocate_budget(mesh, &distortion, samples, max);
-        return refine_allocation(&faces, scene, &mut distortion, first, samples, fit);
+        let resolutions = refine_allocation(&faces, scene, &mut distortion, first, samples, fit);
+        phases.allocate = started.elapsed();
+        return resolutions;
     }
     let material_boundary = if matches!(rule, ResolutionRule::WhereTextured(_)) {
         faces_on_material_boundaries(mesh, face_count)
@@ -175,7 +225,7 @@ pub fn face_resolutions(
                 | ResolutionRule::Budget { max: r, .. } => r,
                 ResolutionRule::TexelDensity { max } => power_of_two_at_least(material.longest_uv_edge_texels, max),
                 ResolutionRule::ErrorBound { bound, max } => {
-                    let fit = FaceFit::new(&materials, face, shared[face], &pyramids, uvs, max);
+                    let fit = FaceFit::new(&materials, face, shared[face], &pyramids, uvs, max, None);
                     (0..=max.log2())
                         .filter_map(|log2| Resolution::from_log2(log2).ok())
                         .find(|&r| fit.error(r) <= bound.max(ROUNDING))
@@ -218,14 +268,43 @@ struct Faces<'a> {
     shared: &'a [SharedUvs],
     pyramids: &'a [Option<crate::convert::bake::TexturePyramid>],
     max: Resolution,
+    /// Each face's test points at its `dense` lattice, kept between the rounds that measure
+    /// every face again when they fit in [`FIT_CACHE_BYTES`] (else empty: each round computes
+    /// them again).
+    cache: Vec<Option<Vec<TestPoint>>>,
 }
 
+/// Bytes of test points [`Faces`] keeps between rounds, counted before they are computed.
+const FIT_CACHE_BYTES: u64 = 512 << 20;
+
 impl<'a> Faces<'a> {
+    fn new(
+        mesh: &'a WeldedMesh,
+        materials: &'a [FaceMaterial],
+        shared: &'a [SharedUvs],
+        pyramids: &'a [Option<crate::convert::bake::TexturePyramid>],
+        max: Resolution,
+    ) -> Self {
+        let mut faces = Faces { mesh, materials, shared, pyramids, max, cache: Vec::new() };
+        let bytes: u64 = materials
+            .iter()
+            .filter(|material| material.texture.is_some())
+            .map(|material| u64::from(dense_lattice(material, max)).pow(2) * std::mem::size_of::<TestPoint>() as u64)
+            .sum();
+        if bytes <= FIT_CACHE_BYTES {
+            let cache =
+                (0..materials.len()).into_par_iter().map(|face| faces.fit(face).map(FaceFit::into_points)).collect();
+            faces.cache = cache;
+        }
+        faces
+    }
+
     /// Face `face`'s test points and texture; `None` for a face without a texture.
-    fn fit(&self, face: usize) -> Option<FaceFit<'a>> {
+    fn fit(&self, face: usize) -> Option<FaceFit<'_>> {
         self.materials.get(face)?.texture?;
         let uvs = self.mesh.corner_uvs.get(face).copied().unwrap_or([[0.0; 2]; 3]);
-        Some(FaceFit::new(self.materials, face, *self.shared.get(face)?, self.pyramids, uvs, self.max))
+        let cached = self.cache.get(face).and_then(Option::as_deref);
+        Some(FaceFit::new(self.materials, face, *self.shared.get(face)?, self.pyramids, uvs, self.max, cached))
     }
 
     /// The distortion the allocation weighs: error² × the face's world area (zero at or
@@ -487,7 +566,7 @@ pub fn bake_and_verify(
     if shared.len() != face_count {
         return 0;
     }
-    let faces = Faces { mesh, materials: &materials, shared: &shared, pyramids: &pyramids, max };
+    let faces = Faces::new(mesh, &materials, &shared, &pyramids, max);
     let mut rounds = 0;
     loop {
         rounds += 1;
@@ -518,224 +597,4 @@ fn power_of_two_at_least(x: f32, max: Resolution) -> Resolution {
     let wanted = if x.is_finite() && x > 1.0 { x.ceil() as u64 } else { 1 };
     let log2 = wanted.next_power_of_two().trailing_zeros().min(max.log2());
     Resolution::from_log2(log2).unwrap_or(max)
-}
-
-/// Where a face's shared samples are baked: the UVs and material of each element's owner
-/// face (the lowest face id containing it, as [`bake_texture`] bakes), in this face's
-/// orientation — across a UV seam the owner maps the element to other texels.
-#[derive(Debug, Clone, Copy)]
-struct SharedUvs {
-    /// Per corner: the owner's UV at that vertex and the owner face.
-    corners: [([f32; 2], usize); 3],
-    /// Per face edge k (corner k → k + 1): the owner's UVs at both ends and the owner face.
-    edges: [([f32; 2], [f32; 2], usize); 3],
-}
-
-/// The [`SharedUvs`] of every face of `mesh`.
-fn shared_uvs(mesh: &WeldedMesh) -> Vec<SharedUvs> {
-    let mut vertex_owner = vec![usize::MAX; mesh.positions_world.len()];
-    let mut edge_owner = std::collections::HashMap::new();
-    for (face, t) in mesh.triangles.iter().enumerate() {
-        for k in 0..3 {
-            if let Some(owner) = vertex_owner.get_mut(t[k] as usize) {
-                *owner = (*owner).min(face);
-            }
-            let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
-            edge_owner.entry((a, b)).or_insert(face);
-        }
-    }
-    let uv_of = |face: usize, vertex: u32| -> [f32; 2] {
-        let (Some(t), Some(uvs)) = (mesh.triangles.get(face), mesh.corner_uvs.get(face)) else { return [0.0; 2] };
-        t.iter().position(|&v| v == vertex).map_or([0.0; 2], |k| uvs[k])
-    };
-    mesh.triangles
-        .iter()
-        .enumerate()
-        .map(|(face, t)| {
-            let corners = [0, 1, 2].map(|k| {
-                let owner = vertex_owner.get(t[k] as usize).copied().filter(|&o| o != usize::MAX).unwrap_or(face);
-                (uv_of(owner, t[k]), owner)
-            });
-            let edges = [0, 1, 2].map(|k| {
-                let (start, end) = (t[k], t[(k + 1) % 3]);
-                let owner = edge_owner.get(&(start.min(end), start.max(end))).copied().unwrap_or(face);
-                (uv_of(owner, start), uv_of(owner, end), owner)
-            });
-            SharedUvs { corners, edges }
-        })
-        .collect()
-}
-
-/// One face's texture and test points, for [`FaceFit::error`].
-struct FaceFit<'a> {
-    /// Every face's material (shared samples use their owner's).
-    materials: &'a [FaceMaterial],
-    shared: SharedUvs,
-    material: &'a FaceMaterial,
-    pyramids: &'a [Option<crate::convert::bake::TexturePyramid>],
-    uvs: [[f32; 2]; 3],
-    /// The test lattice from the texture alone: twice the face's longest UV edge in
-    /// texels (a power of two), at least 8, at most `2·max`.
-    dense: u32,
-    /// Barycentrics of the test points of `dense` and the truth there, encoded as
-    /// [`difference`] compares it ([`encoded`]).
-    points: Vec<([f32; 3], Rgba)>,
-}
-
-impl<'a> FaceFit<'a> {
-    fn new(
-        materials: &'a [FaceMaterial],
-        face: usize,
-        shared: SharedUvs,
-        pyramids: &'a [Option<crate::convert::bake::TexturePyramid>],
-        uvs: [[f32; 2]; 3],
-        max: Resolution,
-    ) -> Self {
-        let material = &materials[face];
-        let texels = power_of_two_at_least(material.longest_uv_edge_texels, Resolution::MAX).get();
-        let dense = (2 * texels).clamp(8, 2 * max.get());
-        let mut fit = FaceFit { materials, shared, material, pyramids, uvs, dense, points: Vec::new() };
-        fit.points = fit.test_points(dense);
-        fit
-    }
-
-    /// The test points for a face shown at `r`: those of `dense`, or of `2·r` when that is
-    /// finer, so that every strip of one sample spacing along an edge holds test points.
-    /// (With the texture's lattice alone, a face under one texel gets `D = 8`, whose
-    /// centroids lie at least 1/24 of the face from each edge, and at `R ≥ 32` the strip
-    /// where a UV seam's foreign edge colours fade out — 1/R wide — held none: the fit
-    /// saw no error there, random points did, docs/ADAPTIVE.md.)
-    fn points_for(&self, r: Resolution) -> std::borrow::Cow<'_, [([f32; 3], Rgba)]> {
-        let wanted = 2 * r.get();
-        if wanted <= self.dense {
-            std::borrow::Cow::Borrowed(&self.points)
-        } else {
-            std::borrow::Cow::Owned(self.test_points(wanted))
-        }
-    }
-
-    /// The centroids of the `dense²` sub-triangles of a lattice `dense` and the truth there
-    /// (the texture's level 0 read bilinearly, times the factor), [`encoded`] once here
-    /// rather than at every resolution a face is tried at.
-    fn test_points(&self, dense: u32) -> Vec<([f32; 3], Rgba)> {
-        let material = self.material;
-        let level0 = material
-            .texture
-            .and_then(|t| self.pyramids.get(t))
-            .and_then(Option::as_ref)
-            .and_then(|p| p.levels().first());
-        layout::sub_triangle_centroids(dense)
-            .map(|bary| {
-                let uv = interpolate_uv(self.uvs, bary);
-                let texel = level0.map_or([1.0; 4], |level| level.sample_bilinear(uv));
-                (bary, encoded(std::array::from_fn(|c| material.factor[c] * texel[c])))
-            })
-            .collect()
-    }
-
-    /// The error (module docs) of the colours `shown` returns at the test points of a face
-    /// shown at `r`.
-    fn error_of(&self, r: Resolution, shown: impl Fn([f32; 3]) -> Rgba) -> f32 {
-        let points = self.points_for(r);
-        let mut sum = 0.0f64;
-        for (bary, truth) in points.iter() {
-            sum += difference(shown(*bary), *truth);
-        }
-        (sum / (4 * points.len().max(1)) as f64).sqrt() as f32
-    }
-
-    /// The colour baked at lattice point `(i, j)` of resolution `res`: corners and edge
-    /// points from their owner's UVs and material, interior points from the face's own.
-    fn lattice_color(&self, i: u32, j: u32, res: u32) -> Rgba {
-        let n = res as f32;
-        let owner = |face: usize| self.materials.get(face).unwrap_or(self.material);
-        let lerp = |a: [f32; 2], b: [f32; 2], t: f32| [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
-        let corner = match (i, j) {
-            (0, 0) => Some(0),
-            (i, 0) if i == res => Some(1),
-            (0, j) if j == res => Some(2),
-            _ => None,
-        };
-        if let Some(k) = corner {
-            let (uv, face) = self.shared.corners[k];
-            return material_color(owner(face), self.pyramids, uv, res);
-        }
-        let edge = if j == 0 {
-            Some((0, i as f32 / n))
-        } else if i + j == res {
-            Some((1, j as f32 / n))
-        } else if i == 0 {
-            Some((2, (res - j) as f32 / n))
-        } else {
-            None
-        };
-        if let Some((k, t)) = edge {
-            let (start, end, face) = self.shared.edges[k];
-            return material_color(owner(face), self.pyramids, lerp(start, end, t), res);
-        }
-        let bary = [(n - i as f32 - j as f32) / n, i as f32 / n, j as f32 / n];
-        material_color(self.material, self.pyramids, interpolate_uv(self.uvs, bary), res)
-    }
-
-    /// The error (module docs) of face `face` at each `R = 2^l` up to `max` that a budget
-    /// allocation predicts: measured on the calibration store of that level where there is
-    /// one; above the finest calibrated level, the point bake's error scaled by the gain the
-    /// fit made there; the point bake's error where nothing is calibrated.
-    fn predicted_errors(&self, face: u32, max: Resolution, calibration: &[Option<ColorStore>]) -> Vec<f32> {
-        let resolutions: Vec<Resolution> = (0..=max.log2()).map(|l| Resolution::from_log2(l).unwrap_or(max)).collect();
-        let measured = |l: usize| {
-            let store = calibration.get(l)?.as_ref()?;
-            Some(self.error_of(resolutions[l], |bary| sample(store, face, bary, Filter::Linear, 0).unwrap_or([0.0; 4])))
-        };
-        let mut gain = 1.0;
-        let mut errors = Vec::with_capacity(resolutions.len());
-        for (l, &r) in resolutions.iter().enumerate() {
-            match measured(l) {
-                Some(error) => {
-                    let point = self.error(r);
-                    gain = if point > ROUNDING { error / point } else { 1.0 };
-                    errors.push(error);
-                }
-                None => errors.push(gain * self.error(r)),
-            }
-        }
-        errors
-    }
-
-    /// The error (module docs) of the face alone, baked and reconstructed at `r`.
-    fn error(&self, r: Resolution) -> f32 {
-        let res = r.get();
-        let row = |j: u32| (j * (2 * res + 3 - j) / 2) as usize;
-        let mut lattice = Vec::with_capacity(((res + 1) * (res + 2) / 2) as usize);
-        for j in 0..=res {
-            for i in 0..=res - j {
-                lattice.push(self.lattice_color(i, j, res));
-            }
-        }
-        let points = self.points_for(r);
-        let mut sum = 0.0f64;
-        for (bary, truth) in points.iter() {
-            let mut shown = [0.0f32; 4];
-            for s in layout::linear_samples(r, *bary) {
-                let color = lattice[row(s.j) + s.i as usize];
-                for c in 0..4 {
-                    shown[c] += s.weight * color[c];
-                }
-            }
-            sum += difference(shown, *truth);
-        }
-        (sum / (4 * points.len().max(1)) as f64).sqrt() as f32
-    }
-}
-
-/// A colour as the error compares it: RGB sRGB-encoded (module docs), alpha as is.
-fn encoded(color: Rgba) -> Rgba {
-    [linear_to_srgb(color[0]), linear_to_srgb(color[1]), linear_to_srgb(color[2]), color[3]]
-}
-
-/// Squared differences summed over the channels of `shown` [`encoded`] and `truth`, already
-/// encoded.
-fn difference(shown: Rgba, truth: Rgba) -> f64 {
-    let shown = encoded(shown);
-    (0..4).map(|c| f64::from(shown[c] - truth[c]).powi(2)).sum()
 }

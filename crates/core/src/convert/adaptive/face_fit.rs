@@ -1,0 +1,307 @@
+//! One face's error at a resolution (the metric of the module docs in [`super`]): its test
+//! points and the truth there, the face alone baked and reconstructed at `R`, or as a store
+//! shows it.
+
+use crate::colors::format::{Rgba, linear_to_srgb_table};
+use crate::colors::layout::{self, Resolution};
+use crate::colors::store::ColorStore;
+use crate::convert::bake::{FaceMaterial, interpolate_uv, material_color};
+use crate::mesh::weld::WeldedMesh;
+use crate::packing::sampler::{Filter, sample};
+
+use super::{ROUNDING, power_of_two_at_least};
+
+/// A test point's barycentrics and the truth there, [`encoded`].
+pub(super) type TestPoint = ([f32; 3], Rgba);
+
+/// Where a face's shared samples are baked: the UVs and material of each element's owner
+/// face (the lowest face id containing it, as [`bake_texture`] bakes), in this face's
+/// orientation — across a UV seam the owner maps the element to other texels.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct SharedUvs {
+    /// Per corner: the owner's UV at that vertex and the owner face.
+    corners: [([f32; 2], usize); 3],
+    /// Per face edge k (corner k → k + 1): the owner's UVs at both ends and the owner face.
+    edges: [([f32; 2], [f32; 2], usize); 3],
+}
+
+/// The [`SharedUvs`] of every face of `mesh`.
+pub(super) fn shared_uvs(mesh: &WeldedMesh) -> Vec<SharedUvs> {
+    let mut vertex_owner = vec![usize::MAX; mesh.positions_world.len()];
+    let mut edge_owner = std::collections::HashMap::new();
+    for (face, t) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            if let Some(owner) = vertex_owner.get_mut(t[k] as usize) {
+                *owner = (*owner).min(face);
+            }
+            let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+            edge_owner.entry((a, b)).or_insert(face);
+        }
+    }
+    let uv_of = |face: usize, vertex: u32| -> [f32; 2] {
+        let (Some(t), Some(uvs)) = (mesh.triangles.get(face), mesh.corner_uvs.get(face)) else { return [0.0; 2] };
+        t.iter().position(|&v| v == vertex).map_or([0.0; 2], |k| uvs[k])
+    };
+    mesh.triangles
+        .iter()
+        .enumerate()
+        .map(|(face, t)| {
+            let corners = [0, 1, 2].map(|k| {
+                let owner = vertex_owner.get(t[k] as usize).copied().filter(|&o| o != usize::MAX).unwrap_or(face);
+                (uv_of(owner, t[k]), owner)
+            });
+            let edges = [0, 1, 2].map(|k| {
+                let (start, end) = (t[k], t[(k + 1) % 3]);
+                let owner = edge_owner.get(&(start.min(end), start.max(end))).copied().unwrap_or(face);
+                (uv_of(owner, start), uv_of(owner, end), owner)
+            });
+            SharedUvs { corners, edges }
+        })
+        .collect()
+}
+
+/// One face's texture and test points, for [`FaceFit::error`].
+pub(super) struct FaceFit<'a> {
+    /// Every face's material (shared samples use their owner's).
+    materials: &'a [FaceMaterial],
+    shared: SharedUvs,
+    material: &'a FaceMaterial,
+    pyramids: &'a [Option<crate::convert::bake::TexturePyramid>],
+    uvs: [[f32; 2]; 3],
+    /// The test lattice from the texture alone: twice the face's longest UV edge in
+    /// texels (a power of two), at least 8, at most `2·max`.
+    dense: u32,
+    /// Barycentrics of the test points of `dense` and the truth there, encoded as
+    /// [`difference`] compares it ([`encoded`]).
+    points: std::borrow::Cow<'a, [TestPoint]>,
+}
+
+/// The test lattice of a face of `material` from the texture alone: twice its longest UV
+/// edge in texels (a power of two), at least 8, at most `2·max`.
+pub(super) fn dense_lattice(material: &FaceMaterial, max: Resolution) -> u32 {
+    let texels = power_of_two_at_least(material.longest_uv_edge_texels, Resolution::MAX).get();
+    (2 * texels).clamp(8, 2 * max.get())
+}
+
+impl<'a> FaceFit<'a> {
+    /// The test points of the `dense` lattice, to give a later fit of the same face.
+    pub(super) fn into_points(self) -> Vec<TestPoint> {
+        self.points.into_owned()
+    }
+
+    /// The fit of face `face`; its test points are `points` when given (computed for the
+    /// same face by an earlier fit), else computed here.
+    pub(super) fn new(
+        materials: &'a [FaceMaterial],
+        face: usize,
+        shared: SharedUvs,
+        pyramids: &'a [Option<crate::convert::bake::TexturePyramid>],
+        uvs: [[f32; 2]; 3],
+        max: Resolution,
+        points: Option<&'a [TestPoint]>,
+    ) -> Self {
+        let material = &materials[face];
+        let dense = dense_lattice(material, max);
+        let mut fit = FaceFit {
+            materials,
+            shared,
+            material,
+            pyramids,
+            uvs,
+            dense,
+            points: std::borrow::Cow::Borrowed(points.unwrap_or_default()),
+        };
+        if points.is_none() {
+            fit.points = std::borrow::Cow::Owned(fit.test_points(dense));
+        }
+        fit
+    }
+
+    /// The test points for a face shown at `r`: those of `dense`; when `2·r` is finer, every
+    /// strip one sample spacing (`1/r`) wide along an edge needs the finer lattice (with the
+    /// texture's lattice alone, a face under one texel gets `D = 8`, whose centroids lie at
+    /// least 1/24 of the face from each edge, and at `R ≥ 32` the strip where a UV seam's
+    /// foreign edge colours fade out — 1/R wide — held none: the fit saw no error there,
+    /// random points did, docs/ADAPTIVE.md). Then the strips get the centroids of lattice
+    /// `2·r` that lie in them (the strips' borders are lines of that lattice, so its
+    /// sub-triangles are wholly in or out) and the inside the centroids of `dense` that lie
+    /// in it, each part weighted by its share of the face's area: `O(r)` points for the
+    /// strips where the whole lattice `2·r` took `O(r²)`.
+    fn points_for(&self, r: Resolution) -> TestPoints<'_> {
+        let fine = 2 * r.get();
+        if fine <= self.dense {
+            return TestPoints { parts: vec![(std::borrow::Cow::Borrowed(&self.points[..]), 1.0)] };
+        }
+        let n = fine as f32;
+        // Strip: the smallest lattice coordinate of the centroid below 2 (one spacing of `r`).
+        let strip: Vec<[f32; 3]> = layout::sub_triangle_centroids(fine)
+            .filter(|bary| bary.iter().fold(f32::MAX, |m, &b| m.min(b)) * n < 2.0)
+            .collect();
+        let inside: Vec<TestPoint> = self
+            .points
+            .iter()
+            .filter(|(bary, _)| bary.iter().fold(f32::MAX, |m, &b| m.min(b)) * n >= 2.0)
+            .copied()
+            .collect();
+        let strip_share = strip.len() as f64 / f64::from(fine).powi(2);
+        if inside.is_empty() || strip_share >= 1.0 {
+            return TestPoints {
+                parts: vec![(std::borrow::Cow::Owned(self.truth_at(layout::sub_triangle_centroids(fine))), 1.0)],
+            };
+        }
+        let inside_share = 1.0 - strip_share;
+        let strip_points = self.truth_at(strip.into_iter());
+        let (strip_weight, inside_weight) =
+            (strip_share / strip_points.len() as f64, inside_share / inside.len() as f64);
+        TestPoints {
+            parts: vec![
+                (std::borrow::Cow::Owned(strip_points), strip_weight),
+                (std::borrow::Cow::Owned(inside), inside_weight),
+            ],
+        }
+    }
+
+    /// The centroids of the `dense²` sub-triangles of a lattice `dense` and the truth there
+    /// (the texture's level 0 read bilinearly, times the factor), [`encoded`] once here
+    /// rather than at every resolution a face is tried at.
+    fn test_points(&self, dense: u32) -> Vec<TestPoint> {
+        self.truth_at(layout::sub_triangle_centroids(dense))
+    }
+
+    /// The truth at `points` (the texture's level 0 read bilinearly, times the factor),
+    /// [`encoded`].
+    fn truth_at(&self, points: impl Iterator<Item = [f32; 3]>) -> Vec<TestPoint> {
+        let material = self.material;
+        let level0 = material
+            .texture
+            .and_then(|t| self.pyramids.get(t))
+            .and_then(Option::as_ref)
+            .and_then(|p| p.levels().first());
+        points
+            .map(|bary| {
+                let uv = interpolate_uv(self.uvs, bary);
+                let texel = level0.map_or([1.0; 4], |level| level.sample_bilinear(uv));
+                (bary, encoded(std::array::from_fn(|c| material.factor[c] * texel[c])))
+            })
+            .collect()
+    }
+
+    /// The error (module docs) of the colours `shown` returns at the test points of a face
+    /// shown at `r`.
+    pub(super) fn error_of(&self, r: Resolution, shown: impl Fn([f32; 3]) -> Rgba) -> f32 {
+        self.points_for(r).rms(|bary, truth| difference(shown(bary), truth))
+    }
+
+    /// The colour baked at lattice point `(i, j)` of resolution `res`: corners and edge
+    /// points from their owner's UVs and material, interior points from the face's own.
+    fn lattice_color(&self, i: u32, j: u32, res: u32) -> Rgba {
+        let n = res as f32;
+        let owner = |face: usize| self.materials.get(face).unwrap_or(self.material);
+        let lerp = |a: [f32; 2], b: [f32; 2], t: f32| [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
+        let corner = match (i, j) {
+            (0, 0) => Some(0),
+            (i, 0) if i == res => Some(1),
+            (0, j) if j == res => Some(2),
+            _ => None,
+        };
+        if let Some(k) = corner {
+            let (uv, face) = self.shared.corners[k];
+            return material_color(owner(face), self.pyramids, uv, res);
+        }
+        let edge = if j == 0 {
+            Some((0, i as f32 / n))
+        } else if i + j == res {
+            Some((1, j as f32 / n))
+        } else if i == 0 {
+            Some((2, (res - j) as f32 / n))
+        } else {
+            None
+        };
+        if let Some((k, t)) = edge {
+            let (start, end, face) = self.shared.edges[k];
+            return material_color(owner(face), self.pyramids, lerp(start, end, t), res);
+        }
+        let bary = [(n - i as f32 - j as f32) / n, i as f32 / n, j as f32 / n];
+        material_color(self.material, self.pyramids, interpolate_uv(self.uvs, bary), res)
+    }
+
+    /// The error (module docs) of face `face` at each `R = 2^l` up to `max` that a budget
+    /// allocation predicts: measured on the calibration store of that level where there is
+    /// one; above the finest calibrated level, the point bake's error scaled by the gain the
+    /// fit made there; the point bake's error where nothing is calibrated.
+    pub(super) fn predicted_errors(&self, face: u32, max: Resolution, calibration: &[Option<ColorStore>]) -> Vec<f32> {
+        let resolutions: Vec<Resolution> = (0..=max.log2()).map(|l| Resolution::from_log2(l).unwrap_or(max)).collect();
+        let measured = |l: usize| {
+            let store = calibration.get(l)?.as_ref()?;
+            Some(self.error_of(resolutions[l], |bary| sample(store, face, bary, Filter::Linear, 0).unwrap_or([0.0; 4])))
+        };
+        let mut gain = 1.0;
+        let mut errors = Vec::with_capacity(resolutions.len());
+        for (l, &r) in resolutions.iter().enumerate() {
+            match measured(l) {
+                Some(error) => {
+                    let point = self.error(r);
+                    gain = if point > ROUNDING { error / point } else { 1.0 };
+                    errors.push(error);
+                }
+                None => errors.push(gain * self.error(r)),
+            }
+        }
+        errors
+    }
+
+    /// The error (module docs) of the face alone, baked and reconstructed at `r`.
+    pub(super) fn error(&self, r: Resolution) -> f32 {
+        let res = r.get();
+        let row = |j: u32| (j * (2 * res + 3 - j) / 2) as usize;
+        let mut lattice = Vec::with_capacity(((res + 1) * (res + 2) / 2) as usize);
+        for j in 0..=res {
+            for i in 0..=res - j {
+                lattice.push(self.lattice_color(i, j, res));
+            }
+        }
+        self.points_for(r).rms(|bary, truth| {
+            let mut shown = [0.0f32; 4];
+            for s in layout::linear_samples(r, bary) {
+                let color = lattice[row(s.j) + s.i as usize];
+                for c in 0..4 {
+                    shown[c] += s.weight * color[c];
+                }
+            }
+            difference(shown, truth)
+        })
+    }
+}
+
+/// Test points in parts, each with the weight of one of its points (the weights sum to 1
+/// over all points: an area quadrature of the face).
+struct TestPoints<'a> {
+    parts: Vec<(std::borrow::Cow<'a, [TestPoint]>, f64)>,
+}
+
+impl TestPoints<'_> {
+    /// The root of the weighted mean of `squared(bary, truth)` (summed over the four
+    /// channels) per channel.
+    fn rms(&self, squared: impl Fn([f32; 3], Rgba) -> f64) -> f32 {
+        let (mut sum, mut weights) = (0.0f64, 0.0f64);
+        for (points, weight) in &self.parts {
+            let part: f64 = points.iter().map(|(bary, truth)| squared(*bary, *truth)).sum();
+            sum += part * weight;
+            weights += weight * points.len() as f64;
+        }
+        (sum / (4.0 * weights.max(f64::MIN_POSITIVE))).sqrt() as f32
+    }
+}
+
+/// A colour as the error compares it: RGB sRGB-encoded (module docs; by the table, within
+/// 2·10⁻⁷ of the formula), alpha as is.
+fn encoded(color: Rgba) -> Rgba {
+    [linear_to_srgb_table(color[0]), linear_to_srgb_table(color[1]), linear_to_srgb_table(color[2]), color[3]]
+}
+
+/// Squared differences summed over the channels of `shown` [`encoded`] and `truth`, already
+/// encoded.
+fn difference(shown: Rgba, truth: Rgba) -> f64 {
+    let shown = encoded(shown);
+    (0..4).map(|c| f64::from(shown[c] - truth[c]).powi(2)).sum()
+}
