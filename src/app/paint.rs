@@ -20,7 +20,9 @@ use meshpaint_core::colors::layout::Resolution;
 use meshpaint_core::colors::store::{ColorStore, DirtyAccumulator};
 use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::packing::paint_layout::PaintLayout;
-use meshpaint_core::paint::brush::{self, BrushRadius, BrushSettings, FillScope, PaintView, Painter, StrokeUpdate};
+use meshpaint_core::paint::brush::{
+    self, BrushRadius, BrushSettings, FillScope, PaintView, Painter, StrokePoint, StrokeUpdate,
+};
 use meshpaint_core::paint::optimize;
 use meshpaint_core::paint::undo::{StepSummary, UndoHistory};
 use meshpaint_render::Gpu;
@@ -226,9 +228,10 @@ impl DocumentState {
         }
     }
 
-    /// Starts a stroke at `pos` (points).
+    /// Starts a stroke at `pos` (points). The pointer is a mouse: full pressure (winit has no
+    /// tablet pressure yet).
     pub fn begin_stroke(&mut self, ctx: &mut PaintContext<'_>, pos: egui::Pos2) {
-        let px = ctx.viewport.view_px(pos);
+        let px = StrokePoint::mouse(ctx.viewport.view_px(pos));
         let settings = *ctx.brush;
         if let Some(session) = self.paint.as_mut() {
             session.painter.set_settings(settings);
@@ -242,7 +245,7 @@ impl DocumentState {
 
     /// Extends the stroke to `pos` (points).
     pub fn stroke_to(&mut self, ctx: &mut PaintContext<'_>, pos: egui::Pos2) {
-        let px = ctx.viewport.view_px(pos);
+        let px = StrokePoint::mouse(ctx.viewport.view_px(pos));
         let result = self.with_paint(ctx, |view, store, painter, history| painter.stroke_to(view, store, history, px));
         self.stroke_result(ctx, result);
     }
