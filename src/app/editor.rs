@@ -407,7 +407,8 @@ impl Editor {
     /// The document and what paint mode's commands use besides it (split borrows).
     fn paint_parts(&mut self) -> (&mut DocumentState, PaintContext<'_>) {
         let Editor { gpu, document, camera, panels, viewport, status, jobs, .. } = self;
-        let ctx = PaintContext { gpu: gpu.as_ref(), camera, viewport, brush: &mut panels.paint.brush, status, jobs };
+        let (brush, recent_colors) = (&mut panels.paint.brush, &mut panels.paint.recent_colors);
+        let ctx = PaintContext { gpu: gpu.as_ref(), camera, viewport, brush, recent_colors, status, jobs };
         (document, ctx)
     }
 

@@ -30,6 +30,7 @@ use meshpaint_render::Gpu;
 use super::job_output::{JobOutput, Optimized};
 use super::jobs::{JobKind, Jobs};
 use super::paint_session::{Gesture, GestureKind, PaintSession, Repack, Repacked, STRENGTH_GESTURE_POINTS};
+use super::recent_colors::RecentColors;
 use super::session::DocumentState;
 use super::state::{Mode, Severity, Status, ViewportState};
 use super::text::{human_bytes, thousands};
@@ -45,6 +46,8 @@ pub struct PaintContext<'a> {
     pub viewport: &'a mut ViewportState,
     /// The brush settings (the paint panel's).
     pub brush: &'a mut BrushSettings,
+    /// The colours strokes painted with (the paint panel's row).
+    pub recent_colors: &'a mut RecentColors,
     /// The status line.
     pub status: &'a mut Status,
     /// Background work (repack, Optimize).
@@ -218,6 +221,11 @@ impl DocumentState {
                 }
                 if update.stats.samples_changed > 0 || update.stats.faces_resized > 0 {
                     self.edit_generation += 1;
+                }
+                // A colour counts as used once a stroke changed samples with it.
+                let painting = ctx.brush.tool == brush::Tool::Paint && ctx.brush.blend != brush::BlendMode::EraseToBase;
+                if painting && update.stats.samples_changed > 0 {
+                    ctx.recent_colors.push(ctx.brush.color);
                 }
             }
             Some(Err(error)) => {

@@ -147,7 +147,7 @@ pub(super) fn run(args: PaintArgs) -> Result<()> {
     let stroke =
         meshpaint_core::paint::brush::parse_stroke(&args.stroke).map_err(|e| anyhow::anyhow!("--stroke: {e}"))?;
     let color = meshpaint_core::paint::brush::parse_hex_color(&args.color)
-        .with_context(|| format!("--color '{}' is not #rrggbb", args.color))?;
+        .with_context(|| format!("--color '{}' is not #rrggbb or #rgb", args.color))?;
     args.camera.check()?;
     anyhow::ensure!(args.width > 0 && args.height > 0, "--width and --height must be positive");
     let settings = brush_settings(&args, color)?;

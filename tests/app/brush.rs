@@ -984,8 +984,12 @@ fn strokes_and_colours_parse() {
     assert_eq!(brush::parse_hex_color("#ffffff"), Some([1.0, 1.0, 1.0, 1.0]));
     let c = brush::parse_hex_color("808080").unwrap();
     assert!((c[0] - 0.21586).abs() < 1e-4, "{c:?}");
-    assert_eq!(brush::parse_hex_color("#12345"), None);
-    assert_eq!(brush::parse_hex_color("#gg0000"), None);
+    // `#rgb` doubles each digit; spaces around are ignored.
+    assert_eq!(brush::parse_hex_color("#f80"), brush::parse_hex_color("#ff8800"));
+    assert_eq!(brush::parse_hex_color(" ff8800 "), brush::parse_hex_color("#ff8800"));
+    for bad in ["#12345", "#gg0000", "#ff88", "", "#", "+f80", "#ff88000"] {
+        assert_eq!(brush::parse_hex_color(bad), None, "{bad:?}");
+    }
     for response in
         [PressureResponse::NONE, PressureResponse::default(), PressureResponse { radius: true, strength: true }]
     {

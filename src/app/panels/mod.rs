@@ -11,7 +11,7 @@
 //! | [`ImportSettings`] | `import_settings` (app level: the file dialog shows it too) | the resolution choice for opened meshes |
 //! | [`AutosavePanel`] | [`autosave`] | autosave settings, timer and recovery offer |
 //! | [`ViewPanel`] | [`view`] | view settings, the last PSNR |
-//! | [`PaintPanel`] | [`paint`] | the brush, the resolution of "Set R for all" |
+//! | [`PaintPanel`] | [`paint`] (the colour section: [`color`]) | the brush, the colour wheel and hex field, the recent colours, the resolution of "Set R for all" |
 //! | [`OptimizePanel`] | [`optimize`] | Optimize's error bound |
 //! | [`UndoPanel`] | [`undo`] | nothing (shows the document's history) |
 //! | [`ScenePanel`] | [`scene`] | "Redraw continuously" |
@@ -20,6 +20,7 @@
 //! | [`ViewportArea`] | [`viewport`] | nothing (the editor records its area) |
 
 pub mod autosave;
+pub mod color;
 pub mod file;
 pub mod help;
 pub mod menu;

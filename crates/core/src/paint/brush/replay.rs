@@ -13,13 +13,20 @@ use super::painter::{PaintView, Painter, StrokeUpdate};
 use super::scratch::{Scratch, accumulate_masks, face_elements, position};
 use super::settings::{Falloff, StrokePoint};
 
-/// Parses `#rrggbb` (or `rrggbb`) as an sRGB colour and returns it in linear light, opaque.
+/// Parses `#rrggbb` or `#rgb` (the `#` optional, surrounding spaces ignored) as an sRGB
+/// colour and returns it in linear light, opaque. `#rgb` is `#rrggbb` with each digit
+/// doubled (CSS).
 pub fn parse_hex_color(text: &str) -> Option<Rgba> {
+    let text = text.trim();
     let hex = text.strip_prefix('#').unwrap_or(text);
-    if hex.len() != 6 || !hex.is_ascii() {
+    if !hex.bytes().all(|b| b.is_ascii_hexdigit()) {
         return None;
     }
-    let channel = |k: usize| u8::from_str_radix(&hex[2 * k..2 * k + 2], 16).ok();
+    let channel = |k: usize| match hex.len() {
+        6 => u8::from_str_radix(&hex[2 * k..2 * k + 2], 16).ok(),
+        3 => u8::from_str_radix(&hex[k..k + 1], 16).ok().map(|d| d * 17),
+        _ => None,
+    };
     let (r, g, b) = (channel(0)?, channel(1)?, channel(2)?);
     Some([
         crate::colors::format::decode_srgb8(r),

@@ -1,0 +1,210 @@
+//! The everyday painting tools in the editor's UI without a window (egui_kittest, no GPU):
+//! the colour wheel, hex entry and recent colours, brush presets, the heat-map legend,
+//! the up axis and the settings remembered between runs. Truths are computed here
+//! independently: HSV by its textbook formulas, sRGB by IEC 61966-2-1.
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::{NodeT, Queryable};
+use meshpaint::app::Editor;
+use meshpaint_core::io::document::Source;
+
+const JOB_TIMEOUT: Duration = Duration::from_secs(60);
+/// Tall enough for the whole side panel (the paint section with its wheel, file, view).
+const SIZE: [f32; 2] = [1280.0, 1700.0];
+
+fn new_editor() -> Editor {
+    Editor::new(None, Arc::new(|| {}))
+}
+
+fn editor_with_duck() -> Editor {
+    let mut editor = new_editor();
+    editor.open(Source::BuiltIn);
+    assert!(editor.wait_for_job(JOB_TIMEOUT), "opening the Duck timed out");
+    assert!(editor.document.open.is_some(), "the Duck did not open: {:?}", editor.status);
+    editor
+}
+
+fn harness(editor: Editor) -> Harness<'static, Editor> {
+    Harness::builder().with_size(SIZE).build_ui_state(|ui, editor: &mut Editor| editor.ui(ui), editor)
+}
+
+/// sRGB-encoded value → linear (IEC 61966-2-1).
+fn linear(encoded: f32) -> f32 {
+    if encoded <= 0.04045 { encoded / 12.92 } else { ((encoded + 0.055) / 1.055).powf(2.4) }
+}
+
+fn click_at(harness: &mut Harness<'static, Editor>, pos: egui::Pos2) {
+    harness.event(egui::Event::PointerMoved(pos));
+    harness.run_steps(1);
+    for pressed in [true, false] {
+        harness.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+        harness.run_steps(1);
+    }
+    harness.run_steps(1);
+}
+
+fn brush_color(harness: &Harness<'static, Editor>) -> [f32; 4] {
+    harness.state().panels.paint.brush.color
+}
+
+fn assert_close(got: [f32; 4], want: [f32; 4], tolerance: f32, what: &str) {
+    for c in 0..4 {
+        assert!((got[c] - want[c]).abs() <= tolerance, "{what}: got {got:?}, want {want:?}");
+    }
+}
+
+/// Types `text` into the hex field and presses Enter.
+fn enter_hex(harness: &mut Harness<'static, Editor>, text: &str) {
+    harness.get_by_label("Hex").click();
+    harness.run_steps(1);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.run_steps(1);
+    harness.get_by_label("Hex").type_text(text);
+    harness.run_steps(1);
+    harness.key_press(egui::Key::Enter);
+    harness.run_steps(2);
+}
+
+/// The wheel is in the panel without opening anything; a click picks the hue at its angle
+/// (counter-clockwise from red at the right) and the saturation at its distance from the
+/// centre: HSV(120°, 0.9, 1) is sRGB (0.1, 1, 0.1), checked through the textbook formula.
+#[test]
+fn the_colour_wheel_is_always_there_and_picks_hue_and_saturation() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    let wheel = harness.get_by_label("Colour wheel").rect();
+    assert!(wheel.width() >= 100.0 && (wheel.width() - wheel.height()).abs() < 0.5, "{wheel:?}");
+    assert!(wheel.max.y < SIZE[1], "the wheel is off screen");
+    let radius = wheel.width() * 0.5;
+    for (degrees, want) in [(120.0f32, [0.1, 1.0, 0.1]), (0.0, [1.0, 0.1, 0.1]), (240.0, [0.1, 0.1, 1.0])] {
+        let angle = degrees.to_radians();
+        let pos = wheel.center() + egui::vec2(angle.cos(), -angle.sin()) * (0.9 * radius);
+        click_at(&mut harness, pos);
+        let want = [linear(want[0]), linear(want[1]), linear(want[2]), 1.0];
+        // The click lands within float rounding of 0.9 R: a saturation error of 1e-4 at most.
+        assert_close(brush_color(&harness), want, 2e-3, &format!("hue {degrees}°"));
+    }
+    // Brightness 0 makes black; the hue survives it.
+    harness.state_mut().panels.paint.brush.color = [0.0, 0.0, 0.0, 1.0];
+    harness.run_steps(2);
+    assert!(harness.query_all_by_value("#000000").next().is_some(), "the hex field does not follow the colour");
+}
+
+/// `#ff8800`, `ff8800` and `#f80` all give sRGB (255, 136, 0); an invalid entry shows a
+/// message and leaves the colour as it was.
+#[test]
+fn hex_entry_takes_three_spellings_and_refuses_the_rest() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    let orange = [1.0, linear(136.0 / 255.0), 0.0, 1.0];
+    for (text, start) in [("#ff8800", [0.0, 0.0, 1.0, 1.0]), ("ff8800", [0.0, 1.0, 0.0, 1.0]), ("#f80", [0.2; 4])] {
+        harness.state_mut().panels.paint.brush.color = start;
+        harness.run_steps(2);
+        enter_hex(&mut harness, text);
+        let alpha_kept = [orange[0], orange[1], orange[2], start[3]];
+        assert_close(brush_color(&harness), alpha_kept, 1e-6, text);
+        assert!(harness.state().panels.paint.picker.hex_error.is_none(), "{text}");
+        assert!(harness.query_all_by_value("#ff8800").next().is_some(), "{text}: the field does not show #ff8800");
+    }
+    for bad in ["#ff880", "orange", "#gg8800", "  "] {
+        let before = brush_color(&harness);
+        enter_hex(&mut harness, bad);
+        assert_eq!(brush_color(&harness), before, "{bad:?} changed the colour");
+        assert!(harness.query_by_label_contains("is not a colour").is_some(), "{bad:?}: no message");
+    }
+    enter_hex(&mut harness, "#00f");
+    assert!(harness.query_by_label_contains("is not a colour").is_none(), "the message stays after a valid entry");
+}
+
+/// Paints a short stroke across the middle of the 3D view.
+fn stroke(harness: &mut Harness<'static, Editor>, dy: f32) {
+    let center = harness.state().viewport.rect.center() + egui::vec2(0.0, dy);
+    let (from, to) = (center - egui::vec2(40.0, 0.0), center + egui::vec2(40.0, 0.0));
+    harness.event(egui::Event::PointerMoved(from));
+    harness.run_steps(1);
+    let button = |pos, pressed| egui::Event::PointerButton {
+        pos,
+        button: egui::PointerButton::Primary,
+        pressed,
+        modifiers: egui::Modifiers::NONE,
+    };
+    harness.event(button(from, true));
+    harness.run_steps(1);
+    for step in 1..=4 {
+        harness.event(egui::Event::PointerMoved(from + (to - from) * (step as f32 / 4.0)));
+        harness.run_steps(1);
+    }
+    harness.event(button(to, false));
+    harness.run_steps(2);
+}
+
+/// Only colours strokes painted with join the row, newest first and without repeats; a
+/// colour chosen but never painted with does not; clicking one picks it.
+#[test]
+fn recent_colours_are_the_colours_painted_with_and_pick_on_click() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    assert!(harness.query_by_label_contains("Recent colour #").is_none());
+    for hex in ["#ff0000", "#00ff00", "#ff0000", "#0000ff"] {
+        enter_hex(&mut harness, hex);
+        stroke(&mut harness, 0.0);
+    }
+    enter_hex(&mut harness, "#123456");
+    let recent: Vec<String> = harness
+        .state()
+        .panels
+        .paint
+        .recent_colors
+        .srgba8()
+        .iter()
+        .map(|&c| meshpaint::app::recent_colors::hex_of(c))
+        .collect();
+    assert_eq!(recent, ["#0000ff", "#ff0000", "#00ff00"]);
+    assert!(harness.query_by_label("Recent colour #123456").is_none(), "an unused colour is listed");
+    harness.get_by_label("Recent colour #00ff00").click();
+    harness.run_steps(2);
+    assert_eq!(brush_color(&harness), [0.0, 1.0, 0.0, 1.0]);
+}
+
+/// Every text the editor shows (paint mode, the wheel and the recent colours on screen, the
+/// help open) has its glyphs in the fonts egui ships: no missing-glyph boxes.
+#[test]
+fn every_label_has_its_glyphs_in_the_default_fonts() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    harness.key_press(egui::Key::Tab);
+    harness.run_steps(2);
+    stroke(&mut harness, 0.0);
+    harness.key_press(egui::Key::F1);
+    harness.run_steps(3);
+    let mut texts = Vec::new();
+    for node in harness.query_all_by(|_| true) {
+        let node = node.accesskit_node();
+        texts.extend(node.label());
+        texts.extend(node.value());
+    }
+    assert!(texts.len() > 100 && texts.iter().any(|t| t == "Colour wheel"), "{} texts", texts.len());
+    let ctx = harness.ctx.clone();
+    let font = egui::FontId::proportional(14.0);
+    let mono = egui::FontId::monospace(14.0);
+    // The check can fail: the clipboard emoji egui's own colour picker shows is missing.
+    assert!(!ctx.fonts_mut(|fonts| fonts.has_glyph(&font, '\u{1F4CB}')));
+    let missing: Vec<(String, char)> = ctx.fonts_mut(|fonts| {
+        texts
+            .iter()
+            .flat_map(|text| text.chars().map(move |c| (text.clone(), c)))
+            .filter(|(_, c)| !(c.is_control() || (fonts.has_glyph(&font, *c) && fonts.has_glyph(&mono, *c))))
+            .collect()
+    });
+    assert!(missing.is_empty(), "glyphs the fonts lack: {missing:?}");
+}
