@@ -208,3 +208,69 @@ fn every_label_has_its_glyphs_in_the_default_fonts() {
     });
     assert!(missing.is_empty(), "glyphs the fonts lack: {missing:?}");
 }
+
+// ---------------------------------------------------------------- brush presets
+
+/// The three defaults load their brushes (the colour stays); the current brush saves under
+/// a typed name, loads back after changes, updates in place under the same name, and
+/// deletes; an empty name is refused with a message.
+#[test]
+fn brush_presets_save_load_and_delete() {
+    use meshpaint_core::paint::brush::{BrushRadius, Falloff, Tool};
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    let color = [0.3, 0.2, 0.1, 1.0];
+    harness.state_mut().panels.paint.brush.color = color;
+    harness.run_steps(1);
+    harness.get_by_label("Soft airbrush").click();
+    harness.run_steps(2);
+    let brush = harness.state().panels.paint.brush;
+    assert_eq!((brush.tool, brush.falloff, brush.strength), (Tool::Paint, Falloff::Smooth, 0.15));
+    assert_eq!(brush.radius, BrushRadius::Pixels { radius_px: 60.0 });
+    assert_eq!(brush.color, color, "loading a preset changed the colour");
+    harness.get_by_label("Blur brush").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().panels.paint.brush.tool, Tool::Blur);
+    harness.get_by_label("Hard round").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().panels.paint.brush.falloff, Falloff::Constant);
+
+    // Save the current brush, change it, load it back.
+    harness.state_mut().panels.paint.brush.strength = 0.42;
+    harness.run_steps(1);
+    harness.get_by_label("Name").click();
+    harness.run_steps(1);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_label("Name").type_text("Glaze");
+    harness.run_steps(1);
+    harness.get_by_label("Save preset").click();
+    harness.run_steps(2);
+    assert!(harness.query_by_label("Saved \"Glaze\".").is_some());
+    let saved = harness.state().panels.paint.brush;
+    harness.state_mut().panels.paint.brush.strength = 0.9;
+    harness.state_mut().panels.paint.brush.mirror_x = true;
+    harness.run_steps(1);
+    harness.get_by_label("Glaze").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().panels.paint.brush, saved);
+    // Same name: updated in place, not added twice.
+    harness.state_mut().panels.paint.brush.strength = 0.5;
+    harness.run_steps(1);
+    harness.get_by_label("Save preset").click();
+    harness.run_steps(2);
+    let names: Vec<String> =
+        harness.state().panels.paint.presets.presets.list().iter().map(|p| p.name.clone()).collect();
+    assert_eq!(names, ["Hard round", "Soft airbrush", "Blur brush", "Glaze"]);
+    assert_eq!(harness.state().panels.paint.presets.presets.get("Glaze").unwrap().brush.strength, 0.5);
+    harness.get_by_label("Delete preset").click();
+    harness.run_steps(2);
+    assert!(harness.query_by_label("Glaze").is_none());
+    assert!(harness.state().panels.paint.presets.presets.get("Glaze").is_none());
+    // An empty name.
+    harness.state_mut().panels.paint.presets.name = "  ".into();
+    harness.run_steps(1);
+    harness.get_by_label("Save preset").click();
+    harness.run_steps(2);
+    assert!(harness.query_by_label_contains("Type a name").is_some());
+    assert_eq!(harness.state().panels.paint.presets.presets.list().len(), 3);
+}

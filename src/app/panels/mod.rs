@@ -11,7 +11,7 @@
 //! | [`ImportSettings`] | `import_settings` (app level: the file dialog shows it too) | the resolution choice for opened meshes |
 //! | [`AutosavePanel`] | [`autosave`] | autosave settings, timer and recovery offer |
 //! | [`ViewPanel`] | [`view`] | view settings, the last PSNR |
-//! | [`PaintPanel`] | [`paint`] (the colour section: [`color`]) | the brush, the colour wheel and hex field, the recent colours, the resolution of "Set R for all" |
+//! | [`PaintPanel`] | [`paint`] (its sections: [`color`], [`presets`]) | the brush, the colour wheel and hex field, the recent colours, the brush presets, the resolution of "Set R for all" |
 //! | [`OptimizePanel`] | [`optimize`] | Optimize's error bound |
 //! | [`UndoPanel`] | [`undo`] | nothing (shows the document's history) |
 //! | [`ScenePanel`] | [`scene`] | "Redraw continuously" |
@@ -26,6 +26,7 @@ pub mod help;
 pub mod menu;
 pub mod optimize;
 pub mod paint;
+pub mod presets;
 pub mod scene;
 pub mod status_line;
 pub mod undo;

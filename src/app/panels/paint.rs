@@ -1,4 +1,5 @@
-//! The paint panel: enter / leave paint mode, the brush settings (tool, colour with the
+//! The paint panel: enter / leave paint mode, the brush presets ([`super::presets`]), the
+//! brush settings (tool, colour with the
 //! wheel, hex field and recent colours of [`super::color`], radius, strength, falloff,
 //! spacing, blend mode, occlusion, culling, mirror) and the commands eyedropper, fill and
 //! "Set R for all". The brush and the recent colours are this panel's state; the editor
@@ -10,6 +11,7 @@ use meshpaint_core::paint::brush::{
 };
 
 use super::color::ColorPicker;
+use super::presets::PresetsPanel;
 use crate::app::command::Command;
 use crate::app::recent_colors::RecentColors;
 use crate::app::state::Action;
@@ -26,6 +28,8 @@ pub struct PaintPanel {
     pub picker: ColorPicker,
     /// The last distinct colours strokes painted with.
     pub recent_colors: RecentColors,
+    /// The brush presets.
+    pub presets: PresetsPanel,
 }
 
 impl Default for PaintPanel {
@@ -35,6 +39,7 @@ impl Default for PaintPanel {
             resolution_for_all: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
             picker: ColorPicker::default(),
             recent_colors: RecentColors::default(),
+            presets: PresetsPanel::default(),
         }
     }
 }
@@ -58,6 +63,8 @@ impl PaintPanel {
         if ui.add_enabled(ctx.has_document, egui::Button::new(button)).clicked() {
             commands.push(Command::Action(Action::TogglePaintMode));
         }
+        self.presets.ui(ui, &mut self.brush);
+        ui.separator();
         tool_ui(ui, &mut self.brush);
         self.picker.ui(ui, &mut self.brush.color, &self.recent_colors);
         brush_settings_ui(ui, &mut self.brush, ctx.bounds_radius);
