@@ -274,3 +274,59 @@ fn brush_presets_save_load_and_delete() {
     assert!(harness.query_by_label_contains("Type a name").is_some());
     assert_eq!(harness.state().panels.paint.presets.presets.list().len(), 3);
 }
+
+// ---------------------------------------------------------------- heat-map legend
+
+/// The legend shows with the heat map and goes with it; it has a swatch per R = 1 … 4096,
+/// and the Duck's own R (8) is marked as present.
+#[test]
+fn the_heat_map_legend_follows_the_heat_map() {
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    assert!(harness.query_by_label("Heat map R = 8").is_none());
+    harness.key_press(egui::Key::H);
+    harness.run_steps(2);
+    for log2 in 0..=12 {
+        let label = format!("Heat map R = {}", 1u64 << log2);
+        let node = harness.get_by_label(&label);
+        assert!(node.rect().max.y < SIZE[1], "{label} is off screen");
+    }
+    harness.key_press(egui::Key::H);
+    harness.run_steps(2);
+    assert!(harness.query_by_label("Heat map R = 8").is_none());
+}
+
+/// The legend's colour for R is what the renderer draws for a face of that R: the Duck
+/// opened at uniform R = 8 and at R = 32, rendered offscreen (lavapipe) with the heat map,
+/// unlit: the colour of most mesh pixels equals the legend's swatch for that R within one
+/// 8-bit step.
+#[test]
+fn the_heat_map_legend_has_the_colours_the_renderer_draws() {
+    use meshpaint::app::import_settings::ImportMode;
+    use meshpaint_core::colors::layout::Resolution;
+    use meshpaint_render::Shading;
+    let gpu = Arc::new(meshpaint_render::Gpu::new_headless().expect("GPU tests need an adapter (lavapipe)"));
+    let legend = meshpaint::app::panels::heat_legend::legend_entries();
+    for r in [8u64, 32] {
+        let mut editor = Editor::new(Some(Arc::clone(&gpu)), Arc::new(|| {}));
+        editor.panels.import.mode = ImportMode::Uniform;
+        editor.panels.import.resolution = Resolution::new(r).unwrap();
+        editor.open(Source::BuiltIn);
+        assert!(editor.wait_for_job(JOB_TIMEOUT));
+        editor.panels.view.settings.overlays.heatmap = true;
+        editor.panels.view.settings.shading = Shading::Unlit;
+        let mut settings = editor.render_settings();
+        settings.background = [0.0, 0.0, 0.0, 0.0];
+        let image = gpu.render_image(editor.shown_item().unwrap(), &settings, 160, 120).unwrap();
+        let mut counts = std::collections::HashMap::<[u8; 4], usize>::new();
+        for pixel in image.pixels().filter(|p| p.0[3] == 255) {
+            *counts.entry(pixel.0).or_default() += 1;
+        }
+        let (&drawn, &count) = counts.iter().max_by_key(|(_, n)| **n).unwrap();
+        assert!(count > 2000, "R = {r}: only {count} mesh pixels");
+        let (_, swatch) = legend.iter().find(|(legend_r, _)| *legend_r == r).unwrap();
+        for (c, want) in [swatch.r(), swatch.g(), swatch.b()].into_iter().enumerate() {
+            assert!(drawn[c].abs_diff(want) <= 1, "R = {r}: drawn {drawn:?}, legend {swatch:?}");
+        }
+    }
+}

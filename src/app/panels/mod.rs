@@ -10,7 +10,7 @@
 //! | [`FilePanel`] | [`file`] | the file dialog, the directory dialogs start in |
 //! | [`ImportSettings`] | `import_settings` (app level: the file dialog shows it too) | the resolution choice for opened meshes |
 //! | [`AutosavePanel`] | [`autosave`] | autosave settings, timer and recovery offer |
-//! | [`ViewPanel`] | [`view`] | view settings, the last PSNR |
+//! | [`ViewPanel`] | [`view`] (the heat map's legend: [`heat_legend`]) | view settings, the last PSNR |
 //! | [`PaintPanel`] | [`paint`] (its sections: [`color`], [`presets`]) | the brush, the colour wheel and hex field, the recent colours, the brush presets, the resolution of "Set R for all" |
 //! | [`OptimizePanel`] | [`optimize`] | Optimize's error bound |
 //! | [`UndoPanel`] | [`undo`] | nothing (shows the document's history) |
@@ -22,6 +22,7 @@
 pub mod autosave;
 pub mod color;
 pub mod file;
+pub mod heat_legend;
 pub mod help;
 pub mod menu;
 pub mod optimize;
