@@ -241,6 +241,7 @@ impl Editor {
     fn finish_loaded(&mut self, mut document: document::OpenDocument, elapsed: Duration) {
         let text = opened_text(&document, elapsed);
         self.camera = OrbitCamera::framing(document.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES);
+        self.camera.up = self.panels.import.up_axis;
         let history_budget = (self.budget(), document.format);
         // Untextured meshes start at the lowest R where nothing is painted, and resolution
         // follows the brush there; textured ones keep the chosen R, and a project (packed
@@ -643,6 +644,8 @@ impl Editor {
             ctx.request_repaint_after(after);
         }
         self.global_input(&ctx);
+        let bounds = self.document.open.as_ref().map(|d| d.bounds);
+        input::follow_up_axis(&mut self.camera, self.panels.import.up_axis, bounds, &self.viewport);
         let (has_document, idle) = (self.document.open.is_some(), !self.jobs.is_busy());
         let chosen = egui::Panel::top("menu bar").show(ui, |ui| self.panels.menu.ui(ui, has_document, idle)).inner;
         self.apply_all(chosen);

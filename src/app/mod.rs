@@ -15,7 +15,7 @@
 //! | 4 | [`paint`] | paint-mode commands on the document: strokes, live GPU upload, undo / redo, eyedropper, fill, resolution, Optimize, radius / strength gestures, brush cursor |
 //! | 3 | [`panels`], [`job_output`] | each panel a type that owns its state and draws itself, returning commands (menu, status line, file, import settings, autosave, view, paint, optimize, undo, scene, help, 3D view area); what jobs produce |
 //! | 2 | [`session`], [`input`], [`autosave`], [`file_dialog`] | the document being edited ([`session::DocumentState`]: open document, paint session, undo history); all input (shortcuts [`input::SHORTCUTS`], 3D-view navigation, the brush's pointer); autosave state; an egui file browser |
-//! | 1 | [`document`], [`command`], [`import_settings`] | the open document (store and GPU mesh side by side; open, save, export work); the commands panels return; the import settings panel (the open dialog's resolution choice) |
+//! | 1 | [`document`], [`command`], [`import_settings`] | the open document (store and GPU mesh side by side; open, save, export work); the commands panels return; the import settings panel (the open dialog's resolution choice, the up axis) |
 //! | 0 | [`state`], [`jobs`], [`text`], [`widgets`], [`paint_session`], [`unsaved`], [`recent_colors`], [`presets`] | shared small types and [`Action`]s; one background job at a time with progress; number / error text; the resolution combo box; paint-mode state; the actions that wait for "save changes first?"; the recent colours; the brush presets |
 //!
 //! Paint mode is [`Mode::Paint`] (Tab, [`input::SHORTCUTS`]): its tools get the pointer in

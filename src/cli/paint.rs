@@ -159,9 +159,8 @@ pub(super) fn run(args: PaintArgs) -> Result<()> {
     }
     let mut document = open(&args.file, args.resolution, &budget)?;
     let format = packed_format(args.format, document.source);
-    let CameraArgs { yaw, pitch, distance } = args.camera;
     let bounds = meshpaint_core::camera::BoundingSphere::of_points(&document.positions);
-    let camera = meshpaint_core::camera::default_camera(bounds, yaw, pitch, distance);
+    let camera = args.camera.camera(bounds);
     let bvh = meshpaint_core::paint::picking::MeshBvh::build(
         &document.positions,
         &document.store.topology().face_vertices,

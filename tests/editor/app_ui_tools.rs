@@ -330,3 +330,27 @@ fn the_heat_map_legend_has_the_colours_the_renderer_draws() {
         }
     }
 }
+
+// ---------------------------------------------------------------- up axis
+
+/// Choosing "Z up" turns the view of the open document (its geometry stays as it was):
+/// the camera's screen-up is +Z and the mesh is framed again; a document opened afterwards
+/// opens Z-up too.
+#[test]
+fn the_up_axis_turns_the_view_not_the_mesh() {
+    use meshpaint_core::camera::UpAxis;
+    let mut harness = harness(editor_with_duck());
+    harness.run_steps(2);
+    let positions = harness.state().document.open.as_ref().unwrap().document.positions.clone();
+    assert_eq!(harness.state().camera.up, UpAxis::Y);
+    harness.get_by_label("Z up").click();
+    harness.run_steps(2);
+    let camera = harness.state().camera;
+    assert_eq!(camera.up, UpAxis::Z);
+    assert!(camera.right_up().1.z > 0.9, "screen-up is {:?}", camera.right_up().1);
+    assert_eq!(harness.state().document.open.as_ref().unwrap().document.positions, positions);
+    harness.state_mut().open(Source::BuiltIn);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.run_steps(2);
+    assert_eq!(harness.state().camera.up, UpAxis::Z);
+}
