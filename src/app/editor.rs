@@ -32,6 +32,7 @@ use super::panels::{
     LastStroke, PaintPanelContext, Panels, SIDE_PANEL_WIDTH, SceneContext, ViewContext, ViewportContext,
 };
 use super::session::{DocumentState, opened_text};
+use super::settings::SettingsFile;
 use super::state::{Action, Mode, Representation, Severity, Shown, Status, ViewportState};
 use super::text::error_text;
 use super::unsaved::{Pending, UnsavedChoice};
@@ -61,6 +62,8 @@ pub struct Editor {
     pub budget_override: Option<Budget>,
     /// A load error to report once the built-in scene has replaced a failed start-up file.
     fallback_error: Option<String>,
+    /// The settings file (read and written by [`super::editor_settings`]).
+    pub settings_file: SettingsFile,
 }
 
 impl std::fmt::Debug for Editor {
@@ -91,6 +94,7 @@ impl Editor {
             after_save: None,
             budget_override: None,
             fallback_error: None,
+            settings_file: SettingsFile::default(),
         }
     }
 
@@ -258,7 +262,10 @@ impl Editor {
         self.frame_all();
         match self.fallback_error.take() {
             Some(error) => self.set_status(Severity::Error, format!("{error} — showing the built-in Duck instead")),
-            None => self.set_status(Severity::Info, text),
+            None => match self.settings_file.problem.take() {
+                Some(problem) => self.set_status(Severity::Warning, format!("{text}. {problem}")),
+                None => self.set_status(Severity::Info, text),
+            },
         }
     }
 

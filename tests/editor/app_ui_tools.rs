@@ -354,3 +354,89 @@ fn the_up_axis_turns_the_view_not_the_mesh() {
     harness.run_steps(2);
     assert_eq!(harness.state().camera.up, UpAxis::Z);
 }
+
+// ---------------------------------------------------------------- settings file
+
+/// Presets, recent colours, up axis, zoom to pointer and shading written by one editor come
+/// back in the next; nothing is written while a button is held or nothing changed; the file
+/// is TOML in the directory `$MESHPAINT_CONFIG_DIR` names.
+#[test]
+fn settings_are_remembered_between_runs() {
+    use meshpaint::app::settings::{FILE_NAME, settings_path_with};
+    use meshpaint_core::camera::UpAxis;
+    use meshpaint_render::Shading;
+    let dir = crate::common::TempDir::new("settings");
+    let path = settings_path_with(Some(dir.join("config").into_os_string())).unwrap();
+    assert_eq!(path, dir.join("config").join(FILE_NAME));
+    assert_ne!(settings_path_with(Some("".into())), Some(std::path::PathBuf::from(FILE_NAME)));
+
+    let mut editor = new_editor();
+    editor.load_settings(Some(path.clone()));
+    let defaults = editor.settings();
+    assert!(!editor.save_settings_if_changed(false), "nothing changed, yet it wrote");
+    assert!(!path.exists());
+    let mut brush = editor.panels.paint.brush;
+    brush.strength = 0.25;
+    brush.radius = meshpaint_core::paint::brush::BrushRadius::World { radius_world: 0.125 };
+    editor.panels.paint.presets.presets.save("Mine", brush).unwrap();
+    editor.panels.paint.recent_colors.push([1.0, 0.5, 0.0, 0.5]);
+    editor.panels.paint.recent_colors.push([0.0, 0.0, 1.0, 1.0]);
+    editor.panels.import.up_axis = UpAxis::Z;
+    editor.panels.view.settings.zoom_to_cursor = false;
+    editor.panels.view.settings.shading = Shading::Unlit;
+    assert!(!editor.save_settings_if_changed(true), "it wrote while the pointer was down");
+    assert!(editor.save_settings_if_changed(false));
+    assert!(!editor.save_settings_if_changed(false), "it wrote the same settings twice");
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("up_axis = \"z\"") && text.contains("name = \"Mine\""), "{text}");
+
+    let mut next = new_editor();
+    next.load_settings(Some(path.clone()));
+    assert_eq!(next.settings(), editor.settings());
+    assert_ne!(next.settings(), defaults);
+    assert_eq!(next.panels.paint.presets.presets.get("Mine").unwrap().brush, brush);
+    assert_eq!(next.panels.import.up_axis, UpAxis::Z);
+}
+
+/// A settings file that is not TOML, holds an unknown value or comes from a newer version
+/// gives a message and the defaults, and stays as it was until a setting changes; unknown
+/// keys are ignored.
+#[test]
+fn a_bad_settings_file_gives_a_message_and_the_defaults() {
+    let dir = crate::common::TempDir::new("settings-bad");
+    let path = dir.join("settings.toml");
+    let defaults = {
+        let mut editor = new_editor();
+        editor.load_settings(None);
+        editor.settings()
+    };
+    for (text, says) in [
+        ("this is = = not toml", "is not valid"),
+        ("up_axis = \"w\"", "unknown up axis"),
+        ("version = 99", "newer meshpaint"),
+        ("[[presets]]\nname = \"x\"\ntool = \"paint\"", "is not valid"),
+        ("recent_colors = [\"red\"]", "recent colour"),
+    ] {
+        std::fs::write(&path, text).unwrap();
+        let mut editor = new_editor();
+        editor.load_settings(Some(path.clone()));
+        assert_eq!(editor.status.severity, meshpaint::app::Severity::Warning, "{text}");
+        assert!(
+            editor.status.text.contains(says) && editor.status.text.contains("defaults"),
+            "{text}: {:?}",
+            editor.status
+        );
+        assert_eq!(editor.settings(), defaults, "{text}");
+        assert!(!editor.save_settings_if_changed(false));
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), text, "the bad file was overwritten unchanged");
+        // The message is shown again once the first document has opened.
+        editor.open(Source::BuiltIn);
+        assert!(editor.wait_for_job(JOB_TIMEOUT));
+        assert!(editor.status.text.contains(says), "{:?}", editor.status);
+    }
+    std::fs::write(&path, "future_key = 3\n[view]\nzoom_to_cursor = false\nsomething_new = \"x\"\n").unwrap();
+    let mut editor = new_editor();
+    editor.load_settings(Some(path.clone()));
+    assert!(!editor.panels.view.settings.zoom_to_cursor);
+    assert_eq!(editor.status.severity, meshpaint::app::Severity::Info, "{:?}", editor.status);
+}
