@@ -32,6 +32,7 @@ use super::panels::{
     LastStroke, PaintPanelContext, Panels, SIDE_PANEL_WIDTH, SceneContext, ViewContext, ViewportContext,
 };
 use super::session::{DocumentState, opened_text};
+use super::settings::SettingsFile;
 use super::state::{Action, Mode, Representation, Severity, Shown, Status, ViewportState};
 use super::text::error_text;
 use super::unsaved::{Pending, UnsavedChoice};
@@ -61,6 +62,8 @@ pub struct Editor {
     pub budget_override: Option<Budget>,
     /// A load error to report once the built-in scene has replaced a failed start-up file.
     fallback_error: Option<String>,
+    /// The settings file (read and written by [`super::editor_settings`]).
+    pub settings_file: SettingsFile,
 }
 
 impl std::fmt::Debug for Editor {
@@ -91,6 +94,7 @@ impl Editor {
             after_save: None,
             budget_override: None,
             fallback_error: None,
+            settings_file: SettingsFile::default(),
         }
     }
 
@@ -241,6 +245,7 @@ impl Editor {
     fn finish_loaded(&mut self, mut document: document::OpenDocument, elapsed: Duration) {
         let text = opened_text(&document, elapsed);
         self.camera = OrbitCamera::framing(document.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES);
+        self.camera.up = self.panels.import.up_axis;
         let history_budget = (self.budget(), document.format);
         // Untextured meshes start at the lowest R where nothing is painted, and resolution
         // follows the brush there; textured ones keep the chosen R, and a project (packed
@@ -257,7 +262,10 @@ impl Editor {
         self.frame_all();
         match self.fallback_error.take() {
             Some(error) => self.set_status(Severity::Error, format!("{error} — showing the built-in Duck instead")),
-            None => self.set_status(Severity::Info, text),
+            None => match self.settings_file.problem.take() {
+                Some(problem) => self.set_status(Severity::Warning, format!("{text}. {problem}")),
+                None => self.set_status(Severity::Info, text),
+            },
         }
     }
 
@@ -407,7 +415,8 @@ impl Editor {
     /// The document and what paint mode's commands use besides it (split borrows).
     fn paint_parts(&mut self) -> (&mut DocumentState, PaintContext<'_>) {
         let Editor { gpu, document, camera, panels, viewport, status, jobs, .. } = self;
-        let ctx = PaintContext { gpu: gpu.as_ref(), camera, viewport, brush: &mut panels.paint.brush, status, jobs };
+        let (brush, recent_colors) = (&mut panels.paint.brush, &mut panels.paint.recent_colors);
+        let ctx = PaintContext { gpu: gpu.as_ref(), camera, viewport, brush, recent_colors, status, jobs };
         (document, ctx)
     }
 
@@ -642,6 +651,8 @@ impl Editor {
             ctx.request_repaint_after(after);
         }
         self.global_input(&ctx);
+        let bounds = self.document.open.as_ref().map(|d| d.bounds);
+        input::follow_up_axis(&mut self.camera, self.panels.import.up_axis, bounds, &self.viewport);
         let (has_document, idle) = (self.document.open.is_some(), !self.jobs.is_busy());
         let chosen = egui::Panel::top("menu bar").show(ui, |ui| self.panels.menu.ui(ui, has_document, idle)).inner;
         self.apply_all(chosen);

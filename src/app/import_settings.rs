@@ -1,7 +1,11 @@
 //! The import settings panel: how the editor gives an opened mesh its face resolutions,
 //! the choice in the open dialog (and the file panel's section), turned into one
-//! [`ResolutionRule`] of [`meshpaint_core::convert::adaptive`].
+//! [`ResolutionRule`] of [`meshpaint_core::convert::adaptive`]; and which axis is up (Y or
+//! Z: Z-up scans otherwise open lying on their side). The up axis turns the camera
+//! ([`OrbitCamera::up`](meshpaint_core::camera::OrbitCamera::up)), never the geometry, so the
+//! document and everything exported from it stay as the file had them.
 
+use meshpaint_core::camera::UpAxis;
 use meshpaint_core::colors::layout::Resolution;
 use meshpaint_core::convert::adaptive::ResolutionRule;
 
@@ -77,6 +81,8 @@ pub struct ImportSettings {
     pub sample_budget: u64,
     /// The largest `R` of the content-driven modes.
     pub max_resolution: Resolution,
+    /// The axis that is up in the 3D view (the open document's view follows a change).
+    pub up_axis: UpAxis,
 }
 
 impl Default for ImportSettings {
@@ -87,6 +93,7 @@ impl Default for ImportSettings {
             error_bound: 0.01,
             sample_budget: 100_000,
             max_resolution: Resolution::from_log2(6).unwrap_or(Resolution::ONE),
+            up_axis: UpAxis::Y,
         }
     }
 }
@@ -105,8 +112,20 @@ impl ImportSettings {
         }
     }
 
-    /// The mode combo and its parameters, one row, after `label`.
+    /// The mode combo and its parameters, one row, after `label`; the up axis below.
     pub fn ui(&mut self, ui: &mut egui::Ui, label: &str) {
+        self.resolution_ui(ui, label);
+        ui.horizontal(|ui| {
+            ui.label("Up axis:");
+            ui.radio_value(&mut self.up_axis, UpAxis::Y, "Y up").on_hover_text("glTF and most modelling tools");
+            ui.radio_value(&mut self.up_axis, UpAxis::Z, "Z up").on_hover_text(
+                "Many scans and CAD files: without it they lie on their side (the view turns, not the mesh)",
+            );
+        });
+    }
+
+    /// The mode combo and its parameters, one row, after `label`.
+    fn resolution_ui(&mut self, ui: &mut egui::Ui, label: &str) {
         ui.horizontal_wrapped(|ui| {
             let label = ui.label(label);
             egui::ComboBox::from_id_salt("import mode")

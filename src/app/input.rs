@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use egui::{Key, Modifiers, PointerButton};
 use glam::DVec3;
 
-use meshpaint_core::camera::{BoundingSphere, OrbitCamera};
+use meshpaint_core::camera::{BoundingSphere, OrbitCamera, UpAxis};
 
 use super::command::Command;
 use super::document::OpenDocument;
@@ -315,7 +315,7 @@ pub fn paint_input(
 /// the narrower of the 3D view's two fields of view.
 pub fn frame_all(camera: &mut OrbitCamera, bounds: BoundingSphere, viewport: &ViewportState) {
     let (yaw, pitch) = (camera.yaw_degrees, camera.pitch_degrees);
-    let mut framed = OrbitCamera::framing(bounds, yaw, pitch);
+    let mut framed = OrbitCamera { up: camera.up, ..OrbitCamera::framing(bounds, yaw, pitch) };
     let [w, h] = viewport.size_px();
     let aspect = f64::from(w) / f64::from(h.max(1));
     if aspect < 1.0 {
@@ -324,6 +324,17 @@ pub fn frame_all(camera: &mut OrbitCamera, bounds: BoundingSphere, viewport: &Vi
         framed.distance = bounds.radius / half_x.sin() * 1.1;
     }
     *camera = framed;
+}
+
+/// Turns `camera` to `up` when it has another up axis, framing `bounds` (the open mesh's)
+/// again.
+pub fn follow_up_axis(camera: &mut OrbitCamera, up: UpAxis, bounds: Option<BoundingSphere>, viewport: &ViewportState) {
+    if camera.up != up {
+        camera.up = up;
+        if let Some(bounds) = bounds {
+            frame_all(camera, bounds, viewport);
+        }
+    }
 }
 
 /// Centres `camera` on the surface point of `document` under `pos` (points, window

@@ -11,12 +11,12 @@
 //! | layer | file | role |
 //! |---|---|---|
 //! | 6 | [`window`] | winit event loop, surface, egui-winit / egui-wgpu, offscreen 3D view, redraw scheduling |
-//! | 5 | [`editor`] | [`Editor`]: the document, camera, panels, 3D view state, status, jobs; one frame of UI ([`Editor::ui`]); every [`Action`] ([`Editor::perform`]) and [`command::Command`] ([`Editor::apply`]) carried out; finished jobs applied by [`jobs::JobKind`]; open and quit ask Save / Don't save / Cancel while changes are unsaved |
+//! | 5 | [`editor`], [`editor_settings`] | [`Editor`]: the document, camera, panels, 3D view state, status, jobs; one frame of UI ([`Editor::ui`]); every [`Action`] ([`Editor::perform`]) and [`command::Command`] ([`Editor::apply`]) carried out; finished jobs applied by [`jobs::JobKind`]; open and quit ask Save / Don't save / Cancel while changes are unsaved; the settings remembered between runs read from and written to the panels |
 //! | 4 | [`paint`] | paint-mode commands on the document: strokes, live GPU upload, undo / redo, eyedropper, fill, resolution, Optimize, radius / strength gestures, brush cursor |
 //! | 3 | [`panels`], [`job_output`] | each panel a type that owns its state and draws itself, returning commands (menu, status line, file, import settings, autosave, view, paint, optimize, undo, scene, help, 3D view area); what jobs produce |
 //! | 2 | [`session`], [`input`], [`autosave`], [`file_dialog`] | the document being edited ([`session::DocumentState`]: open document, paint session, undo history); all input (shortcuts [`input::SHORTCUTS`], 3D-view navigation, the brush's pointer); autosave state; an egui file browser |
-//! | 1 | [`document`], [`command`], [`import_settings`] | the open document (store and GPU mesh side by side; open, save, export work); the commands panels return; the import settings panel (the open dialog's resolution choice) |
-//! | 0 | [`state`], [`jobs`], [`text`], [`widgets`], [`paint_session`], [`unsaved`] | shared small types and [`Action`]s; one background job at a time with progress; number / error text; the resolution combo box; paint-mode state; the actions that wait for "save changes first?" |
+//! | 1 | [`document`], [`command`], [`import_settings`], [`settings`] | the open document (store and GPU mesh side by side; open, save, export work); the commands panels return; the import settings panel (the open dialog's resolution choice, the up axis); the settings file |
+//! | 0 | [`state`], [`jobs`], [`text`], [`widgets`], [`paint_session`], [`unsaved`], [`recent_colors`], [`presets`] | shared small types and [`Action`]s; one background job at a time with progress; number / error text; the resolution combo box; paint-mode state; the actions that wait for "save changes first?"; the recent colours; the brush presets |
 //!
 //! Paint mode is [`Mode::Paint`] (Tab, [`input::SHORTCUTS`]): its tools get the pointer in
 //! [`input::paint_input`], edit the store through `Arc::make_mut` on
@@ -29,6 +29,7 @@ pub mod autosave;
 pub mod command;
 pub mod document;
 pub mod editor;
+pub mod editor_settings;
 pub mod file_dialog;
 pub mod import_settings;
 pub mod input;
@@ -37,7 +38,10 @@ pub mod jobs;
 pub mod paint;
 pub mod paint_session;
 pub mod panels;
+pub mod presets;
+pub mod recent_colors;
 pub mod session;
+pub mod settings;
 pub mod state;
 pub mod text;
 pub mod unsaved;

@@ -20,7 +20,9 @@ use meshpaint_core::colors::layout::Resolution;
 use meshpaint_core::colors::store::{ColorStore, DirtyAccumulator};
 use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::packing::paint_layout::PaintLayout;
-use meshpaint_core::paint::brush::{self, BrushRadius, BrushSettings, FillScope, PaintView, Painter, StrokeUpdate};
+use meshpaint_core::paint::brush::{
+    self, BrushRadius, BrushSettings, FillScope, PaintView, Painter, StrokePoint, StrokeUpdate,
+};
 use meshpaint_core::paint::optimize;
 use meshpaint_core::paint::undo::{StepSummary, UndoHistory};
 use meshpaint_render::Gpu;
@@ -28,6 +30,7 @@ use meshpaint_render::Gpu;
 use super::job_output::{JobOutput, Optimized};
 use super::jobs::{JobKind, Jobs};
 use super::paint_session::{Gesture, GestureKind, PaintSession, Repack, Repacked, STRENGTH_GESTURE_POINTS};
+use super::recent_colors::RecentColors;
 use super::session::DocumentState;
 use super::state::{Mode, Severity, Status, ViewportState};
 use super::text::{human_bytes, thousands};
@@ -43,6 +46,8 @@ pub struct PaintContext<'a> {
     pub viewport: &'a mut ViewportState,
     /// The brush settings (the paint panel's).
     pub brush: &'a mut BrushSettings,
+    /// The colours strokes painted with (the paint panel's row).
+    pub recent_colors: &'a mut RecentColors,
     /// The status line.
     pub status: &'a mut Status,
     /// Background work (repack, Optimize).
@@ -217,6 +222,11 @@ impl DocumentState {
                 if update.stats.samples_changed > 0 || update.stats.faces_resized > 0 {
                     self.edit_generation += 1;
                 }
+                // A colour counts as used once a stroke changed samples with it.
+                let painting = ctx.brush.tool == brush::Tool::Paint && ctx.brush.blend != brush::BlendMode::EraseToBase;
+                if painting && update.stats.samples_changed > 0 {
+                    ctx.recent_colors.push(ctx.brush.color);
+                }
             }
             Some(Err(error)) => {
                 self.end_stroke(ctx);
@@ -226,9 +236,10 @@ impl DocumentState {
         }
     }
 
-    /// Starts a stroke at `pos` (points).
+    /// Starts a stroke at `pos` (points). The pointer is a mouse: full pressure (winit has no
+    /// tablet pressure yet).
     pub fn begin_stroke(&mut self, ctx: &mut PaintContext<'_>, pos: egui::Pos2) {
-        let px = ctx.viewport.view_px(pos);
+        let px = StrokePoint::mouse(ctx.viewport.view_px(pos));
         let settings = *ctx.brush;
         if let Some(session) = self.paint.as_mut() {
             session.painter.set_settings(settings);
@@ -242,7 +253,7 @@ impl DocumentState {
 
     /// Extends the stroke to `pos` (points).
     pub fn stroke_to(&mut self, ctx: &mut PaintContext<'_>, pos: egui::Pos2) {
-        let px = ctx.viewport.view_px(pos);
+        let px = StrokePoint::mouse(ctx.viewport.view_px(pos));
         let result = self.with_paint(ctx, |view, store, painter, history| painter.stroke_to(view, store, history, px));
         self.stroke_result(ctx, result);
     }

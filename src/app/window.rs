@@ -217,6 +217,8 @@ impl Shell {
         let waker_ctx = egui_ctx.clone();
         let mut editor = Editor::new(gpu.clone(), Arc::new(move || waker_ctx.request_repaint()));
         editor.viewport.texture = Some(view.texture_id);
+        // Before the first document opens: the up axis applies to it.
+        editor.load_settings(super::settings::settings_path());
         editor.open(match &self.options.file {
             Some(path) => Source::File(path.clone()),
             None => Source::BuiltIn,
@@ -270,6 +272,8 @@ impl Running {
         let raw_input = self.egui_state.take_egui_input(&self.window);
         let editor = &mut self.editor;
         let mut full_output = self.egui_ctx.run_ui(raw_input, |ui| editor.ui(ui));
+        let pointer_down = self.egui_ctx.input(|input| input.pointer.any_down());
+        editor.save_settings_if_changed(pointer_down);
         self.egui_state.handle_platform_output(&self.window, full_output.platform_output);
         // Compared with what we last set: winit's `Window::title` is always empty on X11,
         // so comparing with it re-set WM_NAME on every frame.

@@ -86,10 +86,10 @@ impl ResolutionArg {
     }
 }
 
-// `--yaw`, `--pitch` and `--distance` of the orbit camera (`render`, `paint`).
+// `--yaw`, `--pitch`, `--distance` and `--up` of the orbit camera (`render`, `paint`).
 #[derive(Debug, Clone, Copy, clap::Args)]
 pub(super) struct CameraArgs {
-    /// Camera yaw around +Y in degrees (0 looks along −Z).
+    /// Camera yaw around the up axis in degrees (0 looks along −Z; with `--up z`, along +Y).
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     pub(super) yaw: f64,
     /// Camera pitch above the horizon in degrees.
@@ -98,9 +98,23 @@ pub(super) struct CameraArgs {
     /// Eye distance from the scene centre (default: frame the bounding sphere).
     #[arg(long)]
     pub(super) distance: Option<f64>,
+    /// The axis that is up on screen: y, or z for Z-up files (scans, CAD); only the view
+    /// turns, never the geometry.
+    #[arg(long, default_value = "y", value_parser = parse_up)]
+    pub(super) up: meshpaint_core::camera::UpAxis,
+}
+
+fn parse_up(name: &str) -> Result<meshpaint_core::camera::UpAxis, String> {
+    meshpaint_core::camera::UpAxis::from_name(name).ok_or_else(|| format!("unknown up axis '{name}' (y, z)"))
 }
 
 impl CameraArgs {
+    /// The camera these arguments give for a scene of `bounds`.
+    pub(super) fn camera(&self, bounds: meshpaint_core::camera::BoundingSphere) -> meshpaint_core::camera::OrbitCamera {
+        let camera = meshpaint_core::camera::default_camera(bounds, self.yaw, self.pitch, self.distance);
+        meshpaint_core::camera::OrbitCamera { up: self.up, ..camera }
+    }
+
     /// Refuses a `--distance` that is not a positive number.
     pub(super) fn check(&self) -> Result<()> {
         if let Some(distance) = self.distance {

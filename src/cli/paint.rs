@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use meshpaint_core::colors::format::{ColorFormat, Rgba};
 use meshpaint_core::colors::layout::Resolution;
 use meshpaint_core::paint::brush::{
-    BlendMode, BrushRadius, BrushSettings, Falloff, PaintView, Painter, ResolutionOp, Tool,
+    BlendMode, BrushRadius, BrushSettings, Falloff, PaintView, Painter, PressureResponse, ResolutionOp, Tool,
 };
 
 use super::args::{CameraArgs, OutputArgs, ResolutionArg, budget, open, packed_format, parse_format};
@@ -17,9 +17,13 @@ use super::args::{CameraArgs, OutputArgs, ResolutionArg, budget, open, packed_fo
 pub(super) struct PaintArgs {
     /// A .glb / .gltf, .obj, .ply, .stl or packed file.
     file: PathBuf,
-    /// Cursor positions in pixels of the WIDTH × HEIGHT view: "x0,y0 x1,y1 …".
+    /// Cursor positions in pixels of the WIDTH × HEIGHT view, each with an optional pen
+    /// pressure in 0..=1 (1 when left out): "x0,y0 x1,y1,p1 …".
     #[arg(long, allow_hyphen_values = true)]
     stroke: String,
+    /// What the stroke's pen pressure scales: radius, strength, both or none.
+    #[arg(long, default_value = "radius", value_parser = parse_pressure)]
+    pressure: PressureResponse,
     /// Brush colour, sRGB hex (#rrggbb).
     #[arg(long, default_value = "#ff0000")]
     color: String,
@@ -91,6 +95,11 @@ fn parse_falloff(name: &str) -> Result<Falloff, String> {
     Falloff::from_name(name).ok_or_else(|| format!("unknown falloff '{name}' (smooth, linear, constant, sharp)"))
 }
 
+fn parse_pressure(name: &str) -> Result<PressureResponse, String> {
+    PressureResponse::from_name(name)
+        .ok_or_else(|| format!("unknown pressure response '{name}' (radius, strength, both, none)"))
+}
+
 fn parse_blend(name: &str) -> Result<BlendMode, String> {
     BlendMode::from_name(name).ok_or_else(|| format!("unknown blend mode '{name}' (mix, add, multiply, erase)"))
 }
@@ -127,6 +136,7 @@ fn brush_settings(args: &PaintArgs, color: Rgba) -> Result<BrushSettings> {
             .follow_resolution
             .map(|max| Resolution::new(max).context("--follow-resolution"))
             .transpose()?,
+        pressure: args.pressure,
     };
     settings.validate()?;
     Ok(settings)
@@ -137,7 +147,7 @@ pub(super) fn run(args: PaintArgs) -> Result<()> {
     let stroke =
         meshpaint_core::paint::brush::parse_stroke(&args.stroke).map_err(|e| anyhow::anyhow!("--stroke: {e}"))?;
     let color = meshpaint_core::paint::brush::parse_hex_color(&args.color)
-        .with_context(|| format!("--color '{}' is not #rrggbb", args.color))?;
+        .with_context(|| format!("--color '{}' is not #rrggbb or #rgb", args.color))?;
     args.camera.check()?;
     anyhow::ensure!(args.width > 0 && args.height > 0, "--width and --height must be positive");
     let settings = brush_settings(&args, color)?;
@@ -149,9 +159,8 @@ pub(super) fn run(args: PaintArgs) -> Result<()> {
     }
     let mut document = open(&args.file, args.resolution, &budget)?;
     let format = packed_format(args.format, document.source);
-    let CameraArgs { yaw, pitch, distance } = args.camera;
     let bounds = meshpaint_core::camera::BoundingSphere::of_points(&document.positions);
-    let camera = meshpaint_core::camera::default_camera(bounds, yaw, pitch, distance);
+    let camera = args.camera.camera(bounds);
     let bvh = meshpaint_core::paint::picking::MeshBvh::build(
         &document.positions,
         &document.store.topology().face_vertices,

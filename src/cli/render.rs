@@ -4,7 +4,6 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use meshpaint_core::camera::default_camera;
 use meshpaint_core::colors::budget::Budget;
 use meshpaint_core::io::display::{OpenOptions, open_for_display};
 use meshpaint_core::io::document::Source;
@@ -96,9 +95,9 @@ fn filter_mode(filter: RenderFilter, level: Option<u32>) -> Result<FilterMode> {
 pub(super) fn run(args: RenderArgs) -> Result<()> {
     let filter = filter_mode(args.filter, args.level)?;
     args.camera.check()?;
-    let CameraArgs { yaw, pitch, distance } = args.camera;
+    let camera = args.camera;
     let settings = |bounds| {
-        let mut settings = RenderSettings::new(default_camera(bounds, yaw, pitch, distance));
+        let mut settings = RenderSettings::new(camera.camera(bounds));
         settings.filter = filter;
         settings.shading = match args.shading {
             RenderShading::Unlit => Shading::Unlit,

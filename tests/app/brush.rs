@@ -17,7 +17,8 @@ use meshpaint_core::colors::store::{ColorStore, SampleRef};
 use meshpaint_core::mesh::topology::Topology;
 use meshpaint_core::packing::packer;
 use meshpaint_core::paint::brush::{
-    self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, ResolutionOp, Tool,
+    self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, PressureResponse,
+    ResolutionOp, StrokePoint, Tool,
 };
 use meshpaint_core::paint::picking::{BvhPreset, MeshBvh};
 use meshpaint_core::paint::undo::UndoHistory;
@@ -104,7 +105,7 @@ impl Scene {
     }
 
     /// Replays a stroke with `settings` (one undo step) and returns its dabs.
-    fn stroke(&mut self, settings: BrushSettings, points: &[[f64; 2]]) -> Vec<brush::Dab> {
+    fn stroke<P: Copy + Into<StrokePoint>>(&mut self, settings: BrushSettings, points: &[P]) -> Vec<brush::Dab> {
         let mut painter = Painter::new(&self.positions);
         painter.set_settings(settings);
         let mut history = UndoHistory::default();
@@ -129,6 +130,7 @@ fn plain(tool: Tool, color: Rgba, radius: BrushRadius) -> BrushSettings {
         backface_culling: false,
         mirror_x: false,
         follow_resolution: None,
+        pressure: PressureResponse::default(),
     }
 }
 
@@ -973,15 +975,26 @@ fn repacking_after_painting_matches_packing_the_same_colours_directly() {
 
 #[test]
 fn strokes_and_colours_parse() {
-    assert_eq!(brush::parse_stroke("1,2  3.5,-4").unwrap(), vec![[1.0, 2.0], [3.5, -4.0]]);
-    assert!(brush::parse_stroke("").is_err());
-    assert!(brush::parse_stroke("1;2").is_err());
-    assert!(brush::parse_stroke("1,x").is_err());
+    let point = |x, y, pressure| StrokePoint { px: [x, y], pressure };
+    assert_eq!(brush::parse_stroke("1,2  3.5,-4").unwrap(), vec![point(1.0, 2.0, 1.0), point(3.5, -4.0, 1.0)]);
+    assert_eq!(brush::parse_stroke("1,2,0.5 3,4,0").unwrap(), vec![point(1.0, 2.0, 0.5), point(3.0, 4.0, 0.0)]);
+    for bad in ["", "1;2", "1,x", "1,2,1.5", "1,2,-0.1", "1,2,0.5,1", "1,2,nan"] {
+        assert!(brush::parse_stroke(bad).is_err(), "{bad:?} accepted");
+    }
     assert_eq!(brush::parse_hex_color("#ffffff"), Some([1.0, 1.0, 1.0, 1.0]));
     let c = brush::parse_hex_color("808080").unwrap();
     assert!((c[0] - 0.21586).abs() < 1e-4, "{c:?}");
-    assert_eq!(brush::parse_hex_color("#12345"), None);
-    assert_eq!(brush::parse_hex_color("#gg0000"), None);
+    // `#rgb` doubles each digit; spaces around are ignored.
+    assert_eq!(brush::parse_hex_color("#f80"), brush::parse_hex_color("#ff8800"));
+    assert_eq!(brush::parse_hex_color(" ff8800 "), brush::parse_hex_color("#ff8800"));
+    for bad in ["#12345", "#gg0000", "#ff88", "", "#", "+f80", "#ff88000"] {
+        assert_eq!(brush::parse_hex_color(bad), None, "{bad:?}");
+    }
+    for response in
+        [PressureResponse::NONE, PressureResponse::default(), PressureResponse { radius: true, strength: true }]
+    {
+        assert_eq!(PressureResponse::from_name(response.name()), Some(response));
+    }
     for falloff in Falloff::ALL {
         assert_eq!(Falloff::from_name(falloff.name()), Some(falloff));
         assert_eq!(falloff.weight(0.0), 1.0);
@@ -990,6 +1003,76 @@ fn strokes_and_colours_parse() {
     }
     let invalid = BrushSettings { strength: 1.5, ..BrushSettings::default() };
     assert!(invalid.validate().is_err());
+}
+
+// ---------------------------------------------------------------- pen pressure
+
+/// A one-point stroke at pressure 0.5 with pressure → radius places a dab of exactly half the
+/// full-pressure radius, and paints exactly the samples a brute-force distance test over
+/// every stored sample puts within that radius: about a quarter as many as at pressure 1.
+#[test]
+fn pressure_scales_the_dab_radius() {
+    let settings = plain(Tool::Paint, GREEN, BrushRadius::Pixels { radius_px: 60.0 });
+    let mut radii = Vec::new();
+    let mut counts = Vec::new();
+    for pressure in [1.0f32, 0.5] {
+        let mut scene = Scene::new(icosphere(3), 16, GREY, 30.0, 20.0);
+        let dabs = scene.stroke(settings, &[StrokePoint { px: [512.0, 384.0], pressure }]);
+        assert_eq!(dabs.len(), 1);
+        assert_eq!(dabs[0].pressure, pressure);
+        let (center, radius) = (DVec3::from_array(dabs[0].center_world), dabs[0].radius_world);
+        let mut inside = 0u64;
+        for (sample, p, _) in scene.sites() {
+            let margin = ((p - center).length() - radius) / radius;
+            if margin.abs() < 1e-6 {
+                continue;
+            }
+            let painted = bits(scene.store.get(sample).unwrap()) == bits(GREEN);
+            assert_eq!(painted, margin < 0.0, "pressure {pressure}: {sample:?} at margin {margin}");
+            inside += u64::from(margin < 0.0);
+        }
+        radii.push(radius);
+        counts.push(inside);
+    }
+    assert!((radii[1] / radii[0] - 0.5).abs() < 1e-9, "radii {radii:?}");
+    assert!(counts[1] > 100 && counts[1] * 3 < counts[0] && counts[1] * 5 > counts[0], "counts {counts:?}");
+}
+
+/// With pressure → strength the weight follows the pressure (Mix at constant falloff: half
+/// way to the brush colour at 0.5) and the radius does not; along a stroke the pressure is
+/// interpolated linearly between its points.
+#[test]
+fn pressure_scales_the_strength_and_is_interpolated_along_a_stroke() {
+    let mut settings = plain(Tool::Paint, GREEN, BrushRadius::Pixels { radius_px: 40.0 });
+    settings.pressure = PressureResponse { radius: false, strength: true };
+    let mut full = Scene::new(icosphere(3), 8, GREY, 30.0, 20.0);
+    let full_dab = full.stroke(settings, &[[512.0, 384.0]])[0];
+    let mut half = Scene::new(icosphere(3), 8, GREY, 30.0, 20.0);
+    let dab = half.stroke(settings, &[StrokePoint { px: [512.0, 384.0], pressure: 0.5 }])[0];
+    assert_eq!(dab.radius_world, full_dab.radius_world);
+    let center = DVec3::from_array(dab.center_world);
+    let mut checked = 0;
+    for (sample, p, _) in half.sites() {
+        if (p - center).length() < dab.radius_world * (1.0 - 1e-6) {
+            let now = half.store.get(sample).unwrap();
+            for c in 0..4 {
+                let expected = 0.5 * GREY[c] + 0.5 * GREEN[c];
+                assert!((now[c] - expected).abs() < 1e-6, "{sample:?}: {now:?}");
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 50, "{checked} samples inside");
+
+    let mut scene = Scene::new(icosphere(3), 4, GREY, 30.0, 20.0);
+    let (a, b) = ([400.0, 384.0], [640.0, 384.0]);
+    let dabs = scene.stroke(settings, &[StrokePoint { px: a, pressure: 1.0 }, StrokePoint { px: b, pressure: 0.2 }]);
+    assert!(dabs.len() > 10, "{} dabs", dabs.len());
+    for dab in &dabs {
+        let t = (dab.cursor_px[0] - a[0]) / (b[0] - a[0]);
+        let expected = 1.0 - 0.8 * t;
+        assert!((f64::from(dab.pressure) - expected).abs() < 1e-5, "at t = {t}: {}", dab.pressure);
+    }
 }
 
 // ---------------------------------------------------------------- headless replay (CLI)
@@ -1001,7 +1084,8 @@ fn the_paint_command_replays_strokes_like_the_library() {
     let dir = TempDir::new("paint-cli");
     let input = model("Duck/Duck.glb");
     let output = dir.join("painted.mpk");
-    let stroke = "300,300 700,400 500,600";
+    // With pen pressure on two points (pressure → radius, the default).
+    let stroke = "300,300 700,400,0.5 500,600,0.8";
     let status = std::process::Command::new(env!("CARGO_BIN_EXE_meshpaint"))
         .args(["paint", input.to_str().unwrap(), "--stroke", stroke, "--color", "#00ff00", "--radius-px", "20"])
         .args(["--strength", "0.8", "--width", "800", "--height", "600", "--yaw", "40", "--pitch", "-10"])
@@ -1050,6 +1134,8 @@ fn the_paint_command_replays_strokes_like_the_library() {
     assert!(meshpaint_core::mesh::import::import_gltf(&glb).is_ok());
     for bad in [
         vec!["--stroke", "1,2,3"],
+        vec!["--stroke", "1,2,0.5,1"],
+        vec!["--stroke", "1,2", "--pressure", "sideways"],
         vec!["--stroke", "1,2", "--color", "red"],
         vec!["--stroke", "1,2", "--strength", "2"],
         vec!["--stroke", "1,2", "--tool", "set"],

@@ -1029,3 +1029,51 @@ fn cli_render_mct_of_a_painted_mixed_resolution_duck_matches_mesh_colors_linear(
     println!("MCT vs mesh colors linear, coloured mixed-R Duck: {psnr:.1} dB");
     assert!(psnr >= 35.0, "{psnr} dB");
 }
+
+/// A tall box (1 × 1 × 3, Z-up, as scans often are) rendered with `--up z` stands upright:
+/// its silhouette is taller than wide, from the front and from the default angles; with the
+/// default Y up, seen from the side, it lies on its side (wider than tall).
+#[test]
+fn cli_render_up_z_shows_a_z_up_object_upright() {
+    let dir = common::TempDir::new("up-axis");
+    let obj = dir.join("tall.obj");
+    let mut text = String::new();
+    for z in [0.0, 3.0] {
+        for (x, y) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+            text.push_str(&format!("v {x} {y} {z}\n"));
+        }
+    }
+    // Counter-clockwise from outside.
+    for [a, b, c, d] in [[1, 4, 3, 2], [5, 6, 7, 8], [1, 2, 6, 5], [2, 3, 7, 6], [3, 4, 8, 7], [4, 1, 5, 8]] {
+        text.push_str(&format!("f {a} {b} {c}\nf {a} {c} {d}\n"));
+    }
+    std::fs::write(&obj, text).unwrap();
+    // (width, height) of the non-background pixels' bounding box.
+    let silhouette = |extra: &[&str]| {
+        let out = temp_png(&format!("up-{}", extra.join("")));
+        let mut args = vec!["render", obj.to_str().unwrap(), "-o", out.to_str().unwrap(), "--width", "160"];
+        args.extend(["--height", "160", "--shading", "unlit"]);
+        args.extend(extra);
+        let output = run_cli(&args);
+        assert!(output.status.success(), "{extra:?}: {}", String::from_utf8_lossy(&output.stderr));
+        let image = image::open(&out).unwrap().to_rgba8();
+        std::fs::remove_file(&out).unwrap();
+        let background = *image.get_pixel(0, 0);
+        let (mut min, mut max) = ((u32::MAX, u32::MAX), (0, 0));
+        for (x, y, pixel) in image.enumerate_pixels() {
+            if *pixel != background {
+                min = (min.0.min(x), min.1.min(y));
+                max = (max.0.max(x), max.1.max(y));
+            }
+        }
+        assert!(max.0 > min.0, "{extra:?}: nothing drawn");
+        (max.0 - min.0 + 1, max.1 - min.1 + 1)
+    };
+    for angles in [&["--yaw", "0", "--pitch", "0"][..], &[]] {
+        let (w, h) = silhouette(&[&["--up", "z"], angles].concat());
+        assert!(h as f64 > 1.5 * w as f64, "--up z {angles:?}: {w} × {h}, not upright");
+    }
+    // Y up, seen from the side (+X): the box lies along the screen's horizontal.
+    let (w, h) = silhouette(&["--yaw", "90", "--pitch", "0"]);
+    assert!(w as f64 > 1.5 * h as f64, "Y up: {w} × {h}, not lying on its side");
+}

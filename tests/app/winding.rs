@@ -108,6 +108,7 @@ fn culling_paints_the_visible_side(mesh: Mesh, what: &str) {
         backface_culling: true,
         mirror_x: false,
         follow_resolution: None,
+        pressure: meshpaint_core::paint::brush::PressureResponse::default(),
     });
     let eye = camera.eye();
     let center = DVec3::from_array(camera.target) + camera.eye_direction();

@@ -31,7 +31,7 @@ fn editor_with_duck() -> Editor {
 }
 
 fn harness(editor: Editor) -> Harness<'static, Editor> {
-    Harness::builder().with_size([1280.0, 800.0]).build_ui_state(|ui, editor: &mut Editor| editor.ui(ui), editor)
+    Harness::builder().with_size([1280.0, 1600.0]).build_ui_state(|ui, editor: &mut Editor| editor.ui(ui), editor)
 }
 
 #[test]
@@ -917,7 +917,7 @@ fn the_view_switches_to_mesh_color_textures_and_back_live() {
     use meshpaint_render::DrawItem;
     // Tall enough that the view panel's last rows are on screen without scrolling.
     let mut harness = Harness::builder()
-        .with_size([1280.0, 1100.0])
+        .with_size([1280.0, 1700.0])
         .build_ui_state(|ui, editor: &mut Editor| editor.ui(ui), editor_with_gpu_and_duck());
     harness.run_steps(2);
     harness.get_by_label("Representation:").click();

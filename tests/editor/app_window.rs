@@ -133,6 +133,8 @@ fn start_app(display: &str, dir: &Path, log_path: &Path, file: &Path, env: &[(&s
         .env("RUST_LOG", "meshpaint=info")
         .env("XDG_RUNTIME_DIR", dir)
         .env("XDG_STATE_HOME", dir)
+        // Its settings file in the test's directory, never the real one.
+        .env("MESHPAINT_CONFIG_DIR", dir)
         .current_dir(dir)
         .stdin(Stdio::null())
         .stdout(Stdio::null())

@@ -4,4 +4,5 @@
 mod common;
 
 mod app_ui;
+mod app_ui_tools;
 mod app_window;

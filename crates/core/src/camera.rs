@@ -1,7 +1,10 @@
 //! The orbit camera shared by the renderer, headless `render`, picking and stroke replay.
 //!
-//! Right-handed, +Y up. The camera orbits `target` at `distance`, `yaw_degrees` around +Y
-//! (0 looks along −Z, i.e. the eye is on +Z) and `pitch_degrees` up from the horizon.
+//! Right-handed, +Y up by default. The camera orbits `target` at `distance`, `yaw_degrees`
+//! around +Y (0 looks along −Z, i.e. the eye is on +Z) and `pitch_degrees` up from the
+//! horizon. With [`UpAxis::Z`] (scans and CAD files are often Z-up) the same angles are
+//! turned by +90° about X: +Z is up, yaw turns around +Z and yaw 0 looks along +Y from −Y
+//! (Blender's front view). Only the view turns; the geometry is never changed.
 //! Projection is perspective with reversed-Z-free standard depth `[0, 1]` (wgpu); near and
 //! far planes follow the scene's bounding sphere so depth precision holds at tiny and huge
 //! scales. Positions can be far from the origin (1e6): matrices are built relative to the
@@ -42,6 +45,50 @@ impl BoundingSphere {
     }
 }
 
+/// Which world axis points up on screen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum UpAxis {
+    /// +Y up (glTF, OBJ from most modelling tools).
+    #[default]
+    Y,
+    /// +Z up (many scans, CAD, Blender's own axes).
+    Z,
+}
+
+impl UpAxis {
+    /// Both axes.
+    pub const ALL: [UpAxis; 2] = [UpAxis::Y, UpAxis::Z];
+
+    /// The world-space unit vector pointing up.
+    pub fn vector(self) -> DVec3 {
+        match self {
+            UpAxis::Y => DVec3::Y,
+            UpAxis::Z => DVec3::Z,
+        }
+    }
+
+    /// A direction of the Y-up orbit frame in world space (+90° about X for Z-up).
+    pub fn to_world(self, v: DVec3) -> DVec3 {
+        match self {
+            UpAxis::Y => v,
+            UpAxis::Z => DVec3::new(v.x, -v.z, v.y),
+        }
+    }
+
+    /// The name (`y`, `z`).
+    pub fn name(self) -> &'static str {
+        match self {
+            UpAxis::Y => "y",
+            UpAxis::Z => "z",
+        }
+    }
+
+    /// Parses a name given by [`UpAxis::name`] (either case).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|a| a.name().eq_ignore_ascii_case(name))
+    }
+}
+
 /// A perspective orbit camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OrbitCamera {
@@ -57,6 +104,8 @@ pub struct OrbitCamera {
     pub fov_y_degrees: f64,
     /// Radius of the scene, used for the near and far planes.
     pub scene_radius: f64,
+    /// The world axis that is up on screen (yaw turns around it).
+    pub up: UpAxis,
 }
 
 /// Camera yaw of a newly opened document and of `meshpaint render`, degrees.
@@ -93,13 +142,14 @@ impl OrbitCamera {
             pitch_degrees: pitch_degrees.clamp(-89.0, 89.0),
             fov_y_degrees: fov,
             scene_radius: sphere.radius,
+            up: UpAxis::Y,
         }
     }
 
     /// Unit vector from the target towards the eye.
     pub fn eye_direction(&self) -> DVec3 {
         let (yaw, pitch) = (self.yaw_degrees.to_radians(), self.pitch_degrees.clamp(-89.0, 89.0).to_radians());
-        DVec3::new(yaw.sin() * pitch.cos(), pitch.sin(), yaw.cos() * pitch.cos())
+        self.up.to_world(DVec3::new(yaw.sin() * pitch.cos(), pitch.sin(), yaw.cos() * pitch.cos()))
     }
 
     /// Eye position, world space.
@@ -118,7 +168,11 @@ impl OrbitCamera {
 
     /// View matrix relative to `origin` (render positions as `p − origin` for precision).
     pub fn view_from_world_relative(&self, origin: DVec3) -> DMat4 {
-        glam::dcamera::rh::view::look_at_mat4(self.eye() - origin, DVec3::from_array(self.target) - origin, DVec3::Y)
+        glam::dcamera::rh::view::look_at_mat4(
+            self.eye() - origin,
+            DVec3::from_array(self.target) - origin,
+            self.up.vector(),
+        )
     }
 
     /// Projection matrix for a `width × height` image (depth range 0..1).
@@ -160,7 +214,7 @@ impl OrbitCamera {
         Some(((ndc.x + 1.0) * 0.5 * f64::from(width), (1.0 - ndc.y) * 0.5 * f64::from(height)))
     }
 
-    /// Turns the eye around the target: `delta_yaw` degrees around +Y, `delta_pitch` degrees
+    /// Turns the eye around the target: `delta_yaw` degrees around the up axis, `delta_pitch` degrees
     /// up (the pitch stays within ±89°, the yaw within (−180°, 180°]).
     pub fn orbit(&mut self, delta_yaw_degrees: f64, delta_pitch_degrees: f64) {
         let yaw = (self.yaw_degrees + delta_yaw_degrees).rem_euclid(360.0);
@@ -171,8 +225,8 @@ impl OrbitCamera {
     /// Unit vectors pointing right and up on screen, world space.
     pub fn right_up(&self) -> (DVec3, DVec3) {
         let towards_eye = self.eye_direction();
-        let right = DVec3::Y.cross(towards_eye).normalize_or(DVec3::X);
-        let up = towards_eye.cross(right).normalize_or(DVec3::Y);
+        let right = self.up.vector().cross(towards_eye).normalize_or(DVec3::X);
+        let up = towards_eye.cross(right).normalize_or(self.up.vector());
         (right, up)
     }
 
@@ -282,6 +336,32 @@ mod tests {
             assert!(near > 0.0 && near < camera.distance - radius);
             assert!(far > camera.distance + radius);
         }
+    }
+
+    /// With Z up the same angles look at the scene turned +90° about X: the eye's direction
+    /// is the Y-up one turned, +Z projects upwards on screen, and rays and projection agree.
+    #[test]
+    fn z_up_turns_the_view_and_keeps_plus_z_up_on_screen() {
+        let sphere = BoundingSphere { center: [1.0, 2.0, 3.0], radius: 2.0 };
+        let y_up = OrbitCamera::framing(sphere, 30.0, 20.0);
+        let z_up = OrbitCamera { up: UpAxis::Z, ..y_up };
+        let d = y_up.eye_direction();
+        assert!((z_up.eye_direction() - DVec3::new(d.x, -d.z, d.y)).length() < 1e-12);
+        let center = DVec3::from_array(sphere.center);
+        for (camera, up) in [(y_up, DVec3::Y), (z_up, DVec3::Z)] {
+            let (_, y0) = camera.project(center, 640, 480).unwrap();
+            let (_, y1) = camera.project(center + up * 0.5, 640, 480).unwrap();
+            assert!(y1 < y0 - 10.0, "{:?}: up moved from {y0} to {y1}", camera.up);
+            assert!(camera.right_up().1.dot(up) > 0.9);
+            let (x, y) = camera.project(center + DVec3::new(0.3, -0.2, 0.4), 640, 480).unwrap();
+            let (origin, direction) = camera.ray_through_pixel(x, y, 640, 480);
+            let to_point = center + DVec3::new(0.3, -0.2, 0.4) - origin;
+            assert!((to_point - direction * to_point.dot(direction)).length() < 1e-9);
+        }
+        // Front view with Z up looks along +Y (the eye on −Y), as in Blender.
+        let front = OrbitCamera { up: UpAxis::Z, yaw_degrees: 0.0, pitch_degrees: 0.0, ..y_up };
+        assert!((front.eye_direction() - DVec3::NEG_Y).length() < 1e-12);
+        assert_eq!(UpAxis::from_name("Z"), Some(UpAxis::Z));
     }
 
     #[test]

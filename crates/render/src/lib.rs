@@ -37,6 +37,7 @@
 mod baseline;
 mod context;
 mod gpu;
+mod heat;
 mod layouts;
 mod mct;
 mod mesh_gpu;
@@ -47,6 +48,7 @@ mod uniforms;
 pub use baseline::{BaselineMesh, BaselineSource, BaselineVertex, mip_chain_linear};
 pub use context::{GpuContext, backends_from_env};
 pub use gpu::{Gpu, PaintUpload};
+pub use heat::{HEAT_COLORS, heat_color};
 pub use layouts::BindLayouts;
 pub use mct::GpuMct;
 pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshGeometry, MeshUploadOptions, atlas_texture_format, default_atlas_width};

@@ -137,8 +137,7 @@ impl RenderSettings {
     /// Unit vector towards the light, world space: from the eye, tilted up and to the left.
     pub fn light_direction(&self) -> DVec3 {
         let towards_eye = self.camera.eye_direction();
-        let right = DVec3::Y.cross(towards_eye).normalize_or(DVec3::X);
-        let up = towards_eye.cross(right).normalize_or(DVec3::Y);
+        let (right, up) = self.camera.right_up();
         (towards_eye + 0.6 * up - 0.4 * right).normalize_or(towards_eye)
     }
 }

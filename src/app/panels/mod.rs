@@ -10,8 +10,8 @@
 //! | [`FilePanel`] | [`file`] | the file dialog, the directory dialogs start in |
 //! | [`ImportSettings`] | `import_settings` (app level: the file dialog shows it too) | the resolution choice for opened meshes |
 //! | [`AutosavePanel`] | [`autosave`] | autosave settings, timer and recovery offer |
-//! | [`ViewPanel`] | [`view`] | view settings, the last PSNR |
-//! | [`PaintPanel`] | [`paint`] | the brush, the resolution of "Set R for all" |
+//! | [`ViewPanel`] | [`view`] (the heat map's legend: [`heat_legend`]) | view settings, the last PSNR |
+//! | [`PaintPanel`] | [`paint`] (its sections: [`color`], [`presets`]) | the brush, the colour wheel and hex field, the recent colours, the brush presets, the resolution of "Set R for all" |
 //! | [`OptimizePanel`] | [`optimize`] | Optimize's error bound |
 //! | [`UndoPanel`] | [`undo`] | nothing (shows the document's history) |
 //! | [`ScenePanel`] | [`scene`] | "Redraw continuously" |
@@ -20,11 +20,14 @@
 //! | [`ViewportArea`] | [`viewport`] | nothing (the editor records its area) |
 
 pub mod autosave;
+pub mod color;
 pub mod file;
+pub mod heat_legend;
 pub mod help;
 pub mod menu;
 pub mod optimize;
 pub mod paint;
+pub mod presets;
 pub mod scene;
 pub mod status_line;
 pub mod undo;

@@ -1,14 +1,19 @@
-//! The paint panel: enter / leave paint mode, the brush settings (tool, colour, radius,
-//! strength, falloff, spacing, blend mode, occlusion, culling, mirror) and the commands
-//! eyedropper, fill and "Set R for all". The brush is this panel's state; the editor lends
-//! it to paint mode's strokes.
+//! The paint panel: enter / leave paint mode, the brush presets ([`super::presets`]), the
+//! brush settings (tool, colour with the
+//! wheel, hex field and recent colours of [`super::color`], radius, strength, falloff,
+//! spacing, blend mode, occlusion, culling, mirror) and the commands eyedropper, fill and
+//! "Set R for all". The brush and the recent colours are this panel's state; the editor
+//! lends them to paint mode's strokes (which record the colours they paint with).
 
 use meshpaint_core::colors::layout::Resolution;
 use meshpaint_core::paint::brush::{
     BlendMode, BrushRadius, BrushSettings, FOLLOW_BRUSH_MAX_RESOLUTION, Falloff, ResolutionOp, Tool,
 };
 
+use super::color::ColorPicker;
+use super::presets::PresetsPanel;
 use crate::app::command::Command;
+use crate::app::recent_colors::RecentColors;
 use crate::app::state::Action;
 use crate::app::widgets::resolution_combo;
 
@@ -19,6 +24,12 @@ pub struct PaintPanel {
     pub brush: BrushSettings,
     /// The resolution of "Set R for all".
     pub resolution_for_all: Resolution,
+    /// The colour wheel and hex field.
+    pub picker: ColorPicker,
+    /// The last distinct colours strokes painted with.
+    pub recent_colors: RecentColors,
+    /// The brush presets.
+    pub presets: PresetsPanel,
 }
 
 impl Default for PaintPanel {
@@ -26,6 +37,9 @@ impl Default for PaintPanel {
         PaintPanel {
             brush: BrushSettings::default(),
             resolution_for_all: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
+            picker: ColorPicker::default(),
+            recent_colors: RecentColors::default(),
+            presets: PresetsPanel::default(),
         }
     }
 }
@@ -49,6 +63,10 @@ impl PaintPanel {
         if ui.add_enabled(ctx.has_document, egui::Button::new(button)).clicked() {
             commands.push(Command::Action(Action::TogglePaintMode));
         }
+        self.presets.ui(ui, &mut self.brush);
+        ui.separator();
+        tool_ui(ui, &mut self.brush);
+        self.picker.ui(ui, &mut self.brush.color, &self.recent_colors);
         brush_settings_ui(ui, &mut self.brush, ctx.bounds_radius);
         ui.separator();
         ui.add_enabled_ui(ctx.painting, |ui| {
@@ -74,15 +92,8 @@ impl PaintPanel {
     }
 }
 
-/// The egui colour of a linear straight-alpha colour.
-fn to_egui(color: [f32; 4]) -> egui::Rgba {
-    egui::Rgba::from_rgba_unmultiplied(color[0], color[1], color[2], color[3])
-}
-
-/// The brush settings: tool, colour, radius (pixels or world units; `bounds_radius` of the
-/// mesh scales the world slider), strength, spacing, falloff, blend, occlusion, culling,
-/// mirror, edited in place.
-fn brush_settings_ui(ui: &mut egui::Ui, brush: &mut BrushSettings, bounds_radius: Option<f64>) {
+/// The tool row (and the resolution tool's operation).
+fn tool_ui(ui: &mut egui::Ui, brush: &mut BrushSettings) {
     ui.horizontal(|ui| {
         ui.label("Tool:");
         ui.selectable_value(&mut brush.tool, Tool::Paint, "Colour");
@@ -105,15 +116,12 @@ fn brush_settings_ui(ui: &mut egui::Ui, brush: &mut BrushSettings, bounds_radius
             ui.horizontal(|ui| resolution_combo(ui, "To R", r));
         }
     }
-    ui.horizontal(|ui| {
-        ui.label("Colour:");
-        let mut color = to_egui(brush.color);
-        if egui::color_picker::color_edit_button_rgba(ui, &mut color, egui::color_picker::Alpha::OnlyBlend).changed() {
-            brush.color = color.to_rgba_unmultiplied();
-        }
-        let [r, g, b, _] = brush.color.map(meshpaint_core::colors::format::encode_srgb8);
-        ui.label(egui::RichText::new(format!("#{r:02x}{g:02x}{b:02x}")).monospace().weak());
-    });
+}
+
+/// The brush settings after the tool and the colour: radius (pixels or world units;
+/// `bounds_radius` of the mesh scales the world slider), strength, spacing, falloff, blend,
+/// occlusion, culling, mirror, edited in place.
+fn brush_settings_ui(ui: &mut egui::Ui, brush: &mut BrushSettings, bounds_radius: Option<f64>) {
     ui.horizontal(|ui| {
         let mut world = matches!(brush.radius, BrushRadius::World { .. });
         ui.label("Radius in:");

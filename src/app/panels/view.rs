@@ -72,6 +72,11 @@ impl ViewPanel {
             ui.checkbox(&mut view.overlays.heatmap, "Resolution heat map")
                 .on_hover_text("H — log2 R: dark blue 0, blue, cyan, green, yellow, orange, magenta 12");
         });
+        if view.overlays.heatmap {
+            let levels = ctx.document.map(|d| d.document.store.face_resolutions().iter().map(|r| r.log2()));
+            let present = levels.and_then(|levels| Some((levels.clone().min()?, levels.max()?)));
+            super::heat_legend::heat_legend_ui(ui, present);
+        }
         ui.horizontal(|ui| {
             if ui.button("Frame all").on_hover_text("Home").clicked() {
                 commands.push(Command::Action(Action::FrameAll));

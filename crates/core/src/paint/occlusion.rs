@@ -96,7 +96,9 @@ impl DepthMap {
             return None;
         }
         let forward = (target - eye).normalize_or_zero();
-        let right = forward.cross(DVec3::Y).normalize_or_zero();
+        // Any up that is not along `forward` gives the same depths; the camera's keeps the
+        // map's frame upright (and defined when looking straight down Y with Z up).
+        let right = forward.cross(camera.up.vector()).normalize_or_zero();
         let up = right.cross(forward);
         let tan_half = (camera.fov_y_degrees.to_radians() * 0.5).tan();
         if forward == DVec3::ZERO || right == DVec3::ZERO || !(tan_half.is_finite() && tan_half > 0.0) {

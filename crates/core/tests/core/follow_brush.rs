@@ -43,6 +43,7 @@ fn stroke(start: u32, follow: Option<Resolution>, radius: f64) -> Stroke {
         backface_culling: true,
         mirror_x: false,
         follow_resolution: follow,
+        pressure: meshpaint_core::paint::brush::PressureResponse::default(),
     });
     let mut history = UndoHistory::default();
     let centers: Vec<DVec3> = (0..8)

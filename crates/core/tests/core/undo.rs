@@ -110,6 +110,7 @@ fn settings(tool: Tool, blend: BlendMode, color: Rgba, radius_px: f64) -> BrushS
         backface_culling: true,
         mirror_x: true,
         follow_resolution: None,
+        pressure: meshpaint_core::paint::brush::PressureResponse::default(),
     }
 }
 

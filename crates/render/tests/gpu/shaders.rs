@@ -168,3 +168,45 @@ fn the_wgsl_mct_band_table_matches_the_rust_struct() {
     // The shader's group count is the core's.
     assert!(MCT_WGSL.contains(&format!("const MCT_GROUPS: u32 = {}u;", meshpaint_core::mct::layout::GROUPS)));
 }
+
+/// The f32 literals of a constant expression, in order (vectors and arrays flattened).
+fn literals(
+    arena: &naga::Arena<naga::Expression>,
+    module: &naga::Module,
+    expr: naga::Handle<naga::Expression>,
+) -> Vec<f32> {
+    match &arena[expr] {
+        naga::Expression::Literal(naga::Literal::F32(value)) => vec![*value],
+        naga::Expression::Compose { components, .. } => {
+            components.iter().flat_map(|&c| literals(arena, module, c)).collect()
+        }
+        naga::Expression::Splat { size, value } => literals(arena, module, *value).repeat(*size as usize),
+        naga::Expression::Constant(constant) => {
+            literals(&module.global_expressions, module, module.constants[*constant].init)
+        }
+        other => panic!("unexpected expression in the heat map table: {other:?}"),
+    }
+}
+
+/// The legend's colours (`meshpaint_render::HEAT_COLORS`) are the shader's: the table that
+/// `heat_color` in the compiled mesh-colors shader initialises, read from naga's IR, equals
+/// the CPU copy value for value (13 entries, log2 R = 0..=12).
+#[test]
+fn the_heat_map_colours_on_the_cpu_are_the_shaders() {
+    let (module, _) = validate("mesh_colors.wgsl", MESH_COLORS_WGSL);
+    let (_, function) = module
+        .functions
+        .iter()
+        .find(|(_, f)| f.name.as_deref() == Some("heat_color"))
+        .expect("mesh_colors.wgsl has no heat_color");
+    let tables: Vec<Vec<f32>> = function
+        .local_variables
+        .iter()
+        .filter_map(|(_, var)| var.init)
+        .map(|init| literals(&function.expressions, &module, init))
+        .collect();
+    assert_eq!(tables.len(), 1, "heat_color has one table");
+    let cpu: Vec<f32> = meshpaint_render::HEAT_COLORS.iter().flatten().copied().collect();
+    assert_eq!(tables[0], cpu);
+    assert_eq!(meshpaint_render::heat_color(20), meshpaint_render::HEAT_COLORS[12], "R past 4096 clamps");
+}

@@ -25,7 +25,7 @@
 //! | file | what |
 //! |---|---|
 //! | `error.rs` | [`BrushError`] |
-//! | `settings.rs` | [`BrushSettings`], [`Tool`], [`Falloff`], [`BlendMode`], [`BrushRadius`], [`ResolutionOp`], validation |
+//! | `settings.rs` | [`BrushSettings`], [`Tool`], [`Falloff`], [`BlendMode`], [`BrushRadius`], [`ResolutionOp`], [`PressureResponse`], [`StrokePoint`], validation |
 //! | `footprint.rs` | where a dab reaches: the `Coverage` trait, the dab's spheres, fill's "everywhere", [`visible`] |
 //! | `stencil.rs` | the blur's lattice stencils, one per face resolution (neighbours and holders of every lattice point) |
 //! | `scratch.rs` | per-mesh scratch reused across dabs, mask accumulation (pass 1 of a dab) |
@@ -41,7 +41,11 @@
 //! # A stroke
 //!
 //! Cursor positions arrive as pixel coordinates (origin top-left, as
-//! [`OrbitCamera::ray_through_pixel`] takes them). Between two successive positions dabs
+//! [`OrbitCamera::ray_through_pixel`] takes them), each a [`StrokePoint`] with a pen pressure
+//! (1.0 from a mouse; `[x, y]` converts to one). The pressure is interpolated along each
+//! segment and, as [`BrushSettings::pressure`] says, scales each dab's radius and / or
+//! strength (winit has no tablet pressure yet: the editor passes 1.0, `meshpaint paint
+//! --stroke x,y,p` replays it). Between two successive positions dabs
 //! are placed along the segment *in screen space* every `spacing_percent` % of the brush
 //! radius in pixels (the remainder carries over to the next segment), so a fast stroke
 //! whose events are far apart still paints a continuous band (ArmorPaint issue #937). Each
@@ -123,7 +127,7 @@ pub use kernels::DabStats;
 pub use painter::{Dab, MAX_DABS_PER_SEGMENT, MIN_SPACING_PX, PaintView, Painter, StrokeUpdate};
 pub use replay::{parse_hex_color, parse_stroke, replay_stroke, samples_within};
 pub use settings::{
-    BlendMode, BrushRadius, BrushSettings, FOLLOW_BRUSH_MAX_RESOLUTION, Falloff, ResolutionOp, Tool,
-    resolution_for_brush,
+    BlendMode, BrushRadius, BrushSettings, FOLLOW_BRUSH_MAX_RESOLUTION, Falloff, PressureResponse, ResolutionOp,
+    StrokePoint, Tool, resolution_for_brush,
 };
 pub use tools::{FillScope, connected_faces, eyedropper, fill, set_resolution};

@@ -16,7 +16,7 @@ use super::error::BrushError;
 use super::footprint::{Footprint, Occlusion};
 use super::kernels::{DabStats, PaintOp, paint_faces};
 use super::scratch::{Scratch, position};
-use super::settings::{BlendMode, BrushRadius, BrushSettings, ResolutionOp, Tool, resolution_for_brush};
+use super::settings::{BlendMode, BrushRadius, BrushSettings, ResolutionOp, StrokePoint, Tool, resolution_for_brush};
 use crate::colors::layout::Resolution;
 use crate::paint::occlusion::DepthMap;
 
@@ -63,10 +63,12 @@ pub struct Dab {
     pub cursor_px: [f64; 2],
     /// Brush centre: the ray's hit, world space.
     pub center_world: [f64; 3],
-    /// Brush radius, world units.
+    /// Brush radius, world units (pen pressure applied).
     pub radius_world: f64,
     /// The face hit.
     pub face: u32,
+    /// The pen pressure at the dab (interpolated between the stroke's points).
+    pub pressure: f32,
 }
 
 /// What one stroke call did.
@@ -83,6 +85,8 @@ pub struct StrokeUpdate {
 struct StrokeState {
     settings: BrushSettings,
     last_cursor_px: [f64; 2],
+    /// The pen pressure at the previous position.
+    last_pressure: f32,
     /// Screen distance travelled since the last dab position.
     since_dab_px: f64,
     /// World units per pixel at the last hit.
@@ -184,46 +188,59 @@ impl Painter {
         self.stroke.is_some()
     }
 
-    /// Starts a stroke at `cursor_px` with the current settings: opens an undo step and
-    /// places the first dab (none when the cursor is off the mesh). A stroke in progress is
-    /// ended first.
+    /// Starts a stroke at `point` (a cursor position in pixels, with its pen pressure; `[x, y]`
+    /// is full pressure) with the current settings: opens an undo step and places the first
+    /// dab (none when the cursor is off the mesh). A stroke in progress is ended first.
     pub fn begin_stroke(
         &mut self,
         view: &PaintView,
         store: &mut ColorStore,
         history: &mut UndoHistory,
-        cursor_px: [f64; 2],
+        point: impl Into<StrokePoint>,
     ) -> Result<StrokeUpdate, BrushError> {
         self.end_stroke(history);
+        let point = point.into();
         let settings = self.settings;
         settings.validate()?;
+        point.validate()?;
         check_view(view, store, &settings)?;
         history.begin_step(store, settings.label())?;
         self.scratch.fit(store);
         self.scratch.next_stroke();
         self.tracker = None;
-        self.stroke = Some(StrokeState { settings, last_cursor_px: cursor_px, since_dab_px: 0.0, world_per_px: None });
+        self.stroke = Some(StrokeState {
+            settings,
+            last_cursor_px: point.px,
+            last_pressure: point.pressure,
+            since_dab_px: 0.0,
+            world_per_px: None,
+        });
         let mut update = StrokeUpdate::default();
-        if let Err(error) = self.dab_at_cursor(view, store, history, cursor_px, &mut update) {
+        if let Err(error) = self.dab_at_cursor(view, store, history, point, &mut update) {
             self.end_stroke(history);
             return Err(error);
         }
         Ok(update)
     }
 
-    /// Extends the stroke to `cursor_px`, placing dabs every spacing along the screen
-    /// segment from the previous position. Does nothing without a stroke.
+    /// Extends the stroke to `point`, placing dabs every spacing along the screen segment
+    /// from the previous position, the pressure interpolated along it. Does nothing without
+    /// a stroke.
     pub fn stroke_to(
         &mut self,
         view: &PaintView,
         store: &mut ColorStore,
         history: &mut UndoHistory,
-        cursor_px: [f64; 2],
+        point: impl Into<StrokePoint>,
     ) -> Result<StrokeUpdate, BrushError> {
         let mut update = StrokeUpdate::default();
+        let point = point.into();
+        point.validate()?;
         let Some(state) = self.stroke else {
             return Ok(update);
         };
+        let cursor_px = point.px;
+        let (p0, p1) = (state.last_pressure, point.pressure);
         let [x0, y0] = state.last_cursor_px;
         let (dx, dy) = (cursor_px[0] - x0, cursor_px[1] - y0);
         let length = dx.hypot(dy);
@@ -238,20 +255,24 @@ impl Painter {
                 radius_world / world_per_px.max(f64::MIN_POSITIVE)
             }
         };
-        let spacing = (state.settings.spacing_percent / 100.0 * radius_px).max(MIN_SPACING_PX);
+        // Spacing follows the smaller radius of the segment's two ends.
+        let (radius_factor, _) = state.settings.pressure.factors(p0.min(p1));
+        let spacing = (state.settings.spacing_percent / 100.0 * radius_px * radius_factor).max(MIN_SPACING_PX);
         // Distance along this segment to the next dab.
         let mut along = spacing - state.since_dab_px;
         let mut placed = 0;
         let mut last_along = -state.since_dab_px;
         while along <= length && placed < MAX_DABS_PER_SEGMENT {
             let t = along / length;
-            self.dab_at_cursor(view, store, history, [x0 + dx * t, y0 + dy * t], &mut update)?;
+            let at = StrokePoint { px: [x0 + dx * t, y0 + dy * t], pressure: p0 + (p1 - p0) * t as f32 };
+            self.dab_at_cursor(view, store, history, at, &mut update)?;
             last_along = along;
             along += spacing;
             placed += 1;
         }
         if let Some(state) = self.stroke.as_mut() {
             state.last_cursor_px = cursor_px;
+            state.last_pressure = p1;
             state.since_dab_px = (length - last_along).max(0.0);
         }
         Ok(update)
@@ -264,36 +285,46 @@ impl Painter {
         history.end_step()
     }
 
-    /// One dab at the cursor (a stroke must be in progress).
+    /// One dab at the cursor, radius and strength scaled by its pressure as the settings say
+    /// (a stroke must be in progress).
     fn dab_at_cursor(
         &mut self,
         view: &PaintView,
         store: &mut ColorStore,
         history: &mut UndoHistory,
-        cursor_px: [f64; 2],
+        point: StrokePoint,
         update: &mut StrokeUpdate,
     ) -> Result<(), BrushError> {
         let Some(state) = self.stroke else {
             return Ok(());
         };
+        let cursor_px = point.px;
         let Some(hit) = view.pick(cursor_px) else {
             return Ok(());
         };
         let center = DVec3::from_array(hit.position_world);
         let world_per_px = view.world_per_px_at(center);
-        let radius_world = match state.settings.radius {
-            BrushRadius::Pixels { radius_px } => radius_px * world_per_px,
-            BrushRadius::World { radius_world } => radius_world,
-        };
+        let (radius_factor, strength_factor) = state.settings.pressure.factors(point.pressure);
+        let radius_world = radius_factor
+            * match state.settings.radius {
+                BrushRadius::Pixels { radius_px } => radius_px * world_per_px,
+                BrushRadius::World { radius_world } => radius_world,
+            };
+        let settings = BrushSettings { strength: state.settings.strength * strength_factor, ..state.settings };
         if let Some(state) = self.stroke.as_mut()
             && world_per_px > 0.0
         {
             state.world_per_px = Some(world_per_px);
         }
-        let stats =
-            self.dab_with(&state.settings, view, &mut StoreWriter::new(store, history), center, radius_world)?;
+        let stats = self.dab_with(&settings, view, &mut StoreWriter::new(store, history), center, radius_world)?;
         update.stats.add(stats);
-        update.dabs.push(Dab { cursor_px, center_world: hit.position_world, radius_world, face: hit.face });
+        update.dabs.push(Dab {
+            cursor_px,
+            center_world: hit.position_world,
+            radius_world,
+            face: hit.face,
+            pressure: point.pressure,
+        });
         Ok(())
     }
 

@@ -11,15 +11,22 @@ use super::error::BrushError;
 use super::footprint::{Coverage, Footprint};
 use super::painter::{PaintView, Painter, StrokeUpdate};
 use super::scratch::{Scratch, accumulate_masks, face_elements, position};
-use super::settings::Falloff;
+use super::settings::{Falloff, StrokePoint};
 
-/// Parses `#rrggbb` (or `rrggbb`) as an sRGB colour and returns it in linear light, opaque.
+/// Parses `#rrggbb` or `#rgb` (the `#` optional, surrounding spaces ignored) as an sRGB
+/// colour and returns it in linear light, opaque. `#rgb` is `#rrggbb` with each digit
+/// doubled (CSS).
 pub fn parse_hex_color(text: &str) -> Option<Rgba> {
+    let text = text.trim();
     let hex = text.strip_prefix('#').unwrap_or(text);
-    if hex.len() != 6 || !hex.is_ascii() {
+    if !hex.bytes().all(|b| b.is_ascii_hexdigit()) {
         return None;
     }
-    let channel = |k: usize| u8::from_str_radix(&hex[2 * k..2 * k + 2], 16).ok();
+    let channel = |k: usize| match hex.len() {
+        6 => u8::from_str_radix(&hex[2 * k..2 * k + 2], 16).ok(),
+        3 => u8::from_str_radix(&hex[k..k + 1], 16).ok().map(|d| d * 17),
+        _ => None,
+    };
     let (r, g, b) = (channel(0)?, channel(1)?, channel(2)?);
     Some([
         crate::colors::format::decode_srgb8(r),
@@ -29,32 +36,41 @@ pub fn parse_hex_color(text: &str) -> Option<Rgba> {
     ])
 }
 
-/// Parses a stroke given as `"x0,y0 x1,y1 …"` (pixels).
-pub fn parse_stroke(text: &str) -> Result<Vec<[f64; 2]>, String> {
+/// Parses a stroke given as `"x0,y0 x1,y1,p1 …"`: pixels, each point with an optional pen
+/// pressure `p` in `0..=1` (1.0 when left out, as from a mouse).
+pub fn parse_stroke(text: &str) -> Result<Vec<StrokePoint>, String> {
     text.split_whitespace()
-        .map(|pair| {
-            let (x, y) = pair.split_once(',').ok_or_else(|| format!("'{pair}' is not x,y"))?;
-            let x: f64 = x.trim().parse().map_err(|_| format!("'{x}' in '{pair}' is not a number"))?;
-            let y: f64 = y.trim().parse().map_err(|_| format!("'{y}' in '{pair}' is not a number"))?;
-            if !(x.is_finite() && y.is_finite()) {
-                return Err(format!("'{pair}' is not finite"));
+        .map(|point| {
+            let parts: Vec<&str> = point.split(',').collect();
+            let number = |part: &str| -> Result<f64, String> {
+                let value: f64 = part.trim().parse().map_err(|_| format!("'{part}' in '{point}' is not a number"))?;
+                if value.is_finite() { Ok(value) } else { Err(format!("'{point}' is not finite")) }
+            };
+            let (x, y, pressure) = match parts.as_slice() {
+                [x, y] => (number(x)?, number(y)?, 1.0),
+                [x, y, p] => (number(x)?, number(y)?, number(p)?),
+                _ => return Err(format!("'{point}' is not x,y or x,y,pressure")),
+            };
+            if !(0.0..=1.0).contains(&pressure) {
+                return Err(format!("pressure {pressure} in '{point}' is not in 0..=1"));
             }
-            Ok([x, y])
+            Ok(StrokePoint { px: [x, y], pressure: pressure as f32 })
         })
         .collect::<Result<Vec<_>, _>>()
         .and_then(|points| if points.is_empty() { Err("the stroke has no points".into()) } else { Ok(points) })
 }
 
-/// Replays one stroke through `cursor_px` positions: begin, extend, end. Returns the
-/// combined update and the closed step's summary.
-pub fn replay_stroke(
+/// Replays one stroke through `points` (cursor positions `[x, y]` in pixels, or
+/// [`StrokePoint`]s with their pressure): begin, extend, end. Returns the combined update and
+/// the closed step's summary.
+pub fn replay_stroke<P: Copy + Into<StrokePoint>>(
     painter: &mut Painter,
     view: &PaintView,
     store: &mut ColorStore,
     history: &mut UndoHistory,
-    cursor_px: &[[f64; 2]],
+    points: &[P],
 ) -> Result<(StrokeUpdate, Option<StepSummary>), BrushError> {
-    let Some((&first, rest)) = cursor_px.split_first() else {
+    let Some((&first, rest)) = points.split_first() else {
         return Ok((StrokeUpdate::default(), None));
     };
     let mut total = painter.begin_stroke(view, store, history, first)?;

@@ -185,6 +185,87 @@ pub enum Tool {
     Resolution(ResolutionOp),
 }
 
+/// What a stroke point's pen pressure (`0..=1`, 1.0 from a mouse) feeds: each dab's radius
+/// and / or strength is multiplied by the pressure where the dab is placed (interpolated
+/// between the stroke's points).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct PressureResponse {
+    /// The radius follows the pressure (a dab at `p` has `p ·` the radius).
+    pub radius: bool,
+    /// The strength follows the pressure (a dab at `p` has `p ·` the strength).
+    pub strength: bool,
+}
+
+impl Default for PressureResponse {
+    /// Radius follows pressure (the common default of painting programs), strength does not.
+    fn default() -> Self {
+        PressureResponse { radius: true, strength: false }
+    }
+}
+
+impl PressureResponse {
+    /// Neither follows the pressure.
+    pub const NONE: PressureResponse = PressureResponse { radius: false, strength: false };
+
+    /// The command-line name (`none`, `radius`, `strength`, `both`).
+    pub fn name(self) -> &'static str {
+        match (self.radius, self.strength) {
+            (false, false) => "none",
+            (true, false) => "radius",
+            (false, true) => "strength",
+            (true, true) => "both",
+        }
+    }
+
+    /// Parses a name given by [`PressureResponse::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "none" => Some(Self::NONE),
+            "radius" => Some(PressureResponse { radius: true, strength: false }),
+            "strength" => Some(PressureResponse { radius: false, strength: true }),
+            "both" => Some(PressureResponse { radius: true, strength: true }),
+            _ => None,
+        }
+    }
+
+    /// The radius and strength factors of a dab at `pressure` (clamped to `0..=1`; NaN is 0).
+    pub fn factors(self, pressure: f32) -> (f64, f32) {
+        let p = if pressure.is_nan() { 0.0 } else { pressure.clamp(0.0, 1.0) };
+        (if self.radius { f64::from(p) } else { 1.0 }, if self.strength { p } else { 1.0 })
+    }
+}
+
+/// One point of a stroke: the cursor in pixels and the pen pressure there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StrokePoint {
+    /// Cursor position, pixels (origin top-left).
+    pub px: [f64; 2],
+    /// Pen pressure, `0..=1` (1.0 from a mouse).
+    pub pressure: f32,
+}
+
+impl StrokePoint {
+    /// A point at `px` with full pressure (a mouse, or a pen pressed fully).
+    pub fn mouse(px: [f64; 2]) -> Self {
+        StrokePoint { px, pressure: 1.0 }
+    }
+
+    /// Checks the pressure is a number in `0..=1`.
+    pub fn validate(&self) -> Result<(), BrushError> {
+        if (0.0..=1.0).contains(&self.pressure) {
+            Ok(())
+        } else {
+            Err(BrushError::InvalidSetting(format!("pressure {} is not in 0..=1", self.pressure)))
+        }
+    }
+}
+
+impl From<[f64; 2]> for StrokePoint {
+    fn from(px: [f64; 2]) -> Self {
+        StrokePoint::mouse(px)
+    }
+}
+
 /// The largest `R` resolution-follows-the-brush raises a face to (the editor's setting).
 pub const FOLLOW_BRUSH_MAX_RESOLUTION: Resolution = Resolution::SIXTY_FOUR;
 
@@ -216,6 +297,8 @@ pub struct BrushSettings {
     /// to the smallest power of two that resolves it, `R ≥ 4 · longest edge / radius`,
     /// capped at this value (`None`: off). Never lowers a face.
     pub follow_resolution: Option<Resolution>,
+    /// What the stroke points' pen pressure feeds (nothing changes at pressure 1.0).
+    pub pressure: PressureResponse,
 }
 
 /// The resolution a face needs to resolve a brush of `radius_world` (sample spacing at most a
@@ -243,6 +326,7 @@ impl Default for BrushSettings {
             backface_culling: true,
             mirror_x: false,
             follow_resolution: None,
+            pressure: PressureResponse::default(),
         }
     }
 }
