@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The editor with its painting tools in view (colour wheel, hex field, recent colours, brush
 # presets, the heat map with its legend), as a PNG: the real window under Xvfb, one stroke
-# painted with each of three colours, the heat map on. Settings go to a temporary directory.
+# painted with each of three colours, the heat map on (or, with FINAL_KEY=F1, the help window
+# instead). Settings go to a temporary directory.
 #   tools/tools_screenshot.sh [OUT.png] [path/to/meshpaint]
 set -euo pipefail
 out=${1:-target/test-output/tools.png}
@@ -39,7 +40,7 @@ for color in ff8800 2a7fff 33cc44; do
     sleep 2
 done
 xdotool mousemove 1200 1200
-xdotool key h
+xdotool key "${FINAL_KEY:-h}"
 sleep 3
 mkdir -p "$(dirname "$out")"
 import -window root "$out"
