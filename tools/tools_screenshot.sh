@@ -2,7 +2,7 @@
 # The editor with its painting tools in view (colour wheel, hex field, recent colours, brush
 # presets, the heat map with its legend), as a PNG: the real window under Xvfb, one stroke
 # painted with each of three colours, the heat map on (or, with FINAL_KEY=F1, the help window
-# instead). Settings go to a temporary directory.
+# instead; COLORS="" paints nothing). Settings go to a temporary directory.
 #   tools/tools_screenshot.sh [OUT.png] [path/to/meshpaint]
 set -euo pipefail
 out=${1:-target/test-output/tools.png}
@@ -30,13 +30,14 @@ sleep 1
 # in the side panel: read it off a screenshot when the layout changes).
 hex_x=${HEX_X:-140}
 hex_y=${HEX_Y:-360}
-y=520
-for color in ff8800 2a7fff 33cc44; do
+y=${STROKE_Y:-520}
+for color in ${COLORS-ff8800 2a7fff 33cc44}; do
     xdotool mousemove "$hex_x" "$hex_y" click 1 key ctrl+a type "$color"
     xdotool key Return
     sleep 1
-    xdotool mousemove 760 "$y" mousedown 1 mousemove 820 $((y + 10)) mousemove 880 $((y + 20)) mousemove 940 $((y + 20)) mouseup 1
-    y=$((y + 120))
+    x=${STROKE_X:-760}
+    xdotool mousemove "$x" "$y" mousedown 1 mousemove $((x + 60)) $((y + 10)) mousemove $((x + 120)) $((y + 20)) mousemove $((x + 180)) $((y + 20)) mouseup 1
+    y=$((y + ${STROKE_DY:-120}))
     sleep 2
 done
 xdotool mousemove 1200 1200
