@@ -7,6 +7,9 @@
 //! the charts are packed by shape into one page at the highest density that fits, `padding`
 //! texels from every page edge and at least `2 · padding` texels from each other.
 //!
+//! When the charts do not fit one page (very many charts: each needs its gutter), the gutter
+//! is halved until they do, down to one texel; [`GeneratedUvs::padding`] is the one used.
+//!
 //! The page is `size` texels wide and at most `size` high (the unwrapper crops unused rows);
 //! its UVs are rescaled into the square `size × size` texture, so texel boundaries stay
 //! where the packer put them. UVs follow glTF's convention (`(0, 0)` is the image's top-left
@@ -85,7 +88,7 @@ pub struct GeneratedUvs {
     pub corner_uvs: Vec<[[f32; 2]; 3]>,
     /// The texture side the layout was made for.
     pub size: u32,
-    /// The gutter asked for.
+    /// The gutter used (the one asked for, or narrower when the charts did not fit).
     pub padding: u32,
     /// Charts (connected pieces of the layout).
     pub charts: u32,
@@ -134,6 +137,10 @@ pub fn generate_uvs(
     let atlas = uvunwrap::generate_with_progress(&[input], &unwrap_options, report)
         .map_err(|error| UnwrapError::Unwrapper(error.to_string()))?;
     if atlas.page_count > 1 || atlas.width > size || atlas.height > size {
+        if padding > 1 {
+            // Very many charts: a narrower gutter (fewer MIP levels stay clean) before refusing.
+            return generate_uvs(positions, triangles, AtlasOptions { size, padding: padding / 2 }, progress);
+        }
         return Err(UnwrapError::Pages { charts: atlas.chart_count, pages: atlas.page_count, size, padding });
     }
     let Some(mesh) = atlas.meshes.first() else {
