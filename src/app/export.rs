@@ -129,7 +129,13 @@ pub fn estimate(document: &Document, what: ExportWhat) -> Estimate {
         ExportWhat::Packed { format } => {
             let samples = store.sample_count() * 4 / 3;
             let bytes = samples * format.bytes_per_sample() as u64 + faces * 16 + document.positions.len() as u64 * 12;
-            let text = format!("about {} samples with MIP chains in {}, about", thousands(samples), format.name());
+            let text = format!(
+                "{} vertices, {} triangles, about {} samples with MIP chains in {}, about",
+                thousands(document.positions.len() as u64),
+                thousands(faces),
+                thousands(samples),
+                format.name()
+            );
             (document.positions.len() as u64, faces, bytes, text)
         }
     };
