@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::colors::layout::Resolution;
 
+use super::export::ExportRequest;
 use super::jobs::WriteKind;
 use super::state::{Action, Shown};
 use super::unsaved::UnsavedChoice;
@@ -19,6 +20,10 @@ pub enum Command {
     Open(PathBuf),
     /// Write the document to this file: save or export, in this colour format.
     Write(PathBuf, ColorFormat, WriteKind),
+    /// Carry out File → Export…'s choice.
+    Export(ExportRequest),
+    /// Find which UVs a bake at this texture size would use (for File → Export…).
+    CheckUvs(u32),
     /// Fill the whole mesh, or (`connected`) the part last under the pointer.
     Fill {
         /// Only the part connected to the face last under the pointer.

@@ -173,6 +173,11 @@ impl OpenDocument {
         self.document.store.topology().face_count()
     }
 
+    /// Where the document came from: its file, or the built-in scene.
+    pub fn source(&self) -> Source {
+        self.path.clone().map_or(Source::BuiltIn, Source::File)
+    }
+
     /// Whether the view `shown` still has to be built (never for the mesh colors).
     pub fn is_missing(&self, shown: Shown) -> bool {
         match shown {

@@ -29,7 +29,7 @@ use super::jobs::{Finished, JobKind, Jobs, Waker, WriteKind};
 use super::paint::{PaintContext, draw_brush_cursor};
 use super::paint_session::GestureKind;
 use super::panels::{
-    LastStroke, PaintPanelContext, Panels, SIDE_PANEL_WIDTH, SceneContext, ViewContext, ViewportContext,
+    ExportContext, LastStroke, PaintPanelContext, Panels, SIDE_PANEL_WIDTH, SceneContext, ViewContext, ViewportContext,
 };
 use super::session::{DocumentState, opened_text};
 use super::settings::SettingsFile;
@@ -140,6 +140,11 @@ impl Editor {
                 .map(|document| JobOutput::Loaded(Box::new(document)))
                 .map_err(|error| error_text(&error))
         });
+        self.report_start(started, &label);
+    }
+
+    /// Says on the status line that the job `label` started, or why it could not.
+    pub(crate) fn report_start(&mut self, started: Result<(), String>, label: &str) {
         match started {
             Ok(()) => self.set_status(Severity::Info, format!("{label}…")),
             Err(message) => self.set_status(Severity::Error, message),
@@ -165,19 +170,17 @@ impl Editor {
         let label = match kind {
             WriteKind::Save => format!("Saving {}", path.display()),
             WriteKind::ExportPacked => format!("Exporting packed buffers to {}", path.display()),
-            WriteKind::ExportGltf => format!("Exporting glTF to {}", path.display()),
+            // A bake is File → Export…'s (`Command::Export`); the file dialog writes the tessellated glTF.
+            WriteKind::ExportGltf | WriteKind::ExportBaked => format!("Exporting glTF to {}", path.display()),
         };
         let started = self.jobs.start(JobKind::Write(kind), label.clone(), move |job| {
             let written = match kind {
                 WriteKind::Save | WriteKind::ExportPacked => document::write_packed(&document, format, &path, job),
-                WriteKind::ExportGltf => document::write_gltf(&document, &path, job),
+                WriteKind::ExportGltf | WriteKind::ExportBaked => document::write_gltf(&document, &path, job),
             };
             written.map(|written| JobOutput::Written(written, kind)).map_err(|error| error_text(&error))
         });
-        match started {
-            Ok(()) => self.set_status(Severity::Info, format!("{label}…")),
-            Err(message) => self.set_status(Severity::Error, message),
-        }
+        self.report_start(started, &label);
     }
 
     /// Applies a finished job, if any (called every frame).
@@ -214,10 +217,7 @@ impl Editor {
                     self.document.saved_generation = generation;
                     self.panels.autosave.state.saved(self.document.open.as_ref(), generation);
                 }
-                let verb = match kind {
-                    WriteKind::Save => "Saved",
-                    WriteKind::ExportPacked | WriteKind::ExportGltf => "Exported",
-                };
+                let verb = if kind == WriteKind::Save { "Saved" } else { "Exported" };
                 self.set_status(
                     Severity::Info,
                     format!("{verb} {}: {} ({:.2} s)", written.path.display(), written.summary, elapsed.as_secs_f64()),
@@ -230,6 +230,7 @@ impl Editor {
                 self.document.finish_repack(*repacked, elapsed, &mut self.viewport, &mut self.status);
             }
             JobOutput::Autosaved(autosaved) => self.panels.autosave.state.finished(&autosaved),
+            JobOutput::UvsChecked(size, choice) => self.panels.export.uv_check = Some((size, choice)),
             JobOutput::Optimized(done) => {
                 let (document, mut ctx) = self.paint_parts();
                 document.finish_optimize(&mut ctx, *done, elapsed);
@@ -342,8 +343,7 @@ impl Editor {
         if !open.is_missing(shown) || self.jobs.is_busy() {
             return;
         }
-        let source = open.path.clone().map_or(Source::BuiltIn, Source::File);
-        let path = open.path.clone();
+        let (source, path) = (open.source(), open.path.clone());
         let document = Arc::clone(&open.document);
         let (gpu, budget) = (Arc::clone(gpu), self.budget());
         let started = self.jobs.start(JobKind::View, format!("Preparing {}", shown.name()), move |job| {
@@ -483,6 +483,9 @@ impl Editor {
                 None => self.open_dialog(DialogPurpose::SaveAs),
             },
             Action::SaveAs => self.open_dialog(DialogPurpose::SaveAs),
+            Action::Export => {
+                self.panels.export.show_for(self.document.open.as_ref(), &self.panels.file.last_directory)
+            }
             Action::ExportGltf => self.open_dialog(DialogPurpose::ExportGltf),
             Action::ExportPacked => self.open_dialog(DialogPurpose::ExportPacked),
             Action::FrameAll => self.frame_all(),
@@ -550,6 +553,11 @@ impl Editor {
             Command::Open(path) => self.replace_or_close(Pending::Open(Source::File(path))),
             Command::Unsaved(choice) => self.answer_unsaved(choice),
             Command::Write(path, format, kind) => self.write(path, format, kind),
+            Command::Export(request) => {
+                self.panels.file.remember_directory_of(&request.path);
+                self.export(request);
+            }
+            Command::CheckUvs(size) => self.check_uvs(size),
             Command::Fill { connected } => self.with_paint_parts(|document, ctx| document.fill(ctx, connected)),
             Command::SetResolutionAll(resolution) => {
                 let budget = self.budget();
@@ -668,6 +676,9 @@ impl Editor {
         self.panels.help.ui(&ctx, self.viewport.rect.center());
         let chosen = self.panels.file.dialog_ui(&ctx, &mut self.panels.import);
         self.apply_all(chosen);
+        let (document, generation) = (self.document.open.as_ref(), self.document.edit_generation);
+        let chosen = self.panels.export.ui(&ctx, ExportContext { document, generation, idle: !self.jobs.is_busy() });
+        self.apply_all(chosen);
         let chosen = self.panels.autosave.recovery_ui(&ctx, self.viewport.rect.center());
         self.apply_all(chosen);
         let title = self.document.open.as_ref().map_or_else(String::new, |open| open.title.clone());
@@ -693,7 +704,8 @@ impl Editor {
         if self.with_paint_parts(|document, paint| document.gesture_input(paint, ctx)) {
             return;
         }
-        for action in input::shortcuts(ctx, self.mode(), self.panels.file.dialog.is_some()) {
+        let dialog_open = self.panels.file.dialog.is_some() || self.panels.export.open;
+        for action in input::shortcuts(ctx, self.mode(), dialog_open) {
             self.perform(action);
         }
     }

@@ -21,6 +21,9 @@ pub enum JobOutput {
     Autosaved(Autosaved),
     /// Optimize found its changes (applied if the document did not change meanwhile).
     Optimized(Box<Optimized>),
+    /// The UVs a bake of this texture size would use (File → Export…), or why that is
+    /// unknown.
+    UvsChecked(u32, Result<meshpaint_core::convert::unwrap::UvChoice, String>),
     /// An alternate view was built for the document opened from this path (`None`: built-in).
     View(Option<PathBuf>, Box<AlternateView>),
 }

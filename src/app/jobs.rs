@@ -30,6 +30,8 @@ pub enum JobKind {
     View,
     /// Writing a recovery file.
     Autosave,
+    /// Checking which UVs a bake would use (File → Export…).
+    CheckUvs,
 }
 
 /// Which kind of file a write job produced.
@@ -41,6 +43,8 @@ pub enum WriteKind {
     ExportPacked,
     /// A .glb was exported.
     ExportGltf,
+    /// A .glb with the colours baked into a texture was exported.
+    ExportBaked,
 }
 
 /// A callback that wakes the UI thread (a repaint request); called from the worker.

@@ -11,11 +11,11 @@
 //! | layer | file | role |
 //! |---|---|---|
 //! | 6 | [`window`] | winit event loop, surface, egui-winit / egui-wgpu, offscreen 3D view, redraw scheduling |
-//! | 5 | [`editor`], [`editor_settings`] | [`Editor`]: the document, camera, panels, 3D view state, status, jobs; one frame of UI ([`Editor::ui`]); every [`Action`] ([`Editor::perform`]) and [`command::Command`] ([`Editor::apply`]) carried out; finished jobs applied by [`jobs::JobKind`]; open and quit ask Save / Don't save / Cancel while changes are unsaved; the settings remembered between runs read from and written to the panels |
+//! | 5 | [`editor`], [`editor_settings`], [`editor_export`] | [`Editor`]: the document, camera, panels, 3D view state, status, jobs; one frame of UI ([`Editor::ui`]); every [`Action`] ([`Editor::perform`]) and [`command::Command`] ([`Editor::apply`]) carried out; finished jobs applied by [`jobs::JobKind`]; open and quit ask Save / Don't save / Cancel while changes are unsaved; the settings remembered between runs read from and written to the panels; File → Export… carried out |
 //! | 4 | [`paint`] | paint-mode commands on the document: strokes, live GPU upload, undo / redo, eyedropper, fill, resolution, Optimize, radius / strength gestures, brush cursor |
-//! | 3 | [`panels`], [`job_output`] | each panel a type that owns its state and draws itself, returning commands (menu, status line, file, import settings, autosave, view, paint, optimize, undo, scene, help, 3D view area); what jobs produce |
+//! | 3 | [`panels`], [`job_output`] | each panel a type that owns its state and draws itself, returning commands (menu, status line, file, export, import settings, autosave, view, paint, optimize, undo, scene, help, 3D view area); what jobs produce |
 //! | 2 | [`session`], [`input`], [`autosave`], [`file_dialog`] | the document being edited ([`session::DocumentState`]: open document, paint session, undo history); all input (shortcuts [`input::SHORTCUTS`], 3D-view navigation, the brush's pointer); autosave state; an egui file browser |
-//! | 1 | [`document`], [`command`], [`import_settings`], [`settings`] | the open document (store and GPU mesh side by side; open, save, export work); the commands panels return; the import settings panel (the open dialog's resolution choice, the up axis); the settings file |
+//! | 1 | [`document`], [`export`], [`command`], [`import_settings`], [`settings`] | the open document (store and GPU mesh side by side; open, save, export work); File → Export…'s choices, their costs and work (baked texture, tessellated glTF, packed file); the commands panels return; the import settings panel (the open dialog's resolution choice, the up axis); the settings file |
 //! | 0 | [`state`], [`jobs`], [`text`], [`widgets`], [`paint_session`], [`unsaved`], [`recent_colors`], [`presets`] | shared small types and [`Action`]s; one background job at a time with progress; number / error text; the resolution combo box; paint-mode state; the actions that wait for "save changes first?"; the recent colours; the brush presets |
 //!
 //! Paint mode is [`Mode::Paint`] (Tab, [`input::SHORTCUTS`]): its tools get the pointer in
@@ -29,7 +29,9 @@ pub mod autosave;
 pub mod command;
 pub mod document;
 pub mod editor;
+pub mod editor_export;
 pub mod editor_settings;
+pub mod export;
 pub mod file_dialog;
 pub mod import_settings;
 pub mod input;

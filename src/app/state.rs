@@ -179,6 +179,9 @@ pub enum Action {
     Save,
     /// Save under a new name.
     SaveAs,
+    /// Show File → Export…: baked-texture glTF, tessellated glTF or packed file, each with
+    /// its cost.
+    Export,
     /// Export a tessellated vertex-colour .glb.
     ExportGltf,
     /// Export the packed buffers in a chosen colour format.

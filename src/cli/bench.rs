@@ -1,4 +1,4 @@
-//! `meshpaint bench pack | render | paint | adaptive | trade | extremes`: measurements printed as JSON.
+//! `meshpaint bench pack | render | paint | adaptive | trade | extremes | unwrap`: measurements printed as JSON.
 
 use std::path::PathBuf;
 
@@ -147,6 +147,19 @@ pub(super) enum BenchCommand {
         #[arg(long, value_delimiter = ',')]
         rows: Vec<String>,
     },
+    /// A generated UV atlas (`export --texture SIZE --uvs new`): seconds, charts, share of the
+    /// texture used, texels inside two faces' UVs, texel density over the surface; one JSON
+    /// object.
+    Unwrap {
+        /// A .glb / .gltf / OBJ / PLY / STL file.
+        file: PathBuf,
+        /// Texture side.
+        #[arg(long, default_value_t = 4096)]
+        size: u32,
+        /// Midpoint-subdivide the mesh N times first (Bunny144k: 1 → 576k triangles, 2 → 2.3M).
+        #[arg(long, default_value_t = 0)]
+        subdivide: u32,
+    },
     /// The numerical extremes (R = 4096 in perspective, offsets 1e5 / 1e6, scale 1e-4,
     /// slivers, valence 200, RGBA16F's largest value, HDR Add, NaN / ∞ colours, grazing
     /// brushes, the shader's index precision): per case the error measured against an
@@ -221,6 +234,7 @@ impl TradeArgs {
 pub(super) fn run(what: BenchCommand) -> Result<()> {
     match what {
         BenchCommand::Extremes { json } => extremes(json),
+        BenchCommand::Unwrap { file, size, subdivide } => unwrap(&file, size, subdivide),
         BenchCommand::Trade(args) => trade(&args),
         BenchCommand::Adaptive { file, max_resolution, size, views, supersample, bake, rules } => {
             adaptive(file, max_resolution, size, views, supersample, bake, rules)
@@ -238,6 +252,37 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             render(file, resolution, width, height, frames)
         }
     }
+}
+
+/// `bench unwrap`: a generated UV atlas's cost and quality.
+fn unwrap(file: &std::path::Path, size: u32, subdivide: u32) -> Result<()> {
+    use meshpaint_core::convert::unwrap::{AtlasOptions, density, generate_uvs};
+    let budget = budget(None);
+    let (scene, _) = meshpaint_core::io::document::import_scene_within(file, &budget)?;
+    let scene = meshpaint_core::convert::subdivide::subdivide_scene(&scene, subdivide, &budget)?;
+    let welded = meshpaint_core::mesh::weld::weld_scene(&scene);
+    let (positions, triangles) = (&welded.positions_world, &welded.triangles);
+    let generated = generate_uvs(positions, triangles, AtlasOptions::new(size), &|_, _| {})
+        .with_context(|| format!("unwrapping {}", file.display()))?;
+    let stats = density(positions, triangles, &generated.corner_uvs, size);
+    let coverage = meshpaint_core::convert::bake_uv::uv_coverage(&generated.corner_uvs, size);
+    let row = serde_json::json!({
+        "file": file.display().to_string(),
+        "triangles": triangles.len(),
+        "size": size,
+        "padding": generated.padding,
+        "charts": generated.charts,
+        "seconds": generated.elapsed.as_secs_f64(),
+        "utilization": generated.utilization,
+        "faces_without_area": generated.faces_without_area.len(),
+        "overlapping_texels": coverage.overlapping_texels,
+        "density_p5": stats.p5,
+        "density_median": stats.median,
+        "density_p95": stats.p95,
+        "density_spread": stats.spread(),
+    });
+    println!("{row}");
+    Ok(())
 }
 
 /// `bench trade`: every choice's cost and error side by side, the extremes, the plots.

@@ -1,5 +1,6 @@
 //! `meshpaint export`: a tessellated vertex-colour .glb, a packed file, (`--texture`) the
-//! colours baked into the model's own UV texture, as a textured .glb or a plain PNG, or
+//! colours baked into the model's own UVs or a generated UV atlas, as a textured .glb or a
+//! plain PNG, or
 //! (`--representation mct`) a Mesh Color Texture file.
 
 use std::path::{Path, PathBuf};
@@ -8,11 +9,10 @@ use anyhow::{Context, Result};
 
 use meshpaint_core::colors::budget::ATLAS_MAX_WIDTH;
 use meshpaint_core::colors::format::ColorFormat;
-use meshpaint_core::convert::bake_uv::{bake_uv_texture, default_padding};
 use meshpaint_core::io::document::{Document, SourceKind, import_scene};
+use meshpaint_core::io::export_baked::{BakeRequest, BakedExport, OwnMesh, UvSource, bake_export};
 use meshpaint_core::io::export_fit::{FitOptions, write_fitted_glb};
 use meshpaint_core::io::export_gltf::ColorEncoding;
-use meshpaint_core::io::export_textured::{TexturedMesh, encode_png, textured_glb};
 use meshpaint_core::mct;
 use meshpaint_core::mct::file::write_mct;
 use meshpaint_core::mesh::weld::weld_scene;
@@ -29,14 +29,16 @@ pub(super) struct ExportArgs {
     /// Colour format of a packed output: rgba8 (sRGB, default), rgba16f or rgba32f.
     #[arg(long, value_parser = parse_format)]
     format: Option<ColorFormat>,
-    /// Bake the colours into the model's UV texture, SIZE × SIZE texels: -o OUT.glb writes
-    /// the mesh with its original UVs and this texture, -o OUT.png the texture alone.
+    /// Bake the colours into a SIZE × SIZE texture through the model's UVs or generated ones
+    /// (--uvs): -o OUT.glb writes the mesh with those UVs and this texture, -o OUT.png the
+    /// texture alone.
     #[arg(long, value_name = "SIZE")]
     texture: Option<u32>,
-    /// With --texture: the file whose UVs to use (default: FILE; needed for packed input,
-    /// which has no UVs). Its welded mesh must be FILE's.
-    #[arg(long, value_name = "SOURCE", requires = "texture")]
-    uvs: Option<PathBuf>,
+    /// With --texture: `new` generates a non-overlapping UV atlas; a file: bake into that
+    /// model's UVs (its welded mesh must be FILE's; for packed input, the model it came
+    /// from). Default: FILE's own UVs when every face has some and none overlap, else new.
+    #[arg(long, value_name = "new|SOURCE", requires = "texture")]
+    uvs: Option<String>,
     /// .glb: tessellate every face at R >> LEVEL (at least 1); the error is reported.
     #[arg(long, value_name = "LEVEL", conflicts_with_all = ["max_vertices", "texture"])]
     level: Option<u32>,
@@ -146,75 +148,91 @@ fn export_mct(args: &ExportArgs) -> Result<()> {
     Ok(())
 }
 
-/// `--texture SIZE`: bake into the UVs of FILE (or `--uvs`), write a textured .glb or a PNG.
+/// `--texture SIZE`: bake into the model's own UVs or generated ones (`--uvs`), write a
+/// textured .glb or a PNG.
 fn export_texture(args: &ExportArgs, size: u32) -> Result<()> {
     let (path, out) = (&args.file, &args.output.output);
     let extension = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    let to_png = match extension.as_deref() {
+    let png_only = match extension.as_deref() {
         Some("png") => true,
         Some("glb") => false,
         _ => anyhow::bail!("{}: with --texture the output is a .glb or a .png", out.display()),
     };
     anyhow::ensure!(args.format.is_none(), "--format applies to packed output only");
-    let document = open(path, args.resolution, &budget(None))?;
-    let uv_file = match (&args.uvs, document.source) {
-        (Some(source), _) => source.as_path(),
-        (None, SourceKind::Packed(_)) => anyhow::bail!(
-            "{}: a packed file keeps no UVs; name the model it was made from with --uvs SOURCE",
-            path.display()
-        ),
-        (None, _) => path.as_path(),
+    let budget = budget(None);
+    let document = open(path, args.resolution, &budget)?;
+    // Where the model's own UVs come from: --uvs FILE, else FILE itself (a packed file has none).
+    let (uvs, uv_file) = match (args.uvs.as_deref(), document.source) {
+        (Some("new"), _) => (UvSource::New, None),
+        (Some(source), _) => (UvSource::Own, Some(Path::new(source))),
+        (None, SourceKind::Packed(_)) => (UvSource::Auto, None),
+        (None, _) => (UvSource::Auto, Some(path.as_path())),
     };
-    let (scene, _) = import_scene(uv_file)?;
-    let welded = weld_scene(&scene);
-    check_same_mesh(&document, &welded.positions_world, &welded.triangles, path, uv_file)?;
-    let bake = bake_uv_texture(&document.store, &welded.corner_uvs, size, default_padding(size))
-        .with_context(|| format!("baking {}", path.display()))?;
-    let faces = welded.triangles.len();
-    if !bake.faces_without_uvs.is_empty() {
-        let first: Vec<String> = bake.faces_without_uvs.iter().take(10).map(u32::to_string).collect();
-        log::warn!(
-            target: LOG_TARGET,
-            "{}: {} of {faces} faces have no UVs (no area in texture space) and are not in the texture; faces {}{}",
-            uv_file.display(),
-            bake.faces_without_uvs.len(),
-            first.join(", "),
-            if bake.faces_without_uvs.len() > 10 { ", …" } else { "" }
-        );
-    }
-    if bake.overlapping_texels > 0 {
-        log::warn!(
-            target: LOG_TARGET,
-            "{}: {} texels lie in the UVs of two or more faces (overlapping or mirrored islands) and {} of them \
-             have clearly different colours there (> 32 steps): the texture keeps one face's colour, the others' are lost",
-            uv_file.display(),
-            bake.overlapping_texels,
-            bake.conflicting_texels
-        );
-    }
-    let png = encode_png(&bake)?;
-    let coverage = bake.covered_texels as f64 / (f64::from(size) * f64::from(size)) * 100.0;
-    let bytes = if to_png {
-        png
-    } else {
-        let mesh = TexturedMesh {
-            positions: &welded.positions_world,
-            triangles: &welded.triangles,
-            corner_uvs: &welded.corner_uvs,
-            corner_normals: &welded.corner_normals_world,
-        };
-        textured_glb(&mesh, &png)?.bytes
+    let welded = match uv_file {
+        Some(uv_file) => {
+            let (scene, _) = import_scene(uv_file)?;
+            let welded = weld_scene(&scene);
+            check_same_mesh(&document, &welded.positions_world, &welded.triangles, path, uv_file)?;
+            Some(welded)
+        }
+        None => None,
     };
-    meshpaint_core::atomic_write::write_atomically(out, &bytes)
+    let own = welded.as_ref().map(|w| OwnMesh { corner_uvs: &w.corner_uvs, corner_normals: &w.corner_normals_world });
+    let request = BakeRequest { size, uvs, own, png_only };
+    let baked =
+        bake_export(&document, &request, &budget, &|_, _| {}).with_context(|| format!("baking {}", path.display()))?;
+    report_bake(&baked, uv_file.unwrap_or(path), document.store.topology().face_count());
+    meshpaint_core::atomic_write::write_atomically(out, &baked.bytes)
         .map_err(|error| anyhow::anyhow!("{}: cannot {}: {}", error.path.display(), error.action, error.source))?;
+    let coverage = baked.covered_texels as f64 / (f64::from(size) * f64::from(size)) * 100.0;
     eprintln!(
-        "{} → {}: {size}×{size} texture, {coverage:.1}% of the texels in UV islands, {} of {faces} faces without UVs, {} B",
+        "{} → {}: {size}×{size} texture, UVs: {}; {coverage:.1}% of the texels in UV islands, texel density \
+         p5/median/p95 {:.1}/{:.1}/{:.1} per unit (spread {:.2}), {} of {} faces without UVs, {} vertices, {} B",
         path.display(),
         out.display(),
-        bake.faces_without_uvs.len(),
-        bytes.len()
+        baked.choice.reason(),
+        baked.density.p5,
+        baked.density.median,
+        baked.density.p95,
+        baked.density.spread(),
+        baked.faces_without_uvs,
+        document.store.topology().face_count(),
+        baked.vertices,
+        baked.bytes.len()
     );
     Ok(())
+}
+
+/// Warns about faces without UVs and paint lost to overlapping UVs; states the generated
+/// layout.
+fn report_bake(baked: &BakedExport, uv_file: &Path, faces: u32) {
+    if let Some(generated) = &baked.generated {
+        eprintln!(
+            "generated atlas: {} charts, {:.1}% of the texture covered, gutter {} texels, {} faces without area, {:.2} s",
+            generated.charts,
+            generated.utilization * 100.0,
+            generated.padding,
+            generated.faces_without_area.len(),
+            generated.elapsed.as_secs_f64()
+        );
+    }
+    if baked.faces_without_uvs > 0 {
+        log::warn!(
+            target: LOG_TARGET,
+            "{}: {} of {faces} faces have no UVs (no area in texture space) and are not in the texture",
+            uv_file.display(),
+            baked.faces_without_uvs,
+        );
+    }
+    if baked.conflicting_texels > 0 {
+        log::warn!(
+            target: LOG_TARGET,
+            "{}: overlapping or mirrored UV islands: {} texels have clearly different colours (> 32 steps) in \
+             two faces; the texture keeps one face's colour, the others' are lost (--uvs new avoids it)",
+            uv_file.display(),
+            baked.conflicting_texels
+        );
+    }
 }
 
 /// `--level`, `--max-vertices`, `--colors`: the tessellated .glb fitted to the content.

@@ -251,15 +251,17 @@ fn the_command_line_writes_glb_and_png_and_reports_faces_without_uvs() {
     assert_eq!(scene.textures.len(), 1);
     assert_eq!((scene.textures[0].width, scene.textures[0].height), (256, 256));
     assert_eq!(scene.instanced_triangle_count(), 4212);
-    let (ok, stderr) = export(&[&s(&duck), "-o", &s(&png), "--texture", "128"]);
+    // Into the Duck's own UVs (asked for: they overlap, so by default new ones are made).
+    let (ok, stderr) = export(&[&s(&duck), "-o", &s(&png), "--texture", "128", "--uvs", &s(&duck)]);
     assert!(ok, "{stderr}");
     assert_eq!(image::open(&png).unwrap().to_rgba8().dimensions(), (128, 128));
 
-    // A packed file needs --uvs; with the source's UVs it bakes the same texture.
+    // A packed file keeps no UVs (new ones by default); with the source's UVs it bakes the
+    // same texture.
     let run = Command::new(env!("CARGO_BIN_EXE_meshpaint")).args(["pack", &s(&duck), "-o", &s(&mpk)]).output().unwrap();
     assert!(run.status.success());
-    let (ok, stderr) = export(&[&s(&mpk), "-o", &s(&png), "--texture", "128"]);
-    assert!(!ok && stderr.contains("--uvs"), "{stderr}");
+    let (ok, stderr) = export(&[&s(&mpk), "-o", &s(&dir.join("new_uvs.png")), "--texture", "128"]);
+    assert!(ok && stderr.contains("UVs: new UVs: the document keeps no UVs"), "{stderr}");
     let from_packed = dir.join("from_packed.png");
     let (ok, stderr) = export(&[&s(&mpk), "--uvs", &s(&duck), "-o", &s(&from_packed), "--texture", "128"]);
     assert!(ok, "{stderr}");
@@ -277,15 +279,21 @@ fn the_command_line_writes_glb_and_png_and_reports_faces_without_uvs() {
         diffs.len()
     );
     // The Duck's two sides share their UVs: the command says so.
-    assert!(stderr.contains("texels lie in the UVs of two or more faces"), "{stderr}");
+    assert!(stderr.contains("texels strictly inside two faces' UVs (paint there is lost)"), "{stderr}");
     // UVs of another mesh are refused.
     let (ok, stderr) =
         export(&[&s(&mpk), "--uvs", &s(&model("BoxTextured/BoxTextured.glb")), "-o", &s(&png), "--texture", "64"]);
     assert!(!ok && stderr.contains("is not the mesh of"), "{stderr}");
 
-    // An STL has no UVs: every face is reported.
+    // An STL has no UVs: new ones by default; baked into its own, every face is reported.
     let stl = workspace_path("assets/models/AssimpTestModels/sphereWithHole.stl");
     let (ok, stderr) = export(&[&s(&stl), "-o", &s(&png), "--texture", "64"]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stderr.contains("UVs: new UVs: the model has no UVs") && stderr.contains("0 of 285 faces without UVs"),
+        "{stderr}"
+    );
+    let (ok, stderr) = export(&[&s(&stl), "-o", &s(&png), "--texture", "64", "--uvs", &s(&stl)]);
     assert!(ok, "{stderr}");
     assert!(stderr.contains("285 of 285 faces have no UVs"), "{stderr}");
 }

@@ -1056,3 +1056,48 @@ fn exported_triangle_edges_have_no_t_junctions_and_show_their_endpoint_interpola
         assert_eq!(on_edges, 0, "{}: T-junctions", case.name);
     }
 }
+
+/// The tessellated export carries smooth normals (viewers would shade it faceted without):
+/// every NORMAL is unit length; at the mesh's own vertices it is the welded vertex's
+/// area-weighted normal (`mesh::normals::vertex_normals`, computed here from the document);
+/// inside faces it varies (the normals of a sub-triangle's corners differ on a curved
+/// surface), and it points out of the surface the way the face does.
+#[test]
+fn the_tessellated_export_has_smooth_unit_normals() {
+    let document = Document::open(&model("Duck/Duck.glb"), r(4)).unwrap();
+    let bytes = export_tessellated_glb(&document.positions, &document.store).unwrap();
+    let (gltf, buffers, _) = gltf::import_slice(&bytes).unwrap();
+    let primitive = gltf.meshes().next().unwrap().primitives().next().unwrap();
+    let reader = primitive.reader(|buffer| buffers.get(buffer.index()).map(|b| &b.0[..]));
+    let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+    let normals: Vec<[f32; 3]> = reader.read_normals().expect("no NORMAL").collect();
+    let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+    assert_eq!(normals.len(), positions.len());
+    let length = |n: &[f32; 3]| (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    assert!(normals.iter().all(|n| (length(n) - 1.0).abs() < 1e-5), "a normal is not unit length");
+    let expected =
+        meshpaint_core::mesh::normals::vertex_normals(&document.positions, &document.store.topology().face_vertices);
+    let vertex_of: HashMap<[u32; 3], usize> =
+        document.positions.iter().enumerate().map(|(v, p)| (p.map(f32::to_bits), v)).collect();
+    let mut at_vertices = 0;
+    for (p, n) in positions.iter().zip(&normals) {
+        if let Some(&v) = vertex_of.get(&p.map(f32::to_bits)) {
+            let e = expected[v];
+            assert!((0..3).all(|a| (f64::from(n[a]) - e[a]).abs() < 1e-5), "vertex {v}: {n:?} vs {e:?}");
+            at_vertices += 1;
+        }
+    }
+    assert_eq!(at_vertices, document.positions.len());
+    let (mut varying, mut outward) = (0usize, 0usize);
+    let triangles = indices.chunks_exact(3).collect::<Vec<_>>();
+    for t in &triangles {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| glam::Vec3::from(positions[i as usize]));
+        let face = (b - a).cross(c - a).normalize_or_zero();
+        let n = [t[0], t[1], t[2]].map(|i| glam::Vec3::from(normals[i as usize]));
+        varying += usize::from(n[0].dot(n[1]).min(n[1].dot(n[2])) < 0.99999);
+        outward += usize::from(n.iter().all(|n| n.dot(face) > 0.0));
+    }
+    eprintln!("{} of {} triangles with varying normals, {} facing with them", varying, triangles.len(), outward);
+    assert!(varying * 2 > triangles.len(), "normals hardly vary: faceted");
+    assert!(outward * 100 >= triangles.len() * 99, "normals against the faces");
+}

@@ -15,6 +15,7 @@ mod durability;
 mod examples;
 mod export_fit;
 mod export_gltf;
+mod export_uvs;
 mod extremes;
 mod formats;
 mod gpu_render;

@@ -1136,3 +1136,185 @@ fn stroke_messages_say_what_changed() {
     let status = harness.state().status.text.clone();
     assert!(status.starts_with("Paint stroke: ") && status.contains("samples changed"), "{status}");
 }
+
+/// PSNR in dB of `a` against `b` over the pixels where either is not the background.
+fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    let background = *a.get_pixel(0, 0);
+    let (mut sum, mut count) = (0.0f64, 0u64);
+    for (p, q) in a.pixels().zip(b.pixels()) {
+        if *p == background && *q == background {
+            continue;
+        }
+        sum += (0..3).map(|k| (f64::from(p[k]) - f64::from(q[k])).powi(2)).sum::<f64>();
+        count += 1;
+    }
+    10.0 * (255.0f64 * 255.0 / (sum / (3.0 * count.max(1) as f64)).max(1e-12)).log10()
+}
+
+/// Paints the Duck's +X half with the core brush API: dabs of three colours centred on every
+/// 16th vertex right of the mirror plane (no occlusion, so each dab's sphere paints through).
+fn paint_one_half(editor: &mut Editor) {
+    use meshpaint_core::paint::brush::{BrushSettings, PaintView, Painter, Tool};
+    let camera = editor.camera;
+    let open = editor.document.open.as_mut().unwrap();
+    let radius = open.bounds.radius * 0.12;
+    let document = Arc::make_mut(&mut open.document);
+    let positions = document.positions.clone();
+    let mut painter = Painter::new(&positions);
+    let plane = painter.mirror_plane_x();
+    let mut history = meshpaint_core::paint::undo::UndoHistory::default();
+    let view =
+        PaintView { positions: &positions, bvh: &open.bvh, camera: &camera, viewport_px: [512, 512], base: None };
+    let colors = [[0.9, 0.05, 0.05, 1.0], [0.05, 0.6, 0.1, 1.0], [0.1, 0.1, 0.9, 1.0]];
+    let right: Vec<&[f32; 3]> = positions.iter().filter(|p| f64::from(p[0]) > plane + radius).collect();
+    for (k, p) in right.iter().step_by(16).enumerate() {
+        painter.set_settings(BrushSettings {
+            tool: Tool::Paint,
+            color: colors[k % 3],
+            strength: 1.0,
+            occlusion: false,
+            backface_culling: false,
+            mirror_x: false,
+            ..BrushSettings::default()
+        });
+        let center = glam::DVec3::from_array(p.map(f64::from));
+        painter.dab_at(&view, &mut document.store, &mut history, center, radius).unwrap();
+    }
+    editor.document.edit_generation += 1;
+}
+
+/// Drives File → Export… to a baked-texture glTF with `uvs` ("Automatic UVs", "New UVs" or
+/// "Model's own UVs") into `out`; returns the automatic choice the dialog showed.
+fn export_baked_from_the_menu(harness: &mut Harness<'static, Editor>, uvs: &str, out: &Path) -> String {
+    // The menu bar's "File" (drawn before the side panel's "File" section).
+    harness.get_all_by_label("File").next().unwrap().click();
+    harness.run_steps(2);
+    // The menu's entry (the File panel has an "Export…" button too; the menu is drawn last).
+    harness.get_all_by_label("Export…").last().unwrap().click();
+    harness.run_steps(2);
+    assert!(harness.state().panels.export.open, "no export dialog");
+    harness.get_by_label("Baked-texture glTF (.glb) — for any engine").click();
+    harness.get_by_label(uvs).click();
+    harness.run_steps(2);
+    // The automatic choice is checked on a job; its reason is shown when it is back.
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "UV check timed out");
+    harness.run_steps(2);
+    let checked = harness.state().panels.export.uv_check.clone();
+    let line = match checked {
+        Some((_, Ok(choice))) => format!("Automatic: {}.", choice.reason()),
+        _ => String::new(),
+    };
+    if uvs == "Automatic UVs" {
+        assert!(harness.query_by_label(&line).is_some(), "the dialog does not show “{line}”");
+    }
+    assert!(harness.query_by_label_contains("Cost: about").is_some(), "no cost shown");
+    harness.state_mut().panels.export.path = out.display().to_string();
+    harness.run_steps(1);
+    harness.get_by_label("Export").click();
+    harness.run_steps(2);
+    assert!(!harness.state().panels.export.open);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "export timed out");
+    harness.run_steps(2);
+    assert_eq!(harness.state().status.severity, Severity::Info, "{:?}", harness.state().status);
+    assert!(harness.state().status.text.starts_with("Exported"), "{:?}", harness.state().status);
+    line
+}
+
+/// The test: the Duck painted on one side, exported from File → Export… as a baked
+/// glTF. Its own UVs overlap (mirrored halves), so the automatic choice generates new ones
+/// and says why; rendered through the UV baseline (`render --baseline-uv`'s pipeline) it
+/// matches the mesh-colors render at ≥ 35 dB from six directions (no paint lost). The same
+/// export into the Duck's own UVs loses the paint on one side (printed, and below 30 dB on
+/// its worst view).
+#[test]
+fn the_painted_duck_exported_from_the_menu_with_new_uvs_renders_like_its_mesh_colors() {
+    use meshpaint_core::camera::default_camera;
+    use meshpaint_render::{DrawItem, Gpu, RenderSettings};
+    let dir = common::TempDir::new("export_dialog");
+    let mut editor = editor_with_duck();
+    paint_one_half(&mut editor);
+    let mut harness =
+        Harness::builder().with_size([1280.0, 1000.0]).build_ui_state(|ui, editor: &mut Editor| editor.ui(ui), editor);
+    harness.run_steps(2);
+    let (new_glb, own_glb) = (dir.join("duck_new_uvs.glb"), dir.join("duck_own_uvs.glb"));
+    let line = export_baked_from_the_menu(&mut harness, "Automatic UVs", &new_glb);
+    assert!(line.contains("new UVs: the model's UV islands overlap"), "{line}");
+    assert!(harness.state().status.text.contains("new UVs"), "{}", harness.state().status.text);
+    export_baked_from_the_menu(&mut harness, "Model's own UVs", &own_glb);
+
+    let gpu = Gpu::new_headless().expect("GPU tests need an adapter (lavapipe)");
+    let open = harness.state().document.open.as_ref().unwrap();
+    let colors = gpu.upload(&open.document.pack(open.document.display_format()).unwrap()).unwrap();
+    let baked = |path: &Path| {
+        let scene = meshpaint_core::mesh::import::import_gltf(path).unwrap();
+        gpu.upload_baseline(&scene).unwrap().expect("the export has a base-colour texture")
+    };
+    let (new_uvs, own_uvs) = (baked(&new_glb), baked(&own_glb));
+    let (mut worst_new, mut worst_own) = (f64::INFINITY, f64::INFINITY);
+    for (yaw, pitch) in [(90.0, 0.0), (-90.0, 0.0), (0.0, 20.0), (180.0, 20.0), (30.0, 60.0), (210.0, -40.0)] {
+        let mut settings = RenderSettings::new(default_camera(colors.bounds, yaw, pitch, None));
+        settings.filter = meshpaint_render::FilterMode::Linear;
+        let reference = gpu.render_image(DrawItem::MeshColors(&colors), &settings, 512, 512).unwrap();
+        let new = gpu.render_image(DrawItem::Baseline(&new_uvs), &settings, 512, 512).unwrap();
+        let own = gpu.render_image(DrawItem::Baseline(&own_uvs), &settings, 512, 512).unwrap();
+        let (db_new, db_own) = (psnr(&reference, &new), psnr(&reference, &own));
+        eprintln!("view ({yaw}, {pitch}): new UVs {db_new:.1} dB, own UVs {db_own:.1} dB");
+        if (yaw, pitch) == (90.0, 0.0) {
+            for (image, name) in [(&reference, "mesh_colors"), (&new, "new_uvs"), (&own, "own_uvs")] {
+                image.save(common::output_dir().join(format!("export_painted_duck_{name}.png"))).unwrap();
+            }
+        }
+        worst_new = worst_new.min(db_new);
+        worst_own = worst_own.min(db_own);
+    }
+    assert!(worst_new >= 35.0, "generated UVs: worst view {worst_new:.1} dB < 35 dB");
+    assert!(worst_own < 30.0, "the own-UV bake was expected to lose paint (worst view {worst_own:.1} dB)");
+}
+
+/// File → Export… shows each choice's cost before writing: the tessellated glTF's level,
+/// vertices and triangles (a vertex budget picks the level; the file gets smooth normals),
+/// the packed file's samples; both are written by a job with a status message.
+#[test]
+fn the_export_dialog_shows_each_cost_and_writes_tessellated_and_packed_files() {
+    let dir = common::TempDir::new("export_dialog_kinds");
+    let mut harness = Harness::builder()
+        .with_size([1280.0, 1000.0])
+        .build_ui_state(|ui, editor: &mut Editor| editor.ui(ui), editor_with_duck());
+    harness.run_steps(2);
+    harness.state_mut().perform(Action::Export);
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    harness.get_by_label("Tessellated glTF (.glb) — vertex colours").click();
+    harness.run_steps(2);
+    assert!(harness.query_by_label_contains("Cost: level 0: ").is_some(), "no tessellation cost");
+    harness.get_by_label("At most").click();
+    harness.state_mut().panels.export.max_vertices = 20_000;
+    harness.run_steps(2);
+    // The Duck at R = 8 has 69× its triangles at level 0; 20,000 vertices fit level 2.
+    assert!(harness.query_by_label_contains("Cost: level 2: ").is_some(), "the vertex budget does not pick a level");
+    let glb = dir.join("duck_tessellated.glb");
+    harness.state_mut().panels.export.path = glb.display().to_string();
+    harness.run_steps(1);
+    harness.get_by_label("Export").click();
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    assert!(harness.state().status.text.contains("level 2") && harness.state().status.text.contains("smooth normals"));
+    let (gltf, _, _) = gltf::import(&glb).unwrap();
+    let primitive = gltf.meshes().next().unwrap().primitives().next().unwrap();
+    assert!(primitive.get(&gltf::Semantic::Normals).is_some(), "no NORMAL");
+
+    harness.state_mut().perform(Action::Export);
+    harness.run_steps(2);
+    harness.get_by_label("Packed file (.mpk) — mesh colors").click();
+    harness.run_steps(2);
+    assert!(harness.query_by_label_contains("samples with MIP chains").is_some(), "no packed cost");
+    assert!(harness.state().panels.export.path.ends_with(".mpk"), "{}", harness.state().panels.export.path);
+    let mpk = dir.join("duck.mpk");
+    harness.state_mut().panels.export.path = mpk.display().to_string();
+    harness.run_steps(1);
+    harness.get_by_label("Export").click();
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT));
+    assert!(harness.state().status.text.starts_with("Exported"), "{:?}", harness.state().status);
+    assert!(std::fs::metadata(&mpk).unwrap().len() > 10_000);
+}

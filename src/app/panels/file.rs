@@ -43,6 +43,7 @@ impl FilePanel {
             button(ui, writable, "Save as…", "Ctrl+Shift+S", Action::SaveAs);
         });
         ui.horizontal_wrapped(|ui| {
+            button(ui, writable, "Export…", "baked texture, glTF or packed", Action::Export);
             button(ui, writable, "Export glTF…", "Ctrl+E", Action::ExportGltf);
             button(ui, writable, "Export packed…", "Ctrl+Shift+E", Action::ExportPacked);
         });

@@ -20,6 +20,7 @@ impl MenuBar {
                 action_button(ui, "Save", Action::Save, idle && has_document, &mut chosen);
                 action_button(ui, "Save as…", Action::SaveAs, idle && has_document, &mut chosen);
                 ui.separator();
+                action_button(ui, "Export…", Action::Export, idle && has_document, &mut chosen);
                 action_button(ui, "Export glTF…", Action::ExportGltf, idle && has_document, &mut chosen);
                 action_button(ui, "Export packed buffers…", Action::ExportPacked, idle && has_document, &mut chosen);
                 ui.separator();

@@ -8,6 +8,7 @@
 //! | [`MenuBar`] | [`menu`] | nothing |
 //! | [`StatusLine`] | [`status_line`] | nothing (shows the editor's status) |
 //! | [`FilePanel`] | [`file`] | the file dialog, the directory dialogs start in |
+//! | [`ExportPanel`] | [`export`] | File → Export…'s choices, the UV check, the cost shown |
 //! | [`ImportSettings`] | `import_settings` (app level: the file dialog shows it too) | the resolution choice for opened meshes |
 //! | [`AutosavePanel`] | [`autosave`] | autosave settings, timer and recovery offer |
 //! | [`ViewPanel`] | [`view`] (the heat map's legend: [`heat_legend`]) | view settings, the last PSNR |
@@ -21,6 +22,7 @@
 
 pub mod autosave;
 pub mod color;
+pub mod export;
 pub mod file;
 pub mod heat_legend;
 pub mod help;
@@ -37,6 +39,7 @@ pub mod viewport;
 
 pub use crate::app::import_settings::ImportSettings;
 pub use autosave::AutosavePanel;
+pub use export::{ExportContext, ExportPanel};
 pub use file::FilePanel;
 pub use help::HelpWindow;
 pub use menu::MenuBar;
@@ -63,6 +66,8 @@ pub struct Panels {
     pub file: FilePanel,
     /// How meshes opened next get their face resolutions (the open dialog's choice).
     pub import: ImportSettings,
+    /// File → Export….
+    pub export: ExportPanel,
     /// Autosave settings and the recovery offer.
     pub autosave: AutosavePanel,
     /// Filter, shading, overlays, what is shown.

@@ -147,6 +147,45 @@ pub fn uv_face_texels<'a>(corner_uvs: impl IntoIterator<Item = &'a [[f32; 2]; 3]
     count
 }
 
+/// Bytes a `size × size` bake holds at once: the RGBA8 texels, a coverage flag per texel,
+/// and as much again for the PNG encoding (an upper bound; check it against a memory budget
+/// before baking).
+pub fn bake_bytes(size: u32) -> u64 {
+    let texels = u64::from(size) * u64::from(size);
+    texels * (4 + 1 + 4)
+}
+
+/// How faces' UV triangles share a `size × size` texture, counted as [`bake_uv_texture`]
+/// counts them, without sampling any colour.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct UvCoverage {
+    /// Texels some face covers.
+    pub covered_texels: u64,
+    /// Texels strictly inside the UV triangles of two or more faces.
+    pub overlapping_texels: u64,
+    /// Faces whose UV triangle has no area.
+    pub faces_without_uvs: u64,
+}
+
+/// The [`UvCoverage`] of `corner_uvs` in a `size × size` texture.
+pub fn uv_coverage(corner_uvs: &[[[f32; 2]; 3]], size: u32) -> UvCoverage {
+    let mut covered = vec![false; size as usize * size as usize];
+    let mut out = UvCoverage::default();
+    for uvs in corner_uvs {
+        let has_area = for_each_texel(uvs, [size, size], |texel, [w0, w1, w2]| {
+            if covered[texel] && w0.min(w1).min(w2) > 1e-6 {
+                out.overlapping_texels += 1;
+            }
+            covered[texel] = true;
+        });
+        if !has_area {
+            out.faces_without_uvs += 1;
+        }
+    }
+    out.covered_texels = covered.iter().filter(|&&c| c).count() as u64;
+    out
+}
+
 /// Calls `visit(texel, barycentric)` for each texel of a `width × height` texture whose
 /// centre lies in the UV triangle `uvs` (texel index wrapped into the texture); false when
 /// it has no area.

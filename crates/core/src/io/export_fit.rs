@@ -90,7 +90,7 @@ pub fn coarser(store: &ColorStore, levels: u32) -> ColorStore {
 }
 
 /// The smallest level whose tessellation fits `max` vertices, with that store.
-fn level_for(store: &ColorStore, max: u64) -> Result<(u32, ColorStore), FitError> {
+pub fn level_for(store: &ColorStore, max: u64) -> Result<(u32, ColorStore), FitError> {
     let mut level = 0;
     let mut current = store.clone();
     loop {

@@ -31,8 +31,13 @@
 //!   each triangle `(G, start, end)`) and then, when `i + j ≤ R − 2`, the sub-triangle
 //!   `(i+1, j), (i+1, j+1), (i, j+1)` — `R²` triangles per face without fine sides, with the
 //!   face's winding;
+//! - `NORMAL` (float VEC3): smooth normals, so viewers do not shade each sub-triangle flat: the
+//!   area-weighted normals of the welded mesh's vertices ([`vertex_normals`]) interpolated at
+//!   the vertex's barycentric coordinates in its face and made unit (the face normal where
+//!   they cancel). Shared samples get the same normal from either face (an edge sample's
+//!   normal depends on the edge's two vertices only);
 //! - a material with metallic factor 0 and roughness factor 1, so that viewers show the
-//!   colours as diffuse colour; no `NORMAL` (glTF viewers then use flat normals).
+//!   colours as diffuse colour.
 //!
 //! A glTF viewer interpolates `COLOR_0` linearly across each sub-triangle, which is exactly
 //! meshpaint's linear filter ([`crate::packing::sampler`], thesis eq. 2.4).
@@ -59,6 +64,7 @@ use thiserror::Error;
 
 use crate::colors::layout::{self, Resolution};
 use crate::colors::store::{ColorStore, SampleRef};
+use crate::mesh::normals::{face_cross, interpolated_normal, unit_or_zero, vertex_normals};
 
 /// The value of `asset.generator` in exported files.
 pub const GENERATOR: &str = "meshpaint";
@@ -138,6 +144,8 @@ pub enum ExportError {
 pub struct Tessellation {
     /// Vertex positions (barycentric combinations of the face corners).
     pub positions: Vec<[f32; 3]>,
+    /// Unit smooth normals (module documentation).
+    pub normals: Vec<[f32; 3]>,
     /// Vertex colours: the sample colours, linear RGBA, clamped to `[0, 1]`.
     pub colors: Vec<[f32; 4]>,
     /// The sample each vertex shows (`None`: the centroid of a fanned sub-triangle).
@@ -221,7 +229,7 @@ fn fan_counts(ratios: &[u32; 3], res: u32) -> (u64, u64) {
 const UNASSIGNED: u32 = u32::MAX;
 
 /// Bytes per vertex in the binary chunk: POSITION (3 × f32) + COLOR_0 (4 × f32).
-const VERTEX_BYTES: u64 = 12 + 16;
+const VERTEX_BYTES: u64 = 12 + 12 + 16;
 
 /// Room left in the GLB for its headers and JSON chunk (a few kilobytes at most).
 const JSON_ALLOWANCE: u64 = 64 << 10;
@@ -289,12 +297,14 @@ pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessella
     let capacity = usize::try_from(vertex_bound).unwrap_or(0);
     let mut out = Tessellation {
         positions: Vec::with_capacity(capacity),
+        normals: Vec::with_capacity(capacity),
         colors: Vec::with_capacity(capacity),
         samples: Vec::with_capacity(capacity),
         triangles: Vec::with_capacity(usize::try_from(triangle_count).unwrap_or(0)),
     };
     // Lattice point (i, j) of the current face → vertex, row by row (reused per face).
     let mut lattice: Vec<u32> = Vec::new();
+    let smooth = vertex_normals(positions, &topology.face_vertices);
     for (face, corners) in topology.face_vertices.iter().enumerate() {
         let face = face as u32;
         let Some(r) = store.face_resolution(face) else {
@@ -302,6 +312,10 @@ pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessella
         };
         let res = r.get();
         let corner_positions = corners.map(|v| positions.get(v as usize).copied().unwrap_or([0.0; 3]));
+        let normals = FaceNormals {
+            corners: corners.map(|v| smooth.get(v as usize).copied().unwrap_or([0.0; 3])),
+            face: unit_or_zero(face_cross(corner_positions[0], corner_positions[1], corner_positions[2])),
+        };
         lattice.clear();
         for i in 0..=res {
             for j in 0..=res - i {
@@ -328,6 +342,7 @@ pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessella
                     }
                     let index = out.positions.len() as u32;
                     out.positions.push(lattice_position(&corner_positions, r, i, j));
+                    out.normals.push(normals.at(layout::sample_barycentric(r, i, j)));
                     out.colors.push(color.map(|c| c.clamp(0.0, 1.0)));
                     out.samples.push(Some(sample));
                     if let Some(slot) = slot {
@@ -348,7 +363,7 @@ pub fn tessellate(positions: &[[f32; 3]], store: &ColorStore) -> Result<Tessella
             for j in 0..res - i {
                 if let Some(segments) = fan_segments(&ratios, res, i, j) {
                     let ends = [at(i, j), at(i + 1, j), at(i, j + 1)];
-                    let fan = Fan { face, res, i, j, ends, segments, corner_positions: &corner_positions };
+                    let fan = Fan { face, res, i, j, ends, segments, corner_positions: &corner_positions, normals };
                     fan.emit(store, &edge_base, &mut edge_slots, &mut out)?;
                 } else {
                     out.triangles.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
@@ -373,6 +388,21 @@ struct Fan<'a> {
     /// Segments of each side (`R_e / R_f` on a fine side, else 1).
     segments: [u32; 3],
     corner_positions: &'a [[f32; 3]; 3],
+    normals: FaceNormals,
+}
+
+/// A face's corner vertex normals and its own normal (for [`interpolated_normal`]).
+#[derive(Debug, Clone, Copy)]
+struct FaceNormals {
+    corners: [[f64; 3]; 3],
+    face: [f64; 3],
+}
+
+impl FaceNormals {
+    /// The smooth normal at barycentric `w`.
+    fn at(&self, w: [f64; 3]) -> [f32; 3] {
+        interpolated_normal(&self.corners, w, self.face)
+    }
 }
 
 impl Fan<'_> {
@@ -385,7 +415,7 @@ impl Fan<'_> {
         edge_slots: &mut [u32],
         out: &mut Tessellation,
     ) -> Result<(), ExportError> {
-        let Fan { face, res, i, j, ends, segments, corner_positions } = *self;
+        let Fan { face, res, i, j, ends, segments, corner_positions, normals } = *self;
         let topology = store.topology();
         let corner_colors = ends.map(|v| out.colors.get(v as usize).copied().unwrap_or([0.0; 4]));
         let centroid = out.positions.len() as u32;
@@ -396,6 +426,7 @@ impl Fan<'_> {
                 + w[1] * f64::from(corner_positions[1][a])
                 + w[2] * f64::from(corner_positions[2][a])) as f32
         }));
+        out.normals.push(normals.at(w));
         out.colors
             .push(std::array::from_fn(|c| (corner_colors[0][c] + corner_colors[1][c] + corner_colors[2][c]) / 3.0));
         out.samples.push(None);
@@ -437,6 +468,7 @@ impl Fan<'_> {
                         }
                         *slot = out.positions.len() as u32;
                         out.positions.push(lattice_position(corner_positions, r_edge, fi, fj));
+                        out.normals.push(normals.at(layout::sample_barycentric(r_edge, fi, fj)));
                         out.colors.push(color.map(|c| c.clamp(0.0, 1.0)));
                         out.samples.push(Some(sample));
                     }
@@ -526,8 +558,12 @@ pub fn tessellation_to_glb_encoded(
     if vertices == 0 || triangles == 0 {
         return Err(ExportError::Empty);
     }
-    if tessellation.colors.len() != vertices {
-        return Err(ExportError::Encode(format!("{} colours for {vertices} vertices", tessellation.colors.len())));
+    if tessellation.colors.len() != vertices || tessellation.normals.len() != vertices {
+        return Err(ExportError::Encode(format!(
+            "{} colours and {} normals for {vertices} vertices",
+            tessellation.colors.len(),
+            tessellation.normals.len()
+        )));
     }
     if let Some(&bad) = tessellation.triangles.iter().flatten().find(|&&index| index as usize >= vertices) {
         return Err(ExportError::Encode(format!("index {bad} out of range ({vertices} vertices)")));
@@ -542,11 +578,16 @@ pub fn tessellation_to_glb_encoded(
         }
     }
 
-    // Binary chunk, little-endian: positions, colours, indices (each offset a multiple of 4).
+    // Binary chunk, little-endian: positions, normals, colours, indices (each offset a
+    // multiple of 4).
     let u16_indices = use_u16_indices(vertices as u64);
     let index_bytes = if u16_indices { 2 } else { 4 } * 3 * triangles;
     let mut bin: Vec<u8> = Vec::with_capacity(vertices * VERTEX_BYTES as usize + index_bytes + 3);
     for value in tessellation.positions.iter().flatten() {
+        bin.extend_from_slice(&value.to_le_bytes());
+    }
+    let normals_offset = bin.len();
+    for value in tessellation.normals.iter().flatten() {
         bin.extend_from_slice(&value.to_le_bytes());
     }
     let colors_offset = bin.len();
@@ -572,6 +613,7 @@ pub fn tessellation_to_glb_encoded(
         vertices,
         triangles,
         buffer_length,
+        normals_offset,
         colors_offset,
         indices_offset,
         u16_indices,
@@ -602,6 +644,7 @@ struct GltfLayout {
     vertices: usize,
     triangles: usize,
     buffer_length: usize,
+    normals_offset: usize,
     colors_offset: usize,
     indices_offset: usize,
     u16_indices: bool,
@@ -638,7 +681,8 @@ fn gltf_root(layout: GltfLayout) -> json::Root {
             target: Some(Valid(target)),
         })
     };
-    let positions_view = view(&mut root, 0, layout.colors_offset, Target::ArrayBuffer);
+    let positions_view = view(&mut root, 0, layout.normals_offset, Target::ArrayBuffer);
+    let normals_view = view(&mut root, layout.normals_offset, layout.colors_offset, Target::ArrayBuffer);
     let colors_view = view(&mut root, layout.colors_offset, layout.indices_offset, Target::ArrayBuffer);
     let indices_view = view(&mut root, layout.indices_offset, layout.buffer_length, Target::ElementArrayBuffer);
 
@@ -664,6 +708,7 @@ fn gltf_root(layout: GltfLayout) -> json::Root {
         Type::Vec3,
         Some((layout.min, layout.max)),
     ));
+    let normals = root.push(accessor(normals_view, layout.vertices, ComponentType::F32, Type::Vec3, None));
     let (color_component, normalized) = match layout.encoding {
         ColorEncoding::Float => (ComponentType::F32, false),
         ColorEncoding::Unorm16 => (ComponentType::U16, true),
@@ -688,6 +733,7 @@ fn gltf_root(layout: GltfLayout) -> json::Root {
     let primitive = json::mesh::Primitive {
         attributes: BTreeMap::from([
             (Valid(json::mesh::Semantic::Positions), positions),
+            (Valid(json::mesh::Semantic::Normals), normals),
             (Valid(json::mesh::Semantic::Colors(0)), colors),
         ]),
         extensions: None,

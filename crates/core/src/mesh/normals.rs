@@ -55,3 +55,14 @@ pub fn smooth_corner_normal(vertex_normal: [f32; 3], face_normal: [f32; 3]) -> [
         face_normal
     }
 }
+
+/// The smooth normal at barycentric `w` of a face whose corners have the vertex normals
+/// `corners` (unit or zero): their weighted sum made unit, or `face_normal` where that sum
+/// vanishes (opposite normals, zero vertex normals).
+pub fn interpolated_normal(corners: &[[f64; 3]; 3], w: [f64; 3], face_normal: [f64; 3]) -> [f32; 3] {
+    let sum = std::array::from_fn(|a| w[0] * corners[0][a] + w[1] * corners[1][a] + w[2] * corners[2][a]);
+    let unit = unit_or_zero(sum);
+    let unit = if unit == [0.0; 3] { face_normal } else { unit };
+    let unit = if unit == [0.0; 3] { [0.0, 0.0, 1.0] } else { unit };
+    unit.map(|x| x as f32)
+}

@@ -24,3 +24,4 @@ mod seams;
 mod store;
 mod topology;
 mod undo;
+mod unwrap;
