@@ -6,6 +6,7 @@
 //! |---|---|
 //! | [`layout`] | block resolution per face, pairing, tents (level 0) and squares (levels ≥ 1), the 4-byte face record and the band table the shader reads |
 //! | [`mod@build`] | packed mesh colors → atlas texels (reference sampler at every lattice point, `c₃ = c₁ + c₂ − c₀` rings), in parallel bands |
+//! | [`strips`] | strips of squares sharing sides at levels ≥ 1, cut into strip rows |
 //! | [`sample`] | the CPU evaluation of hardware bilinear / trilinear filtering of the atlas |
 //! | [`file`] | the MCT file (`docs/MCT_FORMAT.md`): mesh, records, band table and atlas in one checked, checksummed file |
 //!
@@ -21,6 +22,7 @@ pub mod build;
 pub mod file;
 pub mod layout;
 pub mod sample;
+pub mod strips;
 
 pub use build::build;
 pub use layout::{BlockFrame, MctBands, MctFaceRecord, MctLayout};
@@ -105,10 +107,9 @@ pub struct MeshColorTexture {
 }
 
 impl MeshColorTexture {
-    /// GPU bytes: the atlas, the face records and the band table.
+    /// GPU bytes: the atlas, the face records with the strip-row masks, and the entries of the
+    /// band table the GPU reads (16 bytes each, [`MctLayout::gpu_band_entries`]).
     pub fn gpu_bytes(&self) -> u64 {
-        self.texels.len() as u64
-            + (self.layout.records.len() * std::mem::size_of::<MctFaceRecord>()) as u64
-            + std::mem::size_of::<MctBands>() as u64
+        self.texels.len() as u64 + self.layout.record_bytes() + 16 * self.layout.gpu_band_entries()
     }
 }

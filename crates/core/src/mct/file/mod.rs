@@ -8,7 +8,7 @@
 //! offset 0     header (144 bytes, zero-padded to 256)
 //! offset 256·k positions     vertex_count × [f32; 3]
 //! offset 256·k indices       face_count × [u32; 3]
-//! offset 256·k face records  face_count × u32 (MctFaceRecord)
+//! offset 256·k face records  face_count × u32 (MctFaceRecord), then the strip-row masks (u32 each)
 //! offset 256·k band table    169 × [u32; 4] (MctBands, 2704 bytes)
 //! offset 256·k atlas texels  width × height × bytes_per_sample(format), row-major
 //! ```
@@ -62,7 +62,7 @@ pub use error::MctFileError;
 /// The first 8 bytes of every MCT file.
 pub const MAGIC: [u8; 8] = *b"MESHMCT\0";
 /// The format version this module writes and reads.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 /// Size of the version-1 header in bytes (zero-padded to [`SECTION_ALIGN`]).
 pub const HEADER_SIZE: usize = 144;
 /// Alignment of every section's offset in bytes.
@@ -227,6 +227,7 @@ pub fn to_bytes(positions: &[[f32; 3]], indices: &[[u32; 3]], mct: &MeshColorTex
         positions,
         indices,
         records: &layout.records,
+        masks: &layout.masks,
         bands: &layout.bands,
         width: layout.width,
         height: layout.height,
@@ -237,7 +238,7 @@ pub fn to_bytes(positions: &[[f32; 3]], indices: &[[u32; 3]], mct: &MeshColorTex
     let lengths = [
         u64::from(vertex_count) * POSITION_SIZE,
         u64::from(face_count) * TRIANGLE_SIZE,
-        u64::from(face_count) * RECORD_SIZE,
+        (u64::from(face_count) + layout.masks.len() as u64) * RECORD_SIZE,
         BANDS_SIZE,
         texel_bytes,
     ];
@@ -276,6 +277,7 @@ pub fn to_bytes(positions: &[[f32; 3]], indices: &[[u32; 3]], mct: &MeshColorTex
     out.extend(indices.iter().flatten().flat_map(|i| i.to_le_bytes()));
     pad_to(&mut out, sections[2]);
     out.extend(layout.records.iter().flat_map(|r| r.0.to_le_bytes()));
+    out.extend(layout.masks.iter().flat_map(|m| m.to_le_bytes()));
     pad_to(&mut out, sections[3]);
     out.extend(layout.bands.bands.iter().flatten().flat_map(|w| w.to_le_bytes()));
     pad_to(&mut out, sections[4]);
@@ -399,6 +401,9 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
         return Err(truncated_header());
     };
     let header = Header::parse(header_bytes);
+    if header.version == 1 {
+        return Err(MctFileError::OldVersion);
+    }
     if header.version != VERSION {
         return Err(MctFileError::UnsupportedVersion(header.version));
     }
@@ -428,7 +433,9 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
     let [positions, indices, records, bands, texels] = header.sections;
     check_length(positions, 0, vertex_count, POSITION_SIZE, "vertices")?;
     check_length(indices, 1, face_count, TRIANGLE_SIZE, "faces")?;
-    check_length(records, 2, face_count, RECORD_SIZE, "faces")?;
+    // Face records, then the strip-row masks (their number is checked against the records).
+    let mask_count = (records.length / RECORD_SIZE).saturating_sub(face_count);
+    check_length(records, 2, face_count + mask_count, RECORD_SIZE, "faces and strip-row masks")?;
     check_length(bands, 3, 1, BANDS_SIZE, "band tables")?;
     check_length(texels, 4, texel_count, format.bytes_per_sample() as u64, "texels")?;
 
@@ -437,8 +444,13 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
     let positions: Vec<[f32; 3]> =
         le_words::<3>(section_bytes(bytes, positions)).into_iter().map(|words| words.map(f32::from_bits)).collect();
     let indices = le_words::<3>(section_bytes(bytes, indices));
-    let records: Vec<MctFaceRecord> =
-        le_words::<1>(section_bytes(bytes, records)).into_iter().map(|[word]| MctFaceRecord(word)).collect();
+    let mut words = le_words::<1>(section_bytes(bytes, records));
+    let masks: Vec<u32> = words
+        .split_off(usize::try_from(face_count).unwrap_or(usize::MAX).min(words.len()))
+        .into_iter()
+        .map(|[word]| word)
+        .collect();
+    let records: Vec<MctFaceRecord> = words.into_iter().map(|[word]| MctFaceRecord(word)).collect();
     let mut band_table = MctBands::default();
     for (entry, words) in band_table.bands.iter_mut().zip(le_words::<4>(section_bytes(bytes, bands))) {
         *entry = words;
@@ -447,6 +459,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
         positions: &positions,
         indices: &indices,
         records: &records,
+        masks: &masks,
         bands: &band_table,
         width: header.width,
         height: header.height,
@@ -459,6 +472,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
         height: header.height,
         pairs,
         levels: header.levels,
+        masks,
     };
     let texels = section_bytes(bytes, texels).to_vec();
     Ok(MctFile { positions, indices, mct: MeshColorTexture { layout, format, texels, stats: MctStats::default() } })
