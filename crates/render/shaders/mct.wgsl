@@ -74,8 +74,11 @@ fn mct_log2_block(record: u32) -> u32 {
 fn mct_flip(record: u32) -> bool {
     return (record & 256u) != 0u;
 }
+fn mct_swap(record: u32) -> bool {
+    return (record & 512u) != 0u;
+}
 fn mct_pair(record: u32) -> u32 {
-    return record >> 9u;
+    return record >> 10u;
 }
 
 // The band-table entry of group `g` at `level` (see `mct_bands`).
@@ -125,14 +128,16 @@ fn tent_corner(record: u32, corner: u32) -> vec2<f32> {
 
 // layout.rs `frame_of` at level ≥ 1 in units of the square's side r: the pair shares the
 // diagonal, p at (1, 0) and q at (0, 1); the third corner is the first face's origin (0, 0)
-// or the second face's (1, 1); mirrored vertically when the record says so. A point of the
-// face is texel `x₀ + r · square` at every level.
+// or the second face's (1, 1); p and q exchanged (swap: the tent's p is the square's q) and
+// mirrored vertically when the record says so. A point of the face is texel
+// `x₀ + r · square` at every level.
 fn square_unit_corner(record: u32, corner: u32) -> vec2<f32> {
     var square = select(vec2<f32>(0.0), vec2<f32>(1.0), mct_second(record));
+    let at_p = select(vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0), mct_swap(record));
     if corner == mct_corner_p(record) {
-        square = vec2<f32>(1.0, 0.0);
+        square = at_p;
     } else if corner == mct_corner_q(record) {
-        square = vec2<f32>(0.0, 1.0);
+        square = at_p.yx;
     }
     if mct_flip(record) {
         square.y = 1.0 - square.y;

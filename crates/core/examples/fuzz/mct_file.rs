@@ -177,18 +177,18 @@ pub fn fix_checksum(bytes: &mut [u8]) {
 }
 
 /// A face record with one field changed: corner, direction bit, side bit, block resolution,
-/// flip bit, pair index (near its value, near the group's size, or anything), or
+/// flip or swap bit, pair index (near its value, near the group's size, or anything), or
 /// random bits.
 fn mutate_record(record: u32, faces: u32, rng: &mut Rng) -> u32 {
-    let pair = record >> 9;
+    let pair = record >> 10;
     match rng.below(8) {
         0 => (record & !3) | rng.below(4) as u32,
         1 => record ^ 4,
         2 => record ^ 8,
         3 => (record & !0xf0) | ((rng.below(16) as u32) << 4),
-        4 => (record & 0x1ff) | ((pair.wrapping_add(rng.pick(&[1, u32::MAX, 2])) & 0x7f_ffff) << 9),
-        5 => (record & 0x1ff) | ((rng.interesting_u32(faces) & 0x7f_ffff) << 9),
-        6 => record ^ 256,
+        4 => (record & 0x3ff) | ((pair.wrapping_add(rng.pick(&[1, u32::MAX, 2])) & 0x3f_ffff) << 10),
+        5 => (record & 0x3ff) | ((rng.interesting_u32(faces) & 0x3f_ffff) << 10),
+        6 => record ^ (256 << rng.below(2)),
         _ => rng.next_u64() as u32,
     }
 }

@@ -31,6 +31,7 @@
 
 use crate::colors::layout::MAX_LOG2_RESOLUTION;
 use crate::mct::MctError;
+use crate::mct::ring::right_angle_at_q;
 use crate::mct::strips::{EdgeFaces, Oriented, ROW_SIZES, StripRows, strip_rows};
 use crate::packing::linear::PackedMesh;
 use rayon::prelude::*;
@@ -38,8 +39,8 @@ use rayon::prelude::*;
 /// Number of block-resolution groups (`log2 R_b` = 0..=12) and of levels per group.
 pub const GROUPS: usize = MAX_LOG2_RESOLUTION as usize + 1;
 
-/// Largest pair index a face record holds (23 bits).
-pub const MAX_PAIRS_PER_GROUP: u32 = 1 << 23;
+/// Largest pair index a face record holds (22 bits).
+pub const MAX_PAIRS_PER_GROUP: u32 = 1 << 22;
 
 /// One face's placement in a `u32` (keep in sync with `mct_record_*` in
 /// crates/render/shaders/mct.wgsl):
@@ -51,7 +52,8 @@ pub const MAX_PAIRS_PER_GROUP: u32 = 1 << 23;
 /// | 3 | side: 0 = first face of its pair, 1 = second |
 /// | 4–7 | `log2 R_b` |
 /// | 8 | the square (levels ≥ 1) is mirrored vertically |
-/// | 9–31 | pair index within the group |
+/// | 9 | swap: the square has `p` where this record's `q` is and `q` where its `p` is (the tent's right angle was moved to the other end of the shared edge, [`super::ring`]) |
+/// | 10–31 | pair index within the group |
 #[repr(transparent)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct MctFaceRecord(pub u32);
@@ -60,15 +62,20 @@ const _: () = assert!(std::mem::size_of::<MctFaceRecord>() == 4);
 
 impl MctFaceRecord {
     /// Packs the fields; `pair < MAX_PAIRS_PER_GROUP`, `corner_p < 3`, `log2_block <= 12`.
-    pub fn new(corner_p: u32, q_next: bool, second: bool, log2_block: u32, pair: u32, flip: bool) -> Self {
+    pub fn new(corner_p: u32, q_next: bool, second: bool, log2_block: u32, pair: u32, [flip, swap]: [bool; 2]) -> Self {
         MctFaceRecord(
             (corner_p & 3)
                 | (u32::from(q_next) << 2)
                 | (u32::from(second) << 3)
                 | ((log2_block & 15) << 4)
                 | (u32::from(flip) << 8)
-                | (pair << 9),
+                | (u32::from(swap) << 9)
+                | (pair << 10),
         )
+    }
+    /// Whether the square of levels ≥ 1 exchanges `p` and `q`.
+    pub fn swap(self) -> bool {
+        self.0 & 512 != 0
     }
     /// Whether the square of levels ≥ 1 is mirrored vertically.
     pub fn flip(self) -> bool {
@@ -96,7 +103,7 @@ impl MctFaceRecord {
     }
     /// The pair's index within its group.
     pub fn pair(self) -> u32 {
-        self.0 >> 9
+        self.0 >> 10
     }
 }
 
@@ -257,8 +264,13 @@ impl MctLayout {
         }
         let mut records = vec![MctFaceRecord::default(); packed.indices.len()];
         for (g, group) in rows.iter().enumerate() {
-            for (index, pair) in group.pairs.iter().enumerate() {
-                assign_records(packed, &mut records, g as u32, index as u32, pair);
+            let swaps: Vec<bool> = group
+                .pairs
+                .par_iter()
+                .map(|pair| right_angle_at_q(packed, pair.faces, pair.p, pair.q, 1 << g))
+                .collect();
+            for (index, (pair, swap)) in group.pairs.iter().zip(swaps).enumerate() {
+                assign_records(packed, &mut records, g as u32, index as u32, pair, swap);
             }
         }
         let pairs = rows.into_iter().map(|group| group.pairs.into_iter().map(|p| p.faces).collect()).collect();
@@ -317,6 +329,7 @@ pub fn frame_of(record: MctFaceRecord, bands: &MctBands, masks: &[u32], level: u
         // square's origin, p at (r, 0), q at (0, r); the second face's at (r, r); mirrored
         // vertically when the record says so.
         let (mask_base, log2_row, pieces) = bands.strip_rows(g);
+        let (p, q) = if record.swap() { (q, p) } else { (p, q) };
         let log2_row = log2_row.min(31);
         let (strip_row, j) = (pair >> log2_row, pair & ((1 << log2_row) - 1));
         let mask = masks.get((u64::from(mask_base) + strip_row) as usize).copied().unwrap_or(0);
@@ -527,13 +540,16 @@ fn push_neighbour(slots: &mut [u32; 3], face: u32) {
     }
 }
 
-/// Writes the records of pair `index` of group `g`.
-fn assign_records(packed: &PackedMesh, records: &mut [MctFaceRecord], g: u32, index: u32, pair: &Oriented) {
+/// Writes the records of pair `index` of group `g`; `swap`: the tents' right angle at the
+/// square's `q` (the record's `p` is then the square's `q`).
+fn assign_records(packed: &PackedMesh, records: &mut [MctFaceRecord], g: u32, index: u32, pair: &Oriented, swap: bool) {
+    let (p, q) = if swap { (pair.q, pair.p) } else { (pair.p, pair.q) };
     for (side, &face) in pair.faces.iter().enumerate() {
         let Some(corners) = packed.indices.get(face as usize) else { continue };
         let find = |v: u32| corners.iter().position(|&c| c == v).unwrap_or(0);
-        let (cp, cq) = (find(pair.p), find(pair.q));
-        records[face as usize] = MctFaceRecord::new(cp as u32, cq == (cp + 1) % 3, side == 1, g, index, pair.flip);
+        let (cp, cq) = (find(p), find(q));
+        records[face as usize] =
+            MctFaceRecord::new(cp as u32, cq == (cp + 1) % 3, side == 1, g, index, [pair.flip, swap]);
     }
 }
 

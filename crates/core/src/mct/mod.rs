@@ -6,6 +6,7 @@
 //! |---|---|
 //! | [`layout`] | block resolution per face, pairing, tents (level 0) and squares (levels ≥ 1), the 4-byte face record and the band table the shader reads |
 //! | [`mod@build`] | packed mesh colors → atlas texels (reference sampler at every lattice point, `c₃ = c₁ + c₂ − c₀` rings), in parallel bands |
+//! | `ring` | which end of a pair's shared edge its tents put the right angle at (RGBA8: the one whose rings clamp less) |
 //! | [`strips`] | strips of squares sharing sides at levels ≥ 1, cut into strip rows |
 //! | [`sample`] | the CPU evaluation of hardware bilinear / trilinear filtering of the atlas |
 //! | [`file`] | the MCT file (`docs/MCT_FORMAT.md`): mesh, records, band table and atlas in one checked, checksummed file |
@@ -21,6 +22,7 @@
 pub mod build;
 pub mod file;
 pub mod layout;
+mod ring;
 pub mod sample;
 pub mod strips;
 

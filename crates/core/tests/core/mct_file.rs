@@ -272,13 +272,16 @@ fn the_worked_example_has_the_documented_size_and_offsets() {
     let sections: Vec<(usize, usize)> = (0..5).map(|k| section(&bytes, k)).collect();
     assert_eq!(sections, [(256, 48), (512, 24), (768, 12), (1024, 2704), (3840, 200)]);
     assert_eq!(bytes.len(), 4040);
-    // Both faces in pair 0 of group 1 (R_b = 2), sharing the edge 0 → 2.
+    // Both faces in pair 0 of group 1 (R_b = 2), sharing the edge 0 → 2; the square has p at
+    // vertex 2, but these random colours clamp fewer rings with the tents' right angle at
+    // vertex 0 (swap).
     assert_eq!(mct.layout.pairs[1], [[0, 1]]);
     let [a, b] = [mct.layout.records[0], mct.layout.records[1]];
-    assert_eq!((a.0, b.0), (0x16, 0x19), "{a:?} {b:?}");
+    assert_eq!((a.0, b.0), (0x210, 0x21c), "{a:?} {b:?}");
+    assert!(a.swap() && b.swap() && !a.flip());
     let (c0, c1) = (packed.indices[0], packed.indices[1]);
     assert_eq!(([c0[a.corner_p()], c0[a.corner_q()]]), [c1[b.corner_p()], c1[b.corner_q()]]);
-    assert_eq!([c0[a.corner_p()], c0[a.corner_q()]], [2, 0]);
+    assert_eq!([c0[a.corner_p()], c0[a.corner_q()]], [0, 2]);
     // Band table: group 1 level 0 at y = 0, one tent period per row (the atlas is one period
     // wide: the down tent crosses the right edge); level 1 at y = 3, one strip row per row;
     // strip rows of 8 pairs, at most 1 piece, masks from 0; one mask (no piece starts).
@@ -301,9 +304,9 @@ fn the_worked_example_has_the_documented_size_and_offsets() {
     assert_eq!(
         frames,
         [
-            ([3, 0], [1, 0], [0, 1], [2, 1, 0], 2),
+            ([3, 0], [1, 0], [0, 1], [0, 1, 2], 2),
             ([0, 3], [1, 0], [0, 1], [1, 2, 0], 1),
-            ([3, 0], [-1, 0], [0, 1], [1, 2, 0], 2),
+            ([3, 0], [-1, 0], [0, 1], [0, 2, 1], 2),
             ([1, 4], [0, -1], [-1, 0], [2, 1, 0], 1),
         ],
         "{frames:?}"
@@ -522,13 +525,13 @@ fn refuses_records_with_a_bad_corner_resolution_level_or_pair() {
     // A pair index past the faces of its group.
     let g = mct.layout.records[face].log2_block() as usize;
     let faces_in_group = mct.layout.records.iter().filter(|r| r.log2_block() as usize == g).count() as u32;
-    let error = refused(&craft(&bytes, |b| set_record(b, face, (record & 0x1ff) | (faces_in_group << 9))));
+    let error = refused(&craft(&bytes, |b| set_record(b, face, (record & 0x3ff) | (faces_in_group << 10))));
     assert!(
         matches!(error, MctFileError::PairIndex { face: 17, pair, faces, .. } if pair == faces_in_group && faces == u64::from(faces_in_group)),
         "{error:?}"
     );
-    let error = refused(&craft(&bytes, |b| set_record(b, face, (record & 0x1ff) | (0x7f_ffff << 9))));
-    assert!(matches!(error, MctFileError::PairIndex { pair: 0x7f_ffff, .. }), "{error:?}");
+    let error = refused(&craft(&bytes, |b| set_record(b, face, (record & 0x3ff) | (0x3f_ffff << 10))));
+    assert!(matches!(error, MctFileError::PairIndex { pair: 0x3f_ffff, .. }), "{error:?}");
     assert!(error.to_string().contains("pairs are numbered from 0"), "{error}");
 }
 
