@@ -18,6 +18,7 @@ mod export_gltf;
 mod extremes;
 mod formats;
 mod gpu_render;
+mod mct_file;
 mod trade;
 mod validator;
 mod winding;

@@ -50,7 +50,8 @@ pub fn build(packed: &PackedMesh, max_dimension: u32, max_bytes: u64) -> Result<
         .zip(chunks.into_par_iter())
         .map(|(band, chunk)| fill_band(packed, &layout, band, chunk, row_bytes))
         .try_reduce(MctStats::default, |a, b| Ok(a.merged(b)))?;
-    Ok(MeshColorTexture { layout, format, texels, stats })
+    let vertex_density = crate::packing::lod::VertexLod::of(packed).density;
+    Ok(MeshColorTexture { layout, format, texels, stats, vertex_density })
 }
 
 /// Every row of blocks, in y order, rows that share texture rows merged.

@@ -106,6 +106,10 @@ pub struct MeshColorTexture {
     pub texels: Vec<u8>,
     /// Counts from the build.
     pub stats: MctStats,
+    /// Per vertex, the samples per world unit mesh colors' level of detail uses
+    /// (`packing::lod::VertexLod::density`, from each face's own `R_f`): trilinear filtering
+    /// picks its levels from it, and an MCT file does not hold `R_f`.
+    pub vertex_density: Vec<f32>,
 }
 
 impl MeshColorTexture {

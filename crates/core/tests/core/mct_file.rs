@@ -211,8 +211,8 @@ fn header_fields_and_sections_are_where_the_format_document_says() {
     let (packed, mct, bytes) = mixed_file(ColorFormat::Rgba16F);
     assert_eq!(&bytes[..8], b"MESHMCT\0");
     assert_eq!(MAGIC, *b"MESHMCT\0");
-    assert_eq!(u32_at(&bytes, VERSION_AT), 2);
-    assert_eq!(VERSION, 2);
+    assert_eq!(u32_at(&bytes, VERSION_AT), 3);
+    assert_eq!(VERSION, 3);
     assert_eq!(u32_at(&bytes, HEADER_SIZE_AT), HEADER_SIZE as u32);
     assert_eq!(u64_at(&bytes, FILE_SIZE_AT), bytes.len() as u64);
     assert_eq!(u32_at(&bytes, FLAGS_AT), 0);
@@ -230,7 +230,7 @@ fn header_fields_and_sections_are_where_the_format_document_says() {
     // Sections: aligned, in order, each at the first multiple of 256 after the previous.
     let (v, f) = (packed.positions.len(), packed.indices.len());
     let texel_bytes = (mct.layout.width * mct.layout.height) as usize * 8;
-    let lengths = [12 * v, 12 * f, 4 * (f + mct.layout.masks.len()), BANDS_BYTES as usize, texel_bytes];
+    let lengths = [16 * v, 12 * f, 4 * (f + mct.layout.masks.len()), BANDS_BYTES as usize, texel_bytes];
     let mut cursor = HEADER_SIZE;
     for (k, length) in lengths.into_iter().enumerate() {
         let (offset, len) = section(&bytes, k);
@@ -241,7 +241,11 @@ fn header_fields_and_sections_are_where_the_format_document_says() {
     assert_eq!(cursor, bytes.len());
     // Section contents, decoded here by hand.
     let (at, _) = section(&bytes, POSITIONS);
-    assert_eq!(f32::from_le_bytes(bytes[at + 16..at + 20].try_into().unwrap()), packed.positions[1][1]);
+    assert_eq!(f32::from_le_bytes(bytes[at + 20..at + 24].try_into().unwrap()), packed.positions[1][1]);
+    // Each vertex's fourth word is its level-of-detail density, as the GPU mesh computes it.
+    let density = meshpaint_core::packing::lod::VertexLod::of(&packed).density;
+    assert_eq!(f32::from_le_bytes(bytes[at + 28..at + 32].try_into().unwrap()), density[1]);
+    assert_eq!(mct.vertex_density, density);
     let (at, _) = section(&bytes, INDICES);
     assert_eq!(u32_at(&bytes, at + 12 * 7 + 8), packed.indices[7][2]);
     for face in [0, 100, 319] {
@@ -270,7 +274,7 @@ fn the_worked_example_has_the_documented_size_and_offsets() {
     let bytes = to_bytes(&packed.positions, &packed.indices, &mct).unwrap();
     assert_eq!((mct.layout.width, mct.layout.height, mct.layout.levels), (10, 5, 2));
     let sections: Vec<(usize, usize)> = (0..5).map(|k| section(&bytes, k)).collect();
-    assert_eq!(sections, [(256, 48), (512, 24), (768, 12), (1024, 2704), (3840, 200)]);
+    assert_eq!(sections, [(256, 64), (512, 24), (768, 12), (1024, 2704), (3840, 200)]);
     assert_eq!(bytes.len(), 4040);
     // Both faces in pair 0 of group 1 (R_b = 2), sharing the edge 0 → 2; the square has p at
     // vertex 2, but these random colours clamp fewer rings with the tents' right angle at
@@ -358,13 +362,16 @@ fn refuses_a_bad_magic_version_header_size_flags_and_reserved_fields() {
         assert!(matches!(error, MctFileError::Truncated { end: 144, .. }), "{len}: {error:?}");
         assert!(error.to_string().contains("truncated"), "{error}");
     }
-    let error = refused(&craft(&bytes, |b| set_u32(b, VERSION_AT, 3)));
-    assert!(matches!(error, MctFileError::UnsupportedVersion(3)), "{error:?}");
-    assert!(error.to_string().contains("version 3"), "{error}");
-    // Version 1 (squares without strips) is refused with what to do.
-    let error = refused(&craft(&bytes, |b| set_u32(b, VERSION_AT, 1)));
-    assert!(matches!(error, MctFileError::OldVersion), "{error:?}");
-    assert!(error.to_string().contains("export it again"), "{error}");
+    let error = refused(&craft(&bytes, |b| set_u32(b, VERSION_AT, 4)));
+    assert!(matches!(error, MctFileError::UnsupportedVersion(4)), "{error:?}");
+    assert!(error.to_string().contains("version 4"), "{error}");
+    // Versions 1 (squares without strips) and 2 (no density per vertex) are refused with what
+    // to do.
+    for old in [1, 2] {
+        let error = refused(&craft(&bytes, |b| set_u32(b, VERSION_AT, old)));
+        assert!(matches!(error, MctFileError::OldVersion(v) if v == old), "{error:?}");
+        assert!(error.to_string().contains("export it again"), "{error}");
+    }
     let error = refused(&craft(&bytes, |b| set_u32(b, HEADER_SIZE_AT, 128)));
     assert!(matches!(error, MctFileError::HeaderSize(128)), "{error:?}");
     let error = refused(&craft(&bytes, |b| set_u32(b, FLAGS_AT, 4)));
@@ -487,10 +494,18 @@ fn refuses_non_finite_positions_and_indices_out_of_range() {
     for value in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
         let error = refused(&craft(&bytes, |b| {
             let (at, _) = section(b, POSITIONS);
-            b[at + 12 * 5 + 4..at + 12 * 5 + 8].copy_from_slice(&value.to_le_bytes());
+            b[at + 16 * 5 + 4..at + 16 * 5 + 8].copy_from_slice(&value.to_le_bytes());
         }));
         assert!(matches!(error, MctFileError::NonFinitePosition { vertex: 5, .. }), "{error:?}");
         assert!(error.to_string().contains("vertex 5 is not finite"), "{error}");
+    }
+    for value in [f32::NAN, f32::INFINITY, -1.0] {
+        let error = refused(&craft(&bytes, |b| {
+            let (at, _) = section(b, POSITIONS);
+            b[at + 16 * 6 + 12..at + 16 * 6 + 16].copy_from_slice(&value.to_le_bytes());
+        }));
+        assert!(matches!(error, MctFileError::BadDensity { vertex: 6, .. }), "{error:?}");
+        assert!(error.to_string().contains("level-of-detail density"), "{error}");
     }
     let v = packed.positions.len() as u32;
     for index in [v, u32::MAX] {

@@ -20,6 +20,7 @@ pub(super) fn check_limits(width: u32, height: u32, levels: u32) -> Result<(), M
 /// What [`check_content`] reads: the mesh and the layout without its pair lists.
 pub(super) struct Content<'a> {
     pub(super) positions: &'a [[f32; 3]],
+    pub(super) density: &'a [f32],
     pub(super) indices: &'a [[u32; 3]],
     pub(super) records: &'a [MctFaceRecord],
     pub(super) masks: &'a [u32],
@@ -32,11 +33,16 @@ pub(super) struct Content<'a> {
 /// Checks the content of a file whose sections have consistent sizes (see the module
 /// docs) and returns the pair lists the records describe.
 pub(super) fn check_content(content: &Content<'_>) -> Result<Vec<Vec<[u32; 2]>>, MctFileError> {
-    let Content { positions, indices, records, masks, bands, width, height, levels } = *content;
+    let Content { positions, density, indices, records, masks, bands, width, height, levels } = *content;
     check_limits(width, height, levels)?;
     for (vertex, position) in (0u64..).zip(positions) {
         if !position.iter().all(|c| c.is_finite()) {
             return Err(MctFileError::NonFinitePosition { vertex, position: *position });
+        }
+    }
+    for (vertex, &value) in (0u64..).zip(density) {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(MctFileError::BadDensity { vertex, density: value });
         }
     }
     let vertex_count = positions.len() as u64;
@@ -121,14 +127,9 @@ fn check_strip_rows(bands: &MctBands, masks: &[u32], pairs: &[Vec<[u32; 2]>]) ->
     for (g, list) in pairs.iter().enumerate().filter(|(_, list)| !list.is_empty()) {
         let resolution = 1u32 << g;
         let (mask_base, log2_row, pieces) = bands.strip_rows(g as u32);
-        let (b3, per_row) = (bands.bands[g * GROUPS][3], 1u64.checked_shl(log2_row).unwrap_or(u64::MAX));
+        let per_row = 1u64.checked_shl(log2_row).unwrap_or(u64::MAX);
         let rows = (list.len() as u64).div_ceil(per_row.max(1));
-        if log2_row > 5
-            || b3 >> 16 != 0
-            || pieces == 0
-            || u64::from(pieces) > per_row + 1
-            || u64::from(mask_base) != next
-        {
+        if log2_row > 5 || pieces == 0 || u64::from(pieces) > per_row + 1 || u64::from(mask_base) != next {
             return Err(MctFileError::StripRows { resolution, log2_row, pieces, mask_base, masks: masks.len() as u64 });
         }
         for index in next..next + rows {

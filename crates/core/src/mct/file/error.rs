@@ -56,11 +56,28 @@ pub enum MctFileError {
     /// The file's version is not [`VERSION`].
     #[error("unsupported MCT file version {0} (this build reads version {VERSION})")]
     UnsupportedVersion(u32),
-    /// A version-1 file: written before squares were laid out in strips.
+    /// A version-1 or -2 file: written before squares were laid out in strips (1) or before
+    /// files held the vertices' level-of-detail density (2).
     #[error(
-        "MCT file version 1 was written by an older meshpaint (squares without strips); this build reads version {VERSION}: export it again from its source with `meshpaint export SOURCE -o OUT.mct --representation mct`"
+        "MCT file version {0} was written by an older meshpaint (version 1: squares without strips; 2: no level-of-detail density per vertex); this build reads version {VERSION}: export it again from its source with `meshpaint export SOURCE -o OUT.mct --representation mct`"
     )]
-    OldVersion,
+    OldVersion(u32),
+    /// A vertex's level-of-detail density is negative, NaN or infinite.
+    #[error("vertex {vertex}: level-of-detail density {density} is not a finite number ≥ 0")]
+    BadDensity {
+        /// The vertex.
+        vertex: u64,
+        /// Its density.
+        density: f32,
+    },
+    /// The texture's per-vertex densities do not match the vertices.
+    #[error("{densities} level-of-detail densities for {vertices} vertices")]
+    DensityCount {
+        /// Densities.
+        densities: u64,
+        /// Vertices.
+        vertices: u64,
+    },
     /// The strip-row fields of a group's band entry are out of range.
     #[error(
         "band table, block resolution {resolution}: strip rows of 2^{log2_row} pairs with at most {pieces} pieces and masks from {mask_base} (rows of at most 32 pairs, 1..=rows+1 pieces, masks inside the {masks} stored)"

@@ -6,7 +6,7 @@
 //!
 //! ```text
 //! offset 0     header (144 bytes, zero-padded to 256)
-//! offset 256·k positions     vertex_count × [f32; 3]
+//! offset 256·k positions     vertex_count × [f32; 4]: x, y, z and the LOD density
 //! offset 256·k indices       face_count × [u32; 3]
 //! offset 256·k face records  face_count × u32 (MctFaceRecord), then the strip-row masks (u32 each)
 //! offset 256·k band table    169 × [u32; 4] (MctBands, 2704 bytes)
@@ -62,7 +62,7 @@ pub use error::MctFileError;
 /// The first 8 bytes of every MCT file.
 pub const MAGIC: [u8; 8] = *b"MESHMCT\0";
 /// The format version this module writes and reads.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 /// Size of the version-1 header in bytes (zero-padded to [`SECTION_ALIGN`]).
 pub const HEADER_SIZE: usize = 144;
 /// Alignment of every section's offset in bytes.
@@ -78,8 +78,8 @@ pub const MAX_LEVELS: u32 = GROUPS as u32;
 
 /// Byte offset of the CRC-32 field in the header.
 const CHECKSUM_OFFSET: usize = 140;
-/// Bytes of one position (`[f32; 3]`).
-const POSITION_SIZE: u64 = 12;
+/// Bytes of one vertex (`[f32; 4]`: position and level-of-detail density).
+const POSITION_SIZE: u64 = 16;
 /// Bytes of one triangle's indices (`[u32; 3]`).
 const TRIANGLE_SIZE: u64 = 12;
 /// Bytes of one face record.
@@ -206,6 +206,12 @@ pub fn to_bytes(positions: &[[f32; 3]], indices: &[[u32; 3]], mct: &MeshColorTex
         .map_err(|_| MctFileError::TooMany { what: "vertices", count: positions.len() as u64 })?;
     let face_count = u32::try_from(indices.len())
         .map_err(|_| MctFileError::TooMany { what: "faces", count: indices.len() as u64 })?;
+    if mct.vertex_density.len() != positions.len() {
+        return Err(MctFileError::DensityCount {
+            densities: mct.vertex_density.len() as u64,
+            vertices: positions.len() as u64,
+        });
+    }
     if indices.len() != layout.records.len() {
         return Err(MctFileError::FaceCountMismatch {
             indices: indices.len() as u64,
@@ -225,6 +231,7 @@ pub fn to_bytes(positions: &[[f32; 3]], indices: &[[u32; 3]], mct: &MeshColorTex
     }
     let pairs = check_content(&Content {
         positions,
+        density: &mct.vertex_density,
         indices,
         records: &layout.records,
         masks: &layout.masks,
@@ -272,7 +279,9 @@ pub fn to_bytes(positions: &[[f32; 3]], indices: &[[u32; 3]], mct: &MeshColorTex
         out.resize(usize::try_from(section.offset).unwrap_or(out.len()), 0);
     };
     pad_to(&mut out, sections[0]);
-    out.extend(positions.iter().flatten().flat_map(|c| c.to_le_bytes()));
+    for (position, density) in positions.iter().zip(&mct.vertex_density) {
+        out.extend(position.iter().chain([density]).flat_map(|c| c.to_le_bytes()));
+    }
     pad_to(&mut out, sections[1]);
     out.extend(indices.iter().flatten().flat_map(|i| i.to_le_bytes()));
     pad_to(&mut out, sections[2]);
@@ -401,8 +410,8 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
         return Err(truncated_header());
     };
     let header = Header::parse(header_bytes);
-    if header.version == 1 {
-        return Err(MctFileError::OldVersion);
+    if header.version == 1 || header.version == 2 {
+        return Err(MctFileError::OldVersion(header.version));
     }
     if header.version != VERSION {
         return Err(MctFileError::UnsupportedVersion(header.version));
@@ -441,8 +450,10 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
 
     // Every section now lies inside `bytes` with the length its count implies, so the
     // vectors below are no larger than the file.
-    let positions: Vec<[f32; 3]> =
-        le_words::<3>(section_bytes(bytes, positions)).into_iter().map(|words| words.map(f32::from_bits)).collect();
+    let (positions, density): (Vec<[f32; 3]>, Vec<f32>) = le_words::<4>(section_bytes(bytes, positions))
+        .into_iter()
+        .map(|[x, y, z, d]| ([x, y, z].map(f32::from_bits), f32::from_bits(d)))
+        .unzip();
     let indices = le_words::<3>(section_bytes(bytes, indices));
     let mut words = le_words::<1>(section_bytes(bytes, records));
     let masks: Vec<u32> = words
@@ -457,6 +468,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
     }
     let pairs = check_content(&Content {
         positions: &positions,
+        density: &density,
         indices: &indices,
         records: &records,
         masks: &masks,
@@ -475,7 +487,8 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
         masks,
     };
     let texels = section_bytes(bytes, texels).to_vec();
-    Ok(MctFile { positions, indices, mct: MeshColorTexture { layout, format, texels, stats: MctStats::default() } })
+    let mct = MeshColorTexture { layout, format, texels, stats: MctStats::default(), vertex_density: density };
+    Ok(MctFile { positions, indices, mct })
 }
 
 /// Writes the MCT file of `positions`, `indices` and `mct` to `path` atomically
