@@ -189,6 +189,15 @@ impl OutputArgs {
 pub(super) const LOG_TARGET: &str = "meshpaint";
 
 /// `--format` values.
+/// Whether `path` starts with the MCT-file magic (`meshpaint export --representation mct`).
+pub(super) fn is_mct_file(path: &Path) -> Result<bool> {
+    use std::io::Read;
+    let mut head = [0u8; 8];
+    let mut file = std::fs::File::open(path).with_context(|| path.display().to_string())?;
+    let read = file.read(&mut head).with_context(|| path.display().to_string())?;
+    Ok(meshpaint_core::mct::file::looks_like_mct(&head[..read]))
+}
+
 pub(super) fn parse_format(name: &str) -> Result<ColorFormat, String> {
     ColorFormat::from_name(name).ok_or_else(|| format!("unknown format '{name}' (rgba8, rgba16f, rgba32f)"))
 }

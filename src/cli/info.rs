@@ -14,12 +14,12 @@ use meshpaint_core::mesh::orientation::Orientation;
 use meshpaint_core::mesh::topology::Topology;
 use meshpaint_core::packing::file as packed_file;
 
-use super::args::{LOG_TARGET, ResolutionArg, open};
+use super::args::{LOG_TARGET, ResolutionArg, is_mct_file, open};
 
 /// Arguments of `meshpaint info`.
 #[derive(Debug, clap::Args)]
 pub(super) struct InfoArgs {
-    /// A .glb / .gltf, .obj, .ply, .stl or packed file.
+    /// A .glb / .gltf, .obj, .ply, .stl, packed or MCT file.
     file: PathBuf,
     #[command(flatten)]
     resolution: ResolutionArg,
@@ -37,8 +37,56 @@ fn is_packed_file(path: &Path) -> Result<bool> {
     Ok(packed_file::looks_like_packed(&head[..read]))
 }
 
+/// `info FILE.mct`: what the MCT file holds (read through every check of the reader).
+fn mct_info(path: &Path, json: bool) -> Result<()> {
+    let file = meshpaint_core::mct::file::read_mct(path)?;
+    let layout = &file.mct.layout;
+    let faces_per_block: Vec<(u32, usize)> = (0u32..)
+        .zip(&layout.pairs)
+        .filter(|(_, pairs)| !pairs.is_empty())
+        .map(|(g, _)| (1 << g, layout.records.iter().filter(|r| r.log2_block() == g).count()))
+        .collect();
+    let lone = layout.pairs.iter().flatten().filter(|pair| pair[1] == u32::MAX).count();
+    if json {
+        let value = serde_json::json!({
+            "file": path.display().to_string(),
+            "kind": "mct",
+            "vertices": file.positions.len(),
+            "faces": file.indices.len(),
+            "format": file.mct.format.name(),
+            "atlas_width": layout.width,
+            "atlas_height": layout.height,
+            "levels": layout.levels,
+            "strip_row_masks": layout.masks.len(),
+            "lone_faces": lone,
+            "gpu_bytes": file.mct.gpu_bytes(),
+            "faces_per_block_resolution": faces_per_block.iter().map(|(r, n)| serde_json::json!({"block_resolution": r, "faces": n})).collect::<Vec<_>>(),
+        });
+        println!("{value}");
+        return Ok(());
+    }
+    println!("{}: Mesh Color Texture file (docs/MCT_FORMAT.md)", path.display());
+    println!("  {} vertices, {} faces ({} without a partner)", file.positions.len(), file.indices.len(), lone);
+    println!(
+        "  atlas {}×{} {} texels, {} levels, {} strip-row masks; {} on the GPU",
+        layout.width,
+        layout.height,
+        file.mct.format.name(),
+        layout.levels,
+        layout.masks.len(),
+        bytes_text(file.mct.gpu_bytes())
+    );
+    for (resolution, faces) in faces_per_block {
+        println!("  block resolution {resolution}: {faces} faces");
+    }
+    Ok(())
+}
+
 pub(super) fn run(args: InfoArgs) -> Result<()> {
     let InfoArgs { file: path, resolution, json } = args;
+    if is_mct_file(&path)? {
+        return mct_info(&path, json);
+    }
     if !is_packed_file(&path)? {
         return gltf_info(&path, resolution, json);
     }

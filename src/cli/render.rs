@@ -7,14 +7,17 @@ use anyhow::{Context, Result};
 use meshpaint_core::colors::budget::Budget;
 use meshpaint_core::io::display::{OpenOptions, open_for_display};
 use meshpaint_core::io::document::Source;
-use meshpaint_render::{DrawItem, FilterMode, Gpu, Overlays, RenderSettings, Shading};
+use meshpaint_core::mct::file::read_mct;
+use meshpaint_core::packing::lod::VertexLod;
+use meshpaint_render::{DrawItem, FilterMode, Gpu, MeshGeometry, Overlays, RenderSettings, Shading};
 
-use super::args::{CameraArgs, LOG_TARGET, Representation, ResolutionArg};
+use super::args::{CameraArgs, LOG_TARGET, Representation, ResolutionArg, is_mct_file};
 
 /// Arguments of `meshpaint render`.
 #[derive(Debug, clap::Args)]
 pub(super) struct RenderArgs {
-    /// A .glb / .gltf, .obj, .ply, .stl or packed file.
+    /// A .glb / .gltf, .obj, .ply, .stl, packed or MCT file (an MCT file, from `export
+    /// --representation mct`, is drawn as Mesh Color Textures).
     file: PathBuf,
     /// Output PNG.
     #[arg(long, short = 'o')]
@@ -110,7 +113,20 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
     let started = std::time::Instant::now();
     let gpu = Gpu::new_headless()?;
     let budget = Budget::from_environment().with_gpu(gpu.budget_limits());
-    let (image, triangles, samples) = if args.baseline_uv {
+    let (image, triangles, samples) = if is_mct_file(&args.file)? {
+        anyhow::ensure!(
+            !args.baseline_uv && !args.position_colors,
+            "{}: an MCT file holds its Mesh Color Texture only (no --baseline-uv, no --position-colors)",
+            args.file.display()
+        );
+        let file = read_mct(&args.file)?;
+        let lod = VertexLod::with_density(&file.positions, &file.indices, file.mct.vertex_density.clone());
+        let (geometry, bounds) = MeshGeometry::upload(&gpu.ctx, &file.positions, &file.indices, &lod)
+            .with_context(|| format!("{}: uploading its mesh", args.file.display()))?;
+        let mct = gpu.upload_mct(&geometry, &file.mct).with_context(|| format!("{}", args.file.display()))?;
+        let image = gpu.render_image(DrawItem::Mct(&mct), &settings(bounds), args.width, args.height)?;
+        (image, geometry.face_count, 0)
+    } else if args.baseline_uv {
         let (scene, _) = meshpaint_core::io::document::import_scene_within(&args.file, &budget)?;
         let mesh = gpu.upload_baseline(&scene)?.with_context(|| {
             format!(

@@ -19,6 +19,7 @@ mod export_uvs;
 mod extremes;
 mod formats;
 mod gpu_render;
+mod mct_file;
 mod rule_flags;
 mod trade;
 mod validator;

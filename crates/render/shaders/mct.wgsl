@@ -9,8 +9,9 @@
 // interpolates level 0's coordinate in the face's tent and the point in the square frame
 // (`uv_square`); the fragment stage places the square at its two levels without a branch
 // or an integer division (the talk's 4D coordinate u_ℓ = r_ℓ · u_s + u_δ(ℓ), u_δ from the
-// band table) and takes two lookups. Keep in sync with
-// crates/core/src/mct/layout.rs (`MctFaceRecord`, `MctBands`, `frame_of`) and
+// band table and the face's place in its strip row, found once per vertex) and takes two
+// lookups. The atlas wraps around in x (the sampler repeats: tents cross the right edge).
+// Keep in sync with crates/core/src/mct/layout.rs (`MctFaceRecord`, `MctBands`, `frame_of`) and
 // crates/core/src/mct/sample.rs (`sample_level`, `sample_trilinear`, the CPU evaluation the
 // GPU is tested against).
 
@@ -25,18 +26,18 @@ override MCT_FLAGS: u32 = 0u;
 // Number of block-resolution groups and levels per group (`GROUPS` in layout.rs).
 const MCT_GROUPS: u32 = 13u;
 
-// One u32 per face in .x (R32Uint data texture; bits: layout.rs `MctFaceRecord`).
+// One u32 per face in .x (R32Uint data texture; bits: layout.rs `MctFaceRecord`), then the
+// strip-row masks (layout.rs `MctLayout::masks`) from texel `u.face_count` on.
 @group(0) @binding(3) var mct_records: texture_2d<u32>;
 @group(0) @binding(4) var mct_atlas: texture_2d<f32>;
 @group(0) @binding(6) var mct_sampler: sampler;
 // The band table (`MctBands` in crates/core/src/mct/layout.rs) as crates/render/src/mct.rs
-// uploads it (`gpu_bands`): at index g · 13 + l, the bands of group g at level l and at the
-// next level min(l + 1, last), each packed as y | per_row << 16 (per_row ≥ 1; tent periods
-// at level 0), so that one lookup gives a fragment both of its levels.
-struct MctBands {
-    bands: array<vec4<u32>, 169>,
-}
-@group(0) @binding(7) var<uniform> mct_bands: MctBands;
+// uploads it (`gpu_bands`): at index g · levels + l, the bands of group g at level l (x) and
+// at the next level min(l + 1, last) (y), each packed as y | per_row << 16 (per_row ≥ 1;
+// tent periods at level 0, strip rows above), their empty leading slots (z: l | next << 16)
+// and the group's strip rows (w: log2 S | pieces << 3 | first mask << 9), so that one lookup
+// gives a fragment both of its levels.
+@group(0) @binding(7) var<storage, read> mct_bands: array<vec4<u32>>;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -48,8 +49,9 @@ struct VertexOut {
     // trilinear) of level 0, the tent; zw: the point in the unit square frame of levels ≥ 1
     // (`square_unit_corner`).
     @location(2) uv_square: vec4<f32>,
-    // Trilinear: log2 R_b and the pair index.
-    @location(3) @interpolate(flat) block: vec2<u32>,
+    // Trilinear: log2 R_b, the strip row k, the pair's index j in it and the piece starts
+    // before it in the row (layout.rs `frame_of`).
+    @location(3) @interpolate(flat) block: vec4<u32>,
     // Trilinear: view depth and the level-of-detail term μ (mesh_common.wgsl `lod_term`).
     @location(4) lod: vec2<f32>,
     // FLAG_SMOOTH: the smooth-shading light term.
@@ -69,10 +71,20 @@ fn mct_second(record: u32) -> bool {
 fn mct_log2_block(record: u32) -> u32 {
     return min((record >> 4u) & 15u, MCT_GROUPS - 1u);
 }
+fn mct_flip(record: u32) -> bool {
+    return (record & 256u) != 0u;
+}
+fn mct_swap(record: u32) -> bool {
+    return (record & 512u) != 0u;
+}
+fn mct_pair(record: u32) -> u32 {
+    return record >> 10u;
+}
 
-// The packed bands of group `g` at `level` (x) and at the next level (y).
-fn mct_bands_at(g: u32, level: u32) -> vec2<u32> {
-    return mct_bands.bands[g * MCT_GROUPS + min(level, MCT_GROUPS - 1u)].xy;
+// The band-table entry of group `g` at `level` (see `mct_bands`).
+fn mct_bands_at(g: u32, level: u32) -> vec4<u32> {
+    let levels = max(u.vertex_levels, 1u);
+    return mct_bands[g * levels + min(level, levels - 1u)];
 }
 
 // (⌊a / b⌋, a mod b) of integers a < 2^24 and b ≥ 1 held in f32, by b's reciprocal `inv_b`
@@ -89,11 +101,12 @@ fn div_rem(a: f32, b: f32, inv_b: f32) -> vec2<f32> {
 // layout.rs `frame_of` at level 0 (a tent): the texel-space point of each corner.
 fn tent_corner(record: u32, corner: u32) -> vec2<f32> {
     let g = mct_log2_block(record);
-    let pair = record >> 8u;
-    let band = mct_bands_at(g, 0u).x;
+    let pair = mct_pair(record);
+    let entry = mct_bands_at(g, 0u);
+    let band = entry.x;
     let periods = f32(band >> 16u);
     let r = i32(1u << g);
-    let row_col = div_rem(f32(pair >> 1u), periods, 1.0 / periods);
+    let row_col = div_rem(f32((pair >> 1u) + (entry.z & 0xffffu)), periods, 1.0 / periods);
     let base_x = i32(row_col.y) * (2 * r + 6);
     let top = i32(band & 0xffffu) + i32(row_col.x) * (r + 1);
     let up = (pair & 1u) == 0u;
@@ -115,26 +128,49 @@ fn tent_corner(record: u32, corner: u32) -> vec2<f32> {
 
 // layout.rs `frame_of` at level ≥ 1 in units of the square's side r: the pair shares the
 // diagonal, p at (1, 0) and q at (0, 1); the third corner is the first face's origin (0, 0)
-// or the second face's (1, 1). A point of the face is texel `x₀ + r · square` at every level.
+// or the second face's (1, 1); p and q exchanged (swap: the tent's p is the square's q) and
+// mirrored vertically when the record says so. A point of the face is texel
+// `x₀ + r · square` at every level.
 fn square_unit_corner(record: u32, corner: u32) -> vec2<f32> {
+    var square = select(vec2<f32>(0.0), vec2<f32>(1.0), mct_second(record));
+    let at_p = select(vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0), mct_swap(record));
     if corner == mct_corner_p(record) {
-        return vec2<f32>(1.0, 0.0);
+        square = at_p;
+    } else if corner == mct_corner_q(record) {
+        square = at_p.yx;
     }
-    if corner == mct_corner_q(record) {
-        return vec2<f32>(0.0, 1.0);
+    if mct_flip(record) {
+        square.y = 1.0 - square.y;
     }
-    return select(vec2<f32>(0.0), vec2<f32>(1.0), mct_second(record));
+    return square;
 }
 
-// layout.rs `frame_of` at level ≥ 1: the texel-space point of `square` in the square of
-// pair `pair` (in f32, exact) of group `g` at `level`, whose packed band is `band`: the
-// square's corner, plus `square` scaled by the block's resolution r = max(1, R_b >> level).
-fn square_point(g: u32, pair: f32, square: vec2<f32>, level: u32, band: u32) -> vec2<f32> {
+// The face's place in its group's strip rows (layout.rs `frame_of`): (strip row k, index j
+// in the row, piece starts before it in the row), from its pair index and the row's mask.
+fn strip_place(g: u32, pair: u32) -> vec3<u32> {
+    let strips = mct_bands_at(g, 0u).w;
+    let log2_row = strips & 7u;
+    let k = pair >> log2_row;
+    let j = pair & ((1u << log2_row) - 1u);
+    var before = 0u;
+    if u.vertex_levels > 1u {
+        let mask = textureLoad(mct_records, data_texel(u.face_count + (strips >> 9u) + k), 0).x;
+        before = countOneBits(mask & ((2u << j) - 2u));
+    }
+    return vec3<u32>(k, j, before);
+}
+
+// layout.rs `frame_of` at level ≥ 1: the texel-space point of `square` in the square at
+// `place` (`strip_place`) of group `g` at `level`, whose band-table words are `band` (y |
+// per_row << 16), `skip` and `strips`: the square's corner, plus `square` scaled by the
+// block's resolution r = max(1, R_b >> level).
+fn square_point(g: u32, place: vec3<u32>, square: vec2<f32>, level: u32, band: u32, skip: u32, strips: u32) -> vec2<f32> {
     let per_row = f32(band >> 16u);
     let r = f32(1u << (g - min(level, g)));
-    let row_col = div_rem(pair, per_row, 1.0 / per_row);
-    let side = r + 1.0;
-    return vec2<f32>(row_col.y * side, f32(band & 0xffffu) + row_col.x * side) + r * square;
+    let width = f32(1u << (strips & 7u)) * r + f32((strips >> 3u) & 63u);
+    let row_col = div_rem(f32(place.x + skip), per_row, 1.0 / per_row);
+    let x = row_col.y * width + f32(place.y) * r + f32(place.z);
+    return vec2<f32>(x, f32(band & 0xffffu) + row_col.x * (r + 1.0)) + r * square;
 }
 
 @vertex
@@ -157,11 +193,13 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
     out.light_dot = select(0.0, pulled.light_dot, (MCT_FLAGS & FLAG_SMOOTH) != 0u);
     out.lod = pulled.lod;
     let square = square_unit_corner(record, corner);
-    out.block = vec2<u32>(g, record >> 8u);
+    let place = strip_place(g, mct_pair(record));
+    out.block = vec4<u32>(g, place);
     let level = select(0u, min(u.level, max(u.vertex_levels, 1u) - 1u), LEVEL_MODE == 0u);
     var point = tent_corner(record, corner);
     if level > 0u {
-        point = square_point(g, f32(record >> 8u), square, level, mct_bands_at(g, level).x);
+        let entry = mct_bands_at(g, level);
+        point = square_point(g, place, square, level, entry.x, entry.z & 0xffffu, entry.w);
     }
     out.uv_square = vec4<f32>((point + 0.5) / vec2<f32>(textureDimensions(mct_atlas)), square);
     return out;
@@ -186,10 +224,10 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
         let l1 = min(l0 + 1u, last);
         let inv_size = 1.0 / vec2<f32>(textureDimensions(mct_atlas));
         let g = in.block.x;
-        let pair = f32(in.block.y);
+        let place = in.block.yzw;
         let bands = mct_bands_at(g, l0);
-        let s0 = (square_point(g, pair, in.uv_square.zw, max(l0, 1u), bands.x) + 0.5) * inv_size;
-        let s1 = (square_point(g, pair, in.uv_square.zw, max(l1, 1u), bands.y) + 0.5) * inv_size;
+        let s0 = (square_point(g, place, in.uv_square.zw, max(l0, 1u), bands.x, bands.z & 0xffffu, bands.w) + 0.5) * inv_size;
+        let s1 = (square_point(g, place, in.uv_square.zw, max(l1, 1u), bands.y, bands.z >> 16u, bands.w) + 0.5) * inv_size;
         let c0 = textureSampleLevel(mct_atlas, mct_sampler, select(s0, in.uv_square.xy, l0 == 0u), 0.0);
         let c1 = textureSampleLevel(mct_atlas, mct_sampler, select(s1, in.uv_square.xy, l1 == 0u), 0.0);
         color = mix(c0, c1, t);

@@ -96,12 +96,11 @@ impl BindLayouts {
                 layout_entry(
                     7,
                     wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    // The band table's entries in use (crates/render/src/mct.rs `gpu_bands`).
                     wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
                         has_dynamic_offset: false,
-                        min_binding_size: wgpu::BufferSize::new(
-                            std::mem::size_of::<meshpaint_core::mct::MctBands>() as u64
-                        ),
+                        min_binding_size: wgpu::BufferSize::new(16),
                     },
                 ),
             ],

@@ -1,6 +1,6 @@
 //! A Mesh Color Texture on the GPU (crates/core/src/mct): the atlas as one filterable
-//! texture, the 4-byte face records as an R32Uint data texture, the band table as a
-//! uniform buffer; positions, vertex ids and normals are the [`GpuMesh`]'s own textures,
+//! texture (repeating in x), the 4-byte face records and strip-row masks as an R32Uint data
+//! texture, the band table's entries in use as a storage buffer; positions, vertex ids and normals are the [`GpuMesh`]'s own textures,
 //! so switching representation uploads only what MCT adds.
 
 use glam::DVec3;
@@ -10,7 +10,7 @@ use super::mesh_gpu::{atlas_texture_format, data_texture};
 use super::{GpuContext, MeshGeometry, RenderError};
 use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::mct::layout::GROUPS;
-use meshpaint_core::mct::{MctBands, MctFaceRecord, MeshColorTexture};
+use meshpaint_core::mct::{MctFaceRecord, MctLayout, MeshColorTexture};
 
 /// A Mesh Color Texture uploaded for the MCT pipeline, drawn with its mesh's geometry.
 #[derive(Debug)]
@@ -65,22 +65,26 @@ impl GpuMct {
             view_formats: &[],
         });
         write_atlas(ctx, &atlas, mct);
+        let mut words: Vec<u32> = bytemuck::cast_slice::<MctFaceRecord, u32>(&mct.layout.records).to_vec();
+        words.extend_from_slice(&mct.layout.masks);
         let records = data_texture(
             ctx,
             "MCT face records",
             wgpu::TextureFormat::R32Uint,
-            bytemuck::cast_slice::<MctFaceRecord, u8>(&mct.layout.records),
+            bytemuck::cast_slice::<u32, u8>(&words),
         )?;
+        let table = gpu_bands(&mct.layout);
         let bands = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("MCT band table"),
-            size: std::mem::size_of::<MctBands>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            size: std::mem::size_of_val(table.as_slice()) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        ctx.queue.write_buffer(&bands, 0, bytemuck::bytes_of(&gpu_bands(&mct.layout.bands, mct.layout.levels)));
+        ctx.queue.write_buffer(&bands, 0, bytemuck::cast_slice(&table));
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("MCT bilinear"),
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            // Tents cross the atlas's right edge and continue at its left (layout.rs).
+            address_mode_u: wgpu::AddressMode::Repeat,
             address_mode_v: wgpu::AddressMode::ClampToEdge,
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
@@ -134,22 +138,28 @@ impl GpuMct {
     }
 }
 
-/// The band table as shaders/mct.wgsl reads it (`mct_bands`, the size of [`MctBands`]): at
-/// index `g · GROUPS + l`, the bands of group `g` at level `l` and at the next level
-/// `min(l + 1, levels − 1)`, each `y | per_row << 16` (`per_row` at least 1), so that one
-/// lookup gives a fragment both of its levels. `check` keeps both below 2^16.
-fn gpu_bands(bands: &MctBands, levels: u32) -> MctBands {
-    let last = levels.saturating_sub(1) as usize;
-    let packed = |index: usize| {
-        let [y, per_row, ..] = bands.bands[index];
+/// The band table as shaders/mct.wgsl reads it (`mct_bands`): at index `g · levels + l`
+/// for every group up to the finest ([`MctLayout::gpu_band_entries`] entries), the bands of
+/// group `g` at level `l` and at the next level `min(l + 1, levels − 1)`, each
+/// `y | per_row << 16` (`per_row` at least 1), their empty leading slots (`l | next << 16`)
+/// and the group's strip rows (`log2 S | pieces << 3 | first mask << 9`, the mask's index
+/// counted from the first mask: the shader adds the face count), so that one lookup gives a
+/// fragment both of its levels. `check` keeps y, per_row and skip below 2^16.
+fn gpu_bands(layout: &MctLayout) -> Vec<[u32; 4]> {
+    let levels = layout.levels.max(1) as usize;
+    let bands = &layout.bands;
+    let packed = |g: usize, level: usize| {
+        let [y, per_row, ..] = bands.bands[g * GROUPS + level];
         y | (per_row.max(1) << 16)
     };
-    MctBands {
-        bands: std::array::from_fn(|index| {
-            let next = if index % GROUPS < last { index + 1 } else { index };
-            [packed(index), packed(next), 0, 0]
-        }),
-    }
+    let skip = |g: usize, level: usize| bands.bands[g * GROUPS + level][2] & 0xffff;
+    (0..layout.gpu_band_entries() as usize)
+        .map(|index| {
+            let (g, level) = (index / levels, index % levels);
+            let next = (level + 1).min(levels - 1);
+            [packed(g, level), packed(g, next), skip(g, level) | (skip(g, next) << 16), bands.bands[g * GROUPS][3]]
+        })
+        .collect()
 }
 
 /// The atlas size, or why `mct` cannot be drawn with `mesh` on this device.

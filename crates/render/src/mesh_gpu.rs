@@ -190,6 +190,80 @@ pub struct MeshGeometry {
     pub(crate) normals: wgpu::Texture,
 }
 
+impl MeshGeometry {
+    /// Uploads a mesh's geometry alone (an MCT file's: no mesh colors), its vertices' level
+    /// of detail and normals `lod` (`VertexLod::with_density`); returns it and its bounding
+    /// sphere. Every index must be below the vertex count.
+    pub fn upload(
+        ctx: &GpuContext,
+        positions: &[[f32; 3]],
+        indices: &[[u32; 3]],
+        lod: &VertexLod,
+    ) -> Result<(Self, BoundingSphere), RenderError> {
+        let vertex_count = u32::try_from(positions.len())
+            .map_err(|_| RenderError::InvalidMesh(format!("{} vertices", positions.len())))?;
+        if let Some((face, corners)) =
+            indices.iter().enumerate().find(|(_, corners)| corners.iter().any(|&v| v >= vertex_count))
+        {
+            return Err(RenderError::InvalidMesh(format!(
+                "face {face} uses vertex {corners:?}, but there are only {vertex_count} vertices"
+            )));
+        }
+        if lod.density.len() != positions.len() || lod.normal_bits.len() != positions.len() {
+            return Err(RenderError::InvalidMesh(format!(
+                "{} level-of-detail densities for {} vertices",
+                lod.density.len(),
+                positions.len()
+            )));
+        }
+        let bounds = BoundingSphere::of_points(positions);
+        ctx.checked(|| Self::textures(ctx, positions, indices, lod, bounds)).map(|geometry| (geometry, bounds))
+    }
+
+    /// The positions (relative to the centre of `bounds`, with the density in w), vertex ids
+    /// and normals as data textures.
+    fn textures(
+        ctx: &GpuContext,
+        positions: &[[f32; 3]],
+        indices: &[[u32; 3]],
+        lod: &VertexLod,
+        bounds: BoundingSphere,
+    ) -> Result<Self, RenderError> {
+        let origin = DVec3::from_array(bounds.center);
+        let relative: Vec<[f32; 4]> = positions
+            .iter()
+            .zip(&lod.density)
+            .map(|(p, &density)| {
+                let p = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - origin;
+                [p.x as f32, p.y as f32, p.z as f32, density]
+            })
+            .collect();
+        let corners: Vec<[u32; 4]> = indices.iter().map(|&[c0, c1, c2]| [c0, c1, c2, 0]).collect();
+        let positions_texture = data_texture(
+            ctx,
+            "positions (relative to the render origin)",
+            wgpu::TextureFormat::Rgba32Float,
+            bytemuck::cast_slice(&relative),
+        )?;
+        let normals = data_texture(
+            ctx,
+            "vertex normals",
+            wgpu::TextureFormat::Rgba16Float,
+            bytemuck::cast_slice(&lod.normal_bits),
+        )?;
+        let indices_texture =
+            data_texture(ctx, "faces' vertex ids", wgpu::TextureFormat::Rgba32Uint, bytemuck::cast_slice(&corners))?;
+        Ok(MeshGeometry {
+            origin,
+            face_count: indices.len() as u32,
+            vertex_count: positions.len() as u32,
+            positions: positions_texture,
+            indices: indices_texture,
+            normals,
+        })
+    }
+}
+
 /// A packed mesh uploaded for the mesh-colors pipeline.
 #[derive(Debug)]
 pub struct GpuMesh {
@@ -247,32 +321,8 @@ impl GpuMesh {
         let atlas = AtlasLayout::new(packed.sample_count(), width, limits.max_texture_dimension_2d)?;
 
         let bounds = BoundingSphere::of_points(&packed.positions);
-        let origin = DVec3::from_array(bounds.center);
-        let lod = VertexLod::of(packed);
-        let relative: Vec<[f32; 4]> = packed
-            .positions
-            .iter()
-            .zip(&lod.density)
-            .map(|(p, &density)| {
-                let p = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - origin;
-                [p.x as f32, p.y as f32, p.z as f32, density]
-            })
-            .collect();
-        let corners: Vec<[u32; 4]> = packed.indices.iter().map(|&[c0, c1, c2]| [c0, c1, c2, 0]).collect();
-        let positions = data_texture(
-            ctx,
-            "positions (relative to the render origin)",
-            wgpu::TextureFormat::Rgba32Float,
-            bytemuck::cast_slice(&relative),
-        )?;
-        let normals = data_texture(
-            ctx,
-            "vertex normals",
-            wgpu::TextureFormat::Rgba16Float,
-            bytemuck::cast_slice(&lod.normal_bits),
-        )?;
-        let indices =
-            data_texture(ctx, "faces' vertex ids", wgpu::TextureFormat::Rgba32Uint, bytemuck::cast_slice(&corners))?;
+        let MeshGeometry { origin, positions, indices, normals, .. } =
+            MeshGeometry::textures(ctx, &packed.positions, &packed.indices, &VertexLod::of(packed), bounds)?;
         // A face record is four u32 words: exactly one Rgba32Uint texel.
         let face_records = data_texture(
             ctx,

@@ -177,16 +177,18 @@ pub fn fix_checksum(bytes: &mut [u8]) {
 }
 
 /// A face record with one field changed: corner, direction bit, side bit, block resolution,
-/// pair index (near its value, near the group's size, or anything), or random bits.
+/// flip or swap bit, pair index (near its value, near the group's size, or anything), or
+/// random bits.
 fn mutate_record(record: u32, faces: u32, rng: &mut Rng) -> u32 {
-    let pair = record >> 8;
-    match rng.below(7) {
+    let pair = record >> 10;
+    match rng.below(8) {
         0 => (record & !3) | rng.below(4) as u32,
         1 => record ^ 4,
         2 => record ^ 8,
         3 => (record & !0xf0) | ((rng.below(16) as u32) << 4),
-        4 => (record & 0xff) | ((pair.wrapping_add(rng.pick(&[1, u32::MAX, 2])) & 0xff_ffff) << 8),
-        5 => (record & 0xff) | ((rng.interesting_u32(faces) & 0xff_ffff) << 8),
+        4 => (record & 0x3ff) | ((pair.wrapping_add(rng.pick(&[1, u32::MAX, 2])) & 0x3f_ffff) << 10),
+        5 => (record & 0x3ff) | ((rng.interesting_u32(faces) & 0x3f_ffff) << 10),
+        6 => record ^ (256 << rng.below(2)),
         _ => rng.next_u64() as u32,
     }
 }
@@ -372,7 +374,8 @@ pub fn mutate(seeds: &[Vec<u8>], rng: &mut Rng) -> Vec<u8> {
 /// Texels checked per input (the checks are quadratic in the block resolution).
 const TEXEL_BUDGET: u64 = 400_000;
 
-/// Every texel of every block (lattice and ring) at every level lies in the atlas, and the
+/// Every texel of every block (lattice and ring) at every level lies in the atlas (x wraps
+/// around: up to twice the width), and the
 /// CPU sampler answers at every level and level of detail.
 fn check_blocks(file: &MctFile) {
     let layout = &file.mct.layout;
@@ -380,7 +383,7 @@ fn check_blocks(file: &MctFile) {
     let mut budget = TEXEL_BUDGET;
     for (face, &record) in (0u32..).zip(&layout.records) {
         for level in 0..layout.levels {
-            let frame = frame_of(record, &layout.bands, level);
+            let frame = frame_of(record, &layout.bands, &layout.masks, level);
             let r = frame.r;
             let texels = u64::from(r + 2) * u64::from(r + 3) / 2;
             if texels <= budget {
@@ -392,7 +395,7 @@ fn check_blocks(file: &MctFile) {
                         }
                         let [x, y] = frame.texel(alpha, beta);
                         assert!(
-                            (0..w).contains(&x) && (0..h).contains(&y),
+                            (0..2 * w).contains(&x) && (0..h).contains(&y),
                             "face {face} level {level} ({alpha}, {beta}) at texel ({x}, {y}) outside the {w}×{h} atlas"
                         );
                     }

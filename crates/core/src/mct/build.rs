@@ -12,14 +12,12 @@ use crate::packing::sampler::{Filter, MeshColorSource, sample};
 use half::f16;
 use rayon::prelude::*;
 
-/// One band of block rows: texture rows `y0..y0 + height`, the pairs `pairs` of group `g`
-/// at `level`.
+/// Texture rows `y0..y0 + height` and the blocks in them: pairs of group `g` at `level`.
+/// (A band may start in the free end of the previous band's last row: both are one `Band`.)
 struct Band {
     y0: u64,
     height: u64,
-    g: usize,
-    level: u32,
-    pairs: std::ops::Range<usize>,
+    parts: Vec<(usize, u32, std::ops::Range<usize>)>,
 }
 
 /// Builds the Mesh Color Texture of `packed` in `packed`'s colour format, in an atlas at
@@ -52,35 +50,49 @@ pub fn build(packed: &PackedMesh, max_dimension: u32, max_bytes: u64) -> Result<
         .zip(chunks.into_par_iter())
         .map(|(band, chunk)| fill_band(packed, &layout, band, chunk, row_bytes))
         .try_reduce(MctStats::default, |a, b| Ok(a.merged(b)))?;
-    Ok(MeshColorTexture { layout, format, texels, stats })
+    let vertex_density = crate::packing::lod::VertexLod::of(packed).density;
+    Ok(MeshColorTexture { layout, format, texels, stats, vertex_density })
 }
 
-/// Every band of block rows, in y order.
+/// Every row of blocks, in y order, rows that share texture rows merged.
 fn bands(layout: &MctLayout) -> Vec<Band> {
-    let mut out = Vec::new();
+    let mut rows = Vec::new();
     for (g, list) in layout.pairs.iter().enumerate() {
         for level in 0..layout.levels {
             if list.is_empty() {
                 continue;
             }
             let (y, per_row) = layout.bands.band(g as u32, level);
+            let skip = layout.bands.skip(g as u32, level) as usize;
+            let (_, log2_row, _) = layout.bands.strip_rows(g as u32);
             let r = 1u64 << (g as u32).saturating_sub(level);
-            // Level 0: two tents per period; levels ≥ 1: one square per slot.
-            let (pairs_per_row, height) =
-                if level == 0 { (2 * per_row as usize, r + 1) } else { (per_row as usize, r + 1) };
-            let pairs_per_row = pairs_per_row.max(1);
-            for (row, start) in (0..list.len()).step_by(pairs_per_row).enumerate() {
-                out.push(Band {
-                    y0: u64::from(y) + row as u64 * height,
-                    height,
-                    g,
-                    level,
-                    pairs: start..(start + pairs_per_row).min(list.len()),
+            // Slots: level 0 two tents per period; levels ≥ 1 strip rows of 2^log2_row squares.
+            let pairs_per_slot = if level == 0 { 2 } else { 1usize << log2_row };
+            let per_row = (per_row as usize).max(1);
+            let slots = list.len().div_ceil(pairs_per_slot) + skip;
+            for row in 0..slots.div_ceil(per_row) {
+                let first = (row * per_row).saturating_sub(skip) * pairs_per_slot;
+                let end = (((row + 1) * per_row).saturating_sub(skip) * pairs_per_slot).min(list.len());
+                rows.push(Band {
+                    y0: u64::from(y) + row as u64 * (r + 1),
+                    height: r + 1,
+                    parts: vec![(g, level, first..end)],
                 });
             }
         }
     }
-    out.sort_by_key(|b| b.y0);
+    rows.sort_by_key(|b| b.y0);
+    let mut out: Vec<Band> = Vec::with_capacity(rows.len());
+    for row in rows {
+        match out.last_mut() {
+            Some(last) if row.y0 < last.y0 + last.height => {
+                let end = (last.y0 + last.height).max(row.y0 + row.height);
+                last.height = end - last.y0;
+                last.parts.extend(row.parts);
+            }
+            _ => out.push(row),
+        }
+    }
     out
 }
 
@@ -93,15 +105,17 @@ fn fill_band(
 ) -> Result<MctStats, MctError> {
     let mut stats = MctStats::default();
     let mut scratch = Vec::new();
-    for pair in &layout.pairs[band.g][band.pairs.clone()] {
-        let lone = pair[1] == u32::MAX;
-        for &face in pair.iter().filter(|&&f| f != u32::MAX) {
-            let record = layout.records[face as usize];
-            let frame = frame_of(record, &layout.bands, band.level);
-            // Rings: always at level 0 (tents), only for lone faces in squares.
-            let ring = band.level == 0 || lone;
-            let mut writer = BandWriter { chunk, row_bytes, y0: band.y0 as i64, format: packed.format };
-            fill_face(packed, face, band.level, &frame, ring, &mut writer, &mut scratch, &mut stats)?;
+    for (g, level, pairs) in &band.parts {
+        for pair in &layout.pairs[*g][pairs.clone()] {
+            let lone = pair[1] == u32::MAX;
+            for &face in pair.iter().filter(|&&f| f != u32::MAX) {
+                let record = layout.records[face as usize];
+                let frame = frame_of(record, &layout.bands, &layout.masks, *level);
+                // Rings: always at level 0 (tents), only for lone faces in squares.
+                let ring = *level == 0 || lone;
+                let mut writer = BandWriter { chunk, row_bytes, y0: band.y0 as i64, format: packed.format };
+                fill_face(packed, face, *level, &frame, ring, &mut writer, &mut scratch, &mut stats)?;
+            }
         }
     }
     Ok(stats)
@@ -115,9 +129,11 @@ struct BandWriter<'a> {
 }
 
 impl BandWriter<'_> {
+    /// Byte offset of `texel` (x wraps around the atlas width).
     fn offset(&self, texel: [i64; 2]) -> usize {
         let bpp = self.format.bytes_per_sample() as i64;
-        ((texel[1] - self.y0) as u64 * self.row_bytes) as usize + (texel[0] * bpp) as usize
+        let x = texel[0].rem_euclid(self.row_bytes as i64 / bpp);
+        ((texel[1] - self.y0) as u64 * self.row_bytes) as usize + (x * bpp) as usize
     }
     /// Writes a lattice colour; returns what the GPU will read.
     fn write(&mut self, texel: [i64; 2], color: Rgba) -> Rgba {

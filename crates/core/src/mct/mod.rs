@@ -6,6 +6,8 @@
 //! |---|---|
 //! | [`layout`] | block resolution per face, pairing, tents (level 0) and squares (levels ≥ 1), the 4-byte face record and the band table the shader reads |
 //! | [`mod@build`] | packed mesh colors → atlas texels (reference sampler at every lattice point, `c₃ = c₁ + c₂ − c₀` rings), in parallel bands |
+//! | `ring` | which end of a pair's shared edge its tents put the right angle at (RGBA8: the one whose rings clamp less) |
+//! | [`strips`] | strips of squares sharing sides at levels ≥ 1, cut into strip rows |
 //! | [`sample`] | the CPU evaluation of hardware bilinear / trilinear filtering of the atlas |
 //! | [`file`] | the MCT file (`docs/MCT_FORMAT.md`): mesh, records, band table and atlas in one checked, checksummed file |
 //!
@@ -20,7 +22,9 @@
 pub mod build;
 pub mod file;
 pub mod layout;
+mod ring;
 pub mod sample;
+pub mod strips;
 
 pub use build::build;
 pub use layout::{BlockFrame, MctBands, MctFaceRecord, MctLayout};
@@ -102,13 +106,16 @@ pub struct MeshColorTexture {
     pub texels: Vec<u8>,
     /// Counts from the build.
     pub stats: MctStats,
+    /// Per vertex, the samples per world unit mesh colors' level of detail uses
+    /// (`packing::lod::VertexLod::density`, from each face's own `R_f`): trilinear filtering
+    /// picks its levels from it, and an MCT file does not hold `R_f`.
+    pub vertex_density: Vec<f32>,
 }
 
 impl MeshColorTexture {
-    /// GPU bytes: the atlas, the face records and the band table.
+    /// GPU bytes: the atlas, the face records with the strip-row masks, and the entries of the
+    /// band table the GPU reads (16 bytes each, [`MctLayout::gpu_band_entries`]).
     pub fn gpu_bytes(&self) -> u64 {
-        self.texels.len() as u64
-            + (self.layout.records.len() * std::mem::size_of::<MctFaceRecord>()) as u64
-            + std::mem::size_of::<MctBands>() as u64
+        self.texels.len() as u64 + self.layout.record_bytes() + 16 * self.layout.gpu_band_entries()
     }
 }

@@ -7,9 +7,10 @@ use crate::colors::layout::sanitize_barycentric;
 use crate::mct::MeshColorTexture;
 
 impl MeshColorTexture {
-    /// The decoded texel at `(x, y)`, clamped to the atlas (the sampler's clamp-to-edge).
+    /// The decoded texel at `(x, y)`: `x` wraps around the atlas (the sampler repeats
+    /// horizontally), `y` is clamped to it (clamp-to-edge).
     pub fn texel(&self, x: i64, y: i64) -> Rgba {
-        let x = x.clamp(0, i64::from(self.layout.width) - 1) as u64;
+        let x = x.rem_euclid(i64::from(self.layout.width)) as u64;
         let y = y.clamp(0, i64::from(self.layout.height) - 1) as u64;
         let bpp = self.format.bytes_per_sample() as u64;
         let at = ((y * u64::from(self.layout.width) + x) * bpp) as usize;

@@ -71,22 +71,35 @@ pub struct VertexLod {
 impl VertexLod {
     /// Densities and normals of `packed`'s vertices (computed in `f64`).
     pub fn of(packed: &PackedMesh) -> Self {
-        let n = packed.positions.len();
+        let resolutions: Vec<Option<f64>> =
+            packed.face_records.iter().map(|r| r.resolution().map(|r| r.get() as f64)).collect();
+        Self::accumulate(&packed.positions, &packed.indices, &|face| resolutions.get(face).copied().flatten())
+    }
+
+    /// Normals of a mesh whose densities are known (an MCT file stores them): `density` as
+    /// given (its length should be the vertex count), normals as [`VertexLod::of`] computes them.
+    pub fn with_density(positions: &[[f32; 3]], indices: &[[u32; 3]], density: Vec<f32>) -> Self {
+        let normal_bits = Self::accumulate(positions, indices, &|_| Some(1.0)).normal_bits;
+        VertexLod { density, normal_bits }
+    }
+
+    /// Densities (from each face's resolution, `None` skips the face) and normals.
+    fn accumulate(positions: &[[f32; 3]], indices: &[[u32; 3]], resolution: &dyn Fn(usize) -> Option<f64>) -> Self {
+        let n = positions.len();
         let mut density = vec![0.0f64; n];
         let mut normal = vec![[0.0f64; 3]; n];
-        for (corners, record) in packed.indices.iter().zip(&packed.face_records) {
-            let Some(p) =
-                corners.iter().map(|&v| packed.positions.get(v as usize).copied()).collect::<Option<Vec<_>>>()
+        for (face, corners) in indices.iter().enumerate() {
+            let Some(p) = corners.iter().map(|&v| positions.get(v as usize).copied()).collect::<Option<Vec<_>>>()
             else {
                 continue;
             };
             let cross = face_cross(p[0], p[1], p[2]);
             let twice_area = (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]).sqrt();
-            let Some(resolution) = record.resolution() else { continue };
+            let Some(resolution) = resolution(face) else { continue };
             if !(twice_area.is_finite() && twice_area > 0.0) {
                 continue;
             }
-            let face_density = resolution.get() as f64 / twice_area.sqrt();
+            let face_density = resolution / twice_area.sqrt();
             for &v in corners {
                 let v = v as usize;
                 density[v] = density[v].max(face_density);

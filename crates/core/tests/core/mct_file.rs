@@ -211,8 +211,8 @@ fn header_fields_and_sections_are_where_the_format_document_says() {
     let (packed, mct, bytes) = mixed_file(ColorFormat::Rgba16F);
     assert_eq!(&bytes[..8], b"MESHMCT\0");
     assert_eq!(MAGIC, *b"MESHMCT\0");
-    assert_eq!(u32_at(&bytes, VERSION_AT), 1);
-    assert_eq!(VERSION, 1);
+    assert_eq!(u32_at(&bytes, VERSION_AT), 3);
+    assert_eq!(VERSION, 3);
     assert_eq!(u32_at(&bytes, HEADER_SIZE_AT), HEADER_SIZE as u32);
     assert_eq!(u64_at(&bytes, FILE_SIZE_AT), bytes.len() as u64);
     assert_eq!(u32_at(&bytes, FLAGS_AT), 0);
@@ -230,7 +230,7 @@ fn header_fields_and_sections_are_where_the_format_document_says() {
     // Sections: aligned, in order, each at the first multiple of 256 after the previous.
     let (v, f) = (packed.positions.len(), packed.indices.len());
     let texel_bytes = (mct.layout.width * mct.layout.height) as usize * 8;
-    let lengths = [12 * v, 12 * f, 4 * f, BANDS_BYTES as usize, texel_bytes];
+    let lengths = [16 * v, 12 * f, 4 * (f + mct.layout.masks.len()), BANDS_BYTES as usize, texel_bytes];
     let mut cursor = HEADER_SIZE;
     for (k, length) in lengths.into_iter().enumerate() {
         let (offset, len) = section(&bytes, k);
@@ -241,11 +241,20 @@ fn header_fields_and_sections_are_where_the_format_document_says() {
     assert_eq!(cursor, bytes.len());
     // Section contents, decoded here by hand.
     let (at, _) = section(&bytes, POSITIONS);
-    assert_eq!(f32::from_le_bytes(bytes[at + 16..at + 20].try_into().unwrap()), packed.positions[1][1]);
+    assert_eq!(f32::from_le_bytes(bytes[at + 20..at + 24].try_into().unwrap()), packed.positions[1][1]);
+    // Each vertex's fourth word is its level-of-detail density, as the GPU mesh computes it.
+    let density = meshpaint_core::packing::lod::VertexLod::of(&packed).density;
+    assert_eq!(f32::from_le_bytes(bytes[at + 28..at + 32].try_into().unwrap()), density[1]);
+    assert_eq!(mct.vertex_density, density);
     let (at, _) = section(&bytes, INDICES);
     assert_eq!(u32_at(&bytes, at + 12 * 7 + 8), packed.indices[7][2]);
     for face in [0, 100, 319] {
         assert_eq!(record_at(&bytes, face), mct.layout.records[face]);
+    }
+    // The strip-row masks follow the records.
+    assert!(!mct.layout.masks.is_empty());
+    for (k, &mask) in mct.layout.masks.iter().enumerate() {
+        assert_eq!(record_at(&bytes, f + k).0, mask);
     }
     for (g, level) in [(0, 0), (5, 0), (3, 2), (5, 5)] {
         let (y, per_row) = mct.layout.bands.band(g as u32, level as u32);
@@ -263,21 +272,29 @@ fn the_worked_example_has_the_documented_size_and_offsets() {
     let packed = packed(positions, &[[0, 1, 2], [0, 2, 3]], |_| 2, ColorFormat::Rgba8Srgb, 3);
     let mct = mct::build(&packed, MAX_DIM, u64::MAX).unwrap();
     let bytes = to_bytes(&packed.positions, &packed.indices, &mct).unwrap();
-    assert_eq!((mct.layout.width, mct.layout.height, mct.layout.levels), (12, 5, 2));
+    assert_eq!((mct.layout.width, mct.layout.height, mct.layout.levels), (10, 5, 2));
     let sections: Vec<(usize, usize)> = (0..5).map(|k| section(&bytes, k)).collect();
-    assert_eq!(sections, [(256, 48), (512, 24), (768, 8), (1024, 2704), (3840, 240)]);
-    assert_eq!(bytes.len(), 4080);
-    // Both faces in pair 0 of group 1 (R_b = 2), sharing the edge 0 → 2.
+    assert_eq!(sections, [(256, 64), (512, 24), (768, 12), (1024, 2704), (3840, 200)]);
+    assert_eq!(bytes.len(), 4040);
+    // Both faces in pair 0 of group 1 (R_b = 2), sharing the edge 0 → 2; the square has p at
+    // vertex 2, but these random colours clamp fewer rings with the tents' right angle at
+    // vertex 0 (swap).
     assert_eq!(mct.layout.pairs[1], [[0, 1]]);
     let [a, b] = [mct.layout.records[0], mct.layout.records[1]];
-    assert_eq!((a.0, b.0), (0x16, 0x19), "{a:?} {b:?}");
+    assert_eq!((a.0, b.0), (0x210, 0x21c), "{a:?} {b:?}");
+    assert!(a.swap() && b.swap() && !a.flip());
     let (c0, c1) = (packed.indices[0], packed.indices[1]);
     assert_eq!(([c0[a.corner_p()], c0[a.corner_q()]]), [c1[b.corner_p()], c1[b.corner_q()]]);
-    assert_eq!([c0[a.corner_p()], c0[a.corner_q()]], [2, 0]);
-    // Band table: group 1 level 0 at y = 0, one tent period per row; level 1 at y = 3, six
-    // squares of side 2 per row.
+    assert_eq!([c0[a.corner_p()], c0[a.corner_q()]], [0, 2]);
+    // Band table: group 1 level 0 at y = 0, one tent period per row (the atlas is one period
+    // wide: the down tent crosses the right edge); level 1 at y = 3, one strip row per row;
+    // strip rows of 8 pairs, at most 1 piece, masks from 0; one mask (no piece starts).
     assert_eq!(mct.layout.bands.band(1, 0), (0, 1));
-    assert_eq!(mct.layout.bands.band(1, 1), (3, 6));
+    assert_eq!(mct.layout.bands.band(1, 1), (3, 1));
+    assert_eq!(mct.layout.bands.strip_rows(1), (0, 3, 1));
+    assert_eq!(u32_at(&bytes, 1024 + 16 * GROUPS + 12), 3 | (1 << 3));
+    assert_eq!(mct.layout.masks, [0]);
+    assert_eq!(u32_at(&bytes, 768 + 8), 0);
     assert_eq!(u32_at(&bytes, 1024 + 16 * GROUPS + 4), 1);
     assert_eq!(u32_at(&bytes, 1024 + 16 * (GROUPS + 1)), 3);
     // The documented frames.
@@ -291,9 +308,9 @@ fn the_worked_example_has_the_documented_size_and_offsets() {
     assert_eq!(
         frames,
         [
-            ([3, 0], [1, 0], [0, 1], [2, 1, 0], 2),
+            ([3, 0], [1, 0], [0, 1], [0, 1, 2], 2),
             ([0, 3], [1, 0], [0, 1], [1, 2, 0], 1),
-            ([3, 0], [-1, 0], [0, 1], [1, 2, 0], 2),
+            ([3, 0], [-1, 0], [0, 1], [0, 2, 1], 2),
             ([1, 4], [0, -1], [-1, 0], [2, 1, 0], 1),
         ],
         "{frames:?}"
@@ -301,21 +318,22 @@ fn the_worked_example_has_the_documented_size_and_offsets() {
 }
 
 /// The atlas check covers the texels a block uses, not its frame's `(r + 1, 0)` and
-/// `(0, r + 1)`: those lie outside the atlas for valid layouts (a second face of a square
-/// in the first column, a down tent at the end of a row), which must still be accepted.
+/// `(0, r + 1)`, and lets x wrap around once (tents cross the right edge and continue at the
+/// left): valid layouts have both, which must be accepted.
 #[test]
 fn blocks_at_the_atlas_edge_are_accepted() {
     let (_, mct, bytes) = mixed_file(ColorFormat::Rgba8Srgb);
     assert!(from_bytes(&bytes).is_ok());
     let (w, h) = (i64::from(mct.layout.width), i64::from(mct.layout.height));
-    let outside = |t: [i64; 2]| !(0..w).contains(&t[0]) || !(0..h).contains(&t[1]);
-    let mut frame_corner_outside = 0;
+    let outside = |t: [i64; 2]| !(0..2 * w).contains(&t[0]) || !(0..h).contains(&t[1]);
+    let (mut frame_corner_outside, mut wrapping) = (0, 0);
     for face in 0..mct.layout.records.len() as u32 {
         for level in 0..mct.layout.levels {
             let frame = mct.layout.frame(face, level).unwrap();
             let r = frame.r;
             for (alpha, beta) in [(0, 0), (r, 0), (0, r), (r, 1), (1, r)] {
                 assert!(!outside(frame.texel(alpha, beta)), "face {face} level {level} ({alpha}, {beta})");
+                wrapping += u32::from(frame.texel(alpha, beta)[0] >= w);
             }
             if outside(frame.texel(r + 1, 0)) || outside(frame.texel(0, r + 1)) {
                 frame_corner_outside += 1;
@@ -323,6 +341,7 @@ fn blocks_at_the_atlas_edge_are_accepted() {
         }
     }
     assert!(frame_corner_outside > 0, "no block at the atlas edge: the test mesh does not exercise the case");
+    assert!(wrapping > 0, "no tent crosses the right edge: the test mesh does not exercise the case");
 }
 
 // ---------------------------------------------------------------------------------------
@@ -343,9 +362,16 @@ fn refuses_a_bad_magic_version_header_size_flags_and_reserved_fields() {
         assert!(matches!(error, MctFileError::Truncated { end: 144, .. }), "{len}: {error:?}");
         assert!(error.to_string().contains("truncated"), "{error}");
     }
-    let error = refused(&craft(&bytes, |b| set_u32(b, VERSION_AT, 2)));
-    assert!(matches!(error, MctFileError::UnsupportedVersion(2)), "{error:?}");
-    assert!(error.to_string().contains("version 2"), "{error}");
+    let error = refused(&craft(&bytes, |b| set_u32(b, VERSION_AT, 4)));
+    assert!(matches!(error, MctFileError::UnsupportedVersion(4)), "{error:?}");
+    assert!(error.to_string().contains("version 4"), "{error}");
+    // Versions 1 (squares without strips) and 2 (no density per vertex) are refused with what
+    // to do.
+    for old in [1, 2] {
+        let error = refused(&craft(&bytes, |b| set_u32(b, VERSION_AT, old)));
+        assert!(matches!(error, MctFileError::OldVersion(v) if v == old), "{error:?}");
+        assert!(error.to_string().contains("export it again"), "{error}");
+    }
     let error = refused(&craft(&bytes, |b| set_u32(b, HEADER_SIZE_AT, 128)));
     assert!(matches!(error, MctFileError::HeaderSize(128)), "{error:?}");
     let error = refused(&craft(&bytes, |b| set_u32(b, FLAGS_AT, 4)));
@@ -421,8 +447,8 @@ fn refuses_sizes_that_do_not_match_the_counts_before_allocating() {
         assert!(matches!(error, MctFileError::SectionLength { section, .. } if section == section_name), "{error:?}");
         assert!(error.to_string().contains(&format!("{section_name} section is")), "{error}");
     }
-    // The records section's length shortened by one record (its last bytes zeroed, so they
-    // read as the gap's padding): it disagrees with the face count.
+    // The records section's length shortened by one word (its last bytes zeroed, so they
+    // read as the gap's padding): one strip-row mask fewer than the records need.
     let error = refused(&craft(&bytes, |b| {
         let k = SECTIONS_AT + 16 * RECORDS + 8;
         let len = u64_at(b, k);
@@ -430,7 +456,12 @@ fn refuses_sizes_that_do_not_match_the_counts_before_allocating() {
         let (at, _) = section(b, RECORDS);
         b[at + len as usize - 4..at + len as usize].fill(0);
     }));
-    assert!(matches!(error, MctFileError::SectionLength { section: "face records", .. }), "{error:?}");
+    let masks = mct.layout.masks.len() as u64;
+    assert!(
+        matches!(error, MctFileError::MaskCount { stored, expected } if stored == masks - 1 && expected == masks),
+        "{error:?}"
+    );
+    assert!(error.to_string().contains("strip-row masks"), "{error}");
     let error = refused(&craft(&bytes, |b| {
         let k = SECTIONS_AT + 16 * BANDS + 8;
         set_u64(b, k, BANDS_BYTES - 16);
@@ -463,10 +494,18 @@ fn refuses_non_finite_positions_and_indices_out_of_range() {
     for value in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
         let error = refused(&craft(&bytes, |b| {
             let (at, _) = section(b, POSITIONS);
-            b[at + 12 * 5 + 4..at + 12 * 5 + 8].copy_from_slice(&value.to_le_bytes());
+            b[at + 16 * 5 + 4..at + 16 * 5 + 8].copy_from_slice(&value.to_le_bytes());
         }));
         assert!(matches!(error, MctFileError::NonFinitePosition { vertex: 5, .. }), "{error:?}");
         assert!(error.to_string().contains("vertex 5 is not finite"), "{error}");
+    }
+    for value in [f32::NAN, f32::INFINITY, -1.0] {
+        let error = refused(&craft(&bytes, |b| {
+            let (at, _) = section(b, POSITIONS);
+            b[at + 16 * 6 + 12..at + 16 * 6 + 16].copy_from_slice(&value.to_le_bytes());
+        }));
+        assert!(matches!(error, MctFileError::BadDensity { vertex: 6, .. }), "{error:?}");
+        assert!(error.to_string().contains("level-of-detail density"), "{error}");
     }
     let v = packed.positions.len() as u32;
     for index in [v, u32::MAX] {
@@ -501,13 +540,13 @@ fn refuses_records_with_a_bad_corner_resolution_level_or_pair() {
     // A pair index past the faces of its group.
     let g = mct.layout.records[face].log2_block() as usize;
     let faces_in_group = mct.layout.records.iter().filter(|r| r.log2_block() as usize == g).count() as u32;
-    let error = refused(&craft(&bytes, |b| set_record(b, face, (record & 0xff) | (faces_in_group << 8))));
+    let error = refused(&craft(&bytes, |b| set_record(b, face, (record & 0x3ff) | (faces_in_group << 10))));
     assert!(
         matches!(error, MctFileError::PairIndex { face: 17, pair, faces, .. } if pair == faces_in_group && faces == u64::from(faces_in_group)),
         "{error:?}"
     );
-    let error = refused(&craft(&bytes, |b| set_record(b, face, (record & 0xff) | (0xff_ffff << 8))));
-    assert!(matches!(error, MctFileError::PairIndex { pair: 0xff_ffff, .. }), "{error:?}");
+    let error = refused(&craft(&bytes, |b| set_record(b, face, (record & 0x3ff) | (0x3f_ffff << 10))));
+    assert!(matches!(error, MctFileError::PairIndex { pair: 0x3f_ffff, .. }), "{error:?}");
     assert!(error.to_string().contains("pairs are numbered from 0"), "{error}");
 }
 
@@ -616,18 +655,21 @@ fn refuses_any_block_outside_the_atlas() {
         matches!(error, MctFileError::OutsideAtlas { level: 1, texel, width, .. } if texel[0] >= i64::from(width)),
         "{error:?}"
     );
-    // The bottom band (block resolution 4 at level 4: squares of 2 × 2 texels, one row)
-    // ends exactly at the atlas's last row; one row lower, its blocks' far row is the first
-    // row past the atlas.
-    let (g, level) = (2usize, 4usize);
-    assert_eq!(mct.layout.bands.band(g as u32, level as u32), (height - 2, 84));
+    // The band placed last ends exactly at the atlas's last row; one row lower, its blocks'
+    // far row is the first row past the atlas.
+    let last = mct.layout.levels as usize - 1;
+    let g = (0..GROUPS)
+        .filter(|&g| !mct.layout.pairs[g].is_empty())
+        .max_by_key(|&g| mct.layout.bands.band(g as u32, last as u32).0)
+        .unwrap();
     let shifted = craft(&bytes, |b| {
-        let at = band_word_at(b, g, level, 0);
-        set_u32(b, at, height - 1);
+        let at = band_word_at(b, g, last, 0);
+        let y = u32_at(b, at);
+        set_u32(b, at, y + 1);
     });
     let error = refused(&shifted);
     assert!(
-        matches!(error, MctFileError::OutsideAtlas { level: 4, texel, height: h, .. } if texel[1] == i64::from(h) && h == height),
+        matches!(error, MctFileError::OutsideAtlas { level, texel, height: h, .. } if texel[1] == i64::from(h) && h == height && level == last as u32),
         "{error:?}"
     );
 }

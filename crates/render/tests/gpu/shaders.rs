@@ -154,8 +154,10 @@ fn the_smooth_shading_crease_matches_the_rust_constant() {
     }
 }
 
+/// The shader's band table is a runtime-sized array of the 16-byte entries
+/// crates/render/src/mct.rs `gpu_bands` uploads (`[u32; 4]` each, as `MctBands` entries).
 #[test]
-fn the_wgsl_mct_band_table_matches_the_rust_struct() {
+fn the_wgsl_mct_band_table_matches_the_rust_entries() {
     let (module, _) = validate("mct.wgsl", MCT_WGSL);
     let bands = module
         .global_variables
@@ -163,8 +165,16 @@ fn the_wgsl_mct_band_table_matches_the_rust_struct() {
         .find(|(_, global)| global.name.as_deref() == Some("mct_bands"))
         .map(|(_, global)| global.ty)
         .unwrap();
-    let size = module.types[bands].inner.size(module.to_ctx());
-    assert_eq!(size as usize, std::mem::size_of::<meshpaint_core::mct::MctBands>());
+    match module.types[bands].inner {
+        naga::TypeInner::Array { size: naga::ArraySize::Dynamic, stride, .. } => {
+            assert_eq!(stride as usize, std::mem::size_of::<[u32; 4]>());
+            assert_eq!(
+                std::mem::size_of::<meshpaint_core::mct::MctBands>(),
+                std::mem::size_of::<[u32; 4]>() * meshpaint_core::mct::layout::GROUPS.pow(2)
+            );
+        }
+        ref other => panic!("mct_bands is not a runtime-sized array: {other:?}"),
+    }
     // The shader's group count is the core's.
     assert!(MCT_WGSL.contains(&format!("const MCT_GROUPS: u32 = {}u;", meshpaint_core::mct::layout::GROUPS)));
 }

@@ -20,8 +20,10 @@ pub(super) fn check_limits(width: u32, height: u32, levels: u32) -> Result<(), M
 /// What [`check_content`] reads: the mesh and the layout without its pair lists.
 pub(super) struct Content<'a> {
     pub(super) positions: &'a [[f32; 3]],
+    pub(super) density: &'a [f32],
     pub(super) indices: &'a [[u32; 3]],
     pub(super) records: &'a [MctFaceRecord],
+    pub(super) masks: &'a [u32],
     pub(super) bands: &'a MctBands,
     pub(super) width: u32,
     pub(super) height: u32,
@@ -31,11 +33,16 @@ pub(super) struct Content<'a> {
 /// Checks the content of a file whose sections have consistent sizes (see the module
 /// docs) and returns the pair lists the records describe.
 pub(super) fn check_content(content: &Content<'_>) -> Result<Vec<Vec<[u32; 2]>>, MctFileError> {
-    let Content { positions, indices, records, bands, width, height, levels } = *content;
+    let Content { positions, density, indices, records, masks, bands, width, height, levels } = *content;
     check_limits(width, height, levels)?;
     for (vertex, position) in (0u64..).zip(positions) {
         if !position.iter().all(|c| c.is_finite()) {
             return Err(MctFileError::NonFinitePosition { vertex, position: *position });
+        }
+    }
+    for (vertex, &value) in (0u64..).zip(density) {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(MctFileError::BadDensity { vertex, density: value });
         }
     }
     let vertex_count = positions.len() as u64;
@@ -49,8 +56,9 @@ pub(super) fn check_content(content: &Content<'_>) -> Result<Vec<Vec<[u32; 2]>>,
     let faces_per_group = check_records(records, levels)?;
     check_bands(bands, &faces_per_group, levels)?;
     let pairs = rebuild_pairs(records, &faces_per_group)?;
+    check_strip_rows(bands, masks, &pairs)?;
     check_pair_edges(indices, records, &pairs)?;
-    check_blocks_inside(records, bands, width, height, levels)?;
+    check_blocks_inside(records, bands, masks, width, height, levels)?;
     Ok(pairs)
 }
 
@@ -81,14 +89,21 @@ fn check_records(records: &[MctFaceRecord], levels: u32) -> Result<[u64; GROUPS]
     Ok(faces_per_group)
 }
 
-/// Reserved words zero; a row width wherever a face reads the band.
+/// Reserved words zero (word 3 of a group's level-0 entry holds its strip rows when it has
+/// faces); a row width wherever a face reads the band, and fewer empty leading slots than a
+/// row holds.
 fn check_bands(bands: &MctBands, faces_per_group: &[u64; GROUPS], levels: u32) -> Result<(), MctFileError> {
     for (index, entry) in bands.bands.iter().enumerate() {
         let (resolution, level) = (1u32 << (index / GROUPS), (index % GROUPS) as u32);
+        let used = faces_per_group[index / GROUPS] > 0 && level < levels;
         for (word, &value) in entry.iter().enumerate().skip(2) {
-            if value != 0 {
+            let allowed = used && (word == 2 || level == 0);
+            if value != 0 && !allowed {
                 return Err(MctFileError::BandReserved { resolution, level, word, value });
             }
+        }
+        if used && entry[2] >= entry[1].max(1) {
+            return Err(MctFileError::BandReserved { resolution, level, word: 2, value: entry[2] });
         }
     }
     for (g, &faces) in faces_per_group.iter().enumerate() {
@@ -100,6 +115,36 @@ fn check_bands(bands: &MctBands, faces_per_group: &[u64; GROUPS], levels: u32) -
                 return Err(MctFileError::EmptyBand { resolution: 1 << g, level, faces });
             }
         }
+    }
+    Ok(())
+}
+
+/// Each group's strip rows: at most 32 pairs, 1..=S+1 pieces, its masks right after the
+/// previous group's, each with bit 0 and the bits past the row clear and at most `pieces − 1`
+/// piece starts; no mask left over.
+fn check_strip_rows(bands: &MctBands, masks: &[u32], pairs: &[Vec<[u32; 2]>]) -> Result<(), MctFileError> {
+    let mut next = 0u64;
+    for (g, list) in pairs.iter().enumerate().filter(|(_, list)| !list.is_empty()) {
+        let resolution = 1u32 << g;
+        let (mask_base, log2_row, pieces) = bands.strip_rows(g as u32);
+        let per_row = 1u64.checked_shl(log2_row).unwrap_or(u64::MAX);
+        let rows = (list.len() as u64).div_ceil(per_row.max(1));
+        if log2_row > 5 || pieces == 0 || u64::from(pieces) > per_row + 1 || u64::from(mask_base) != next {
+            return Err(MctFileError::StripRows { resolution, log2_row, pieces, mask_base, masks: masks.len() as u64 });
+        }
+        for index in next..next + rows {
+            let Some(&mask) = masks.get(index as usize) else {
+                return Err(MctFileError::MaskCount { stored: masks.len() as u64, expected: next + rows });
+            };
+            let allowed = if per_row >= 32 { u32::MAX - 1 } else { ((1u32 << per_row) - 1) & !1 };
+            if mask & !allowed != 0 || mask.count_ones() + 1 > pieces {
+                return Err(MctFileError::StripMask { index, mask, resolution, per_row: per_row as u32, pieces });
+            }
+        }
+        next += rows;
+    }
+    if next != masks.len() as u64 {
+        return Err(MctFileError::MaskCount { stored: masks.len() as u64, expected: next });
     }
     Ok(())
 }
@@ -184,11 +229,13 @@ fn check_pair_edges(
 /// `α + β = r + 1` with `α, β ≥ 1` (bilinear filtering of a point `α + β ≤ r` reads only
 /// these with a non-zero weight). Their convex hull has the corners `(0, 0)`, `(r, 0)`,
 /// `(0, r)`, `(r, 1)`, `(1, r)`; the frame maps lattice points to texels affinely and the
-/// atlas is a rectangle, so those five suffice. `(r + 1, 0)` and `(0, r + 1)` are not the
+/// atlas is a rectangle, so those five suffice. The atlas wraps around in x (tents cross the
+/// right edge), so `x` may reach up to twice the width; `y` must lie in the atlas. `(r + 1, 0)` and `(0, r + 1)` are not the
 /// block's (they belong to the neighbouring block or lie past the atlas edge).
 fn check_blocks_inside(
     records: &[MctFaceRecord],
     bands: &MctBands,
+    masks: &[u32],
     width: u32,
     height: u32,
     levels: u32,
@@ -196,11 +243,11 @@ fn check_blocks_inside(
     let (w, h) = (i64::from(width), i64::from(height));
     for (face, &record) in (0u64..).zip(records) {
         for level in 0..levels {
-            let frame = frame_of(record, bands, level);
+            let frame = frame_of(record, bands, masks, level);
             let r = frame.r;
             for (alpha, beta) in [(0, 0), (r, 0), (0, r), (r, 1), (1, r)] {
                 let texel = frame.texel(alpha, beta);
-                if !(0..w).contains(&texel[0]) || !(0..h).contains(&texel[1]) {
+                if !(0..2 * w).contains(&texel[0]) || !(0..h).contains(&texel[1]) {
                     return Err(MctFileError::OutsideAtlas { face, level, texel, width, height });
                 }
             }

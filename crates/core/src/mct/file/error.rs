@@ -56,6 +56,68 @@ pub enum MctFileError {
     /// The file's version is not [`VERSION`].
     #[error("unsupported MCT file version {0} (this build reads version {VERSION})")]
     UnsupportedVersion(u32),
+    /// A version-1 or -2 file: written before squares were laid out in strips (1) or before
+    /// files held the vertices' level-of-detail density (2).
+    #[error(
+        "MCT file version {0} was written by an older meshpaint (version 1: squares without strips; 2: no level-of-detail density per vertex); this build reads version {VERSION}: export it again from its source with `meshpaint export SOURCE -o OUT.mct --representation mct`"
+    )]
+    OldVersion(u32),
+    /// A vertex's level-of-detail density is negative, NaN or infinite.
+    #[error("vertex {vertex}: level-of-detail density {density} is not a finite number ≥ 0")]
+    BadDensity {
+        /// The vertex.
+        vertex: u64,
+        /// Its density.
+        density: f32,
+    },
+    /// The texture's per-vertex densities do not match the vertices.
+    #[error("{densities} level-of-detail densities for {vertices} vertices")]
+    DensityCount {
+        /// Densities.
+        densities: u64,
+        /// Vertices.
+        vertices: u64,
+    },
+    /// The strip-row fields of a group's band entry are out of range.
+    #[error(
+        "band table, block resolution {resolution}: strip rows of 2^{log2_row} pairs with at most {pieces} pieces and masks from {mask_base} (rows of at most 32 pairs, 1..=rows+1 pieces, masks inside the {masks} stored)"
+    )]
+    StripRows {
+        /// The block resolution.
+        resolution: u32,
+        /// `log2 S`.
+        log2_row: u32,
+        /// Most pieces per strip row.
+        pieces: u32,
+        /// Index of the group's first mask.
+        mask_base: u32,
+        /// Masks in the file.
+        masks: u64,
+    },
+    /// A strip-row mask is not what the group's rows allow.
+    #[error(
+        "strip-row mask {index} ({mask:#010x}) of block resolution {resolution}: bit 0 and bits past the row's {per_row} pairs must be 0, and it may start at most {pieces} pieces"
+    )]
+    StripMask {
+        /// Index of the mask.
+        index: u64,
+        /// Its value.
+        mask: u32,
+        /// The block resolution.
+        resolution: u32,
+        /// Pairs per strip row.
+        per_row: u32,
+        /// Most pieces per row.
+        pieces: u32,
+    },
+    /// The number of strip-row masks is not the one the records and band table imply.
+    #[error("{stored} strip-row masks follow the face records, the band table and records need {expected}")]
+    MaskCount {
+        /// Masks stored.
+        stored: u64,
+        /// Masks needed.
+        expected: u64,
+    },
     /// The header size field is not [`HEADER_SIZE`].
     #[error("header size is {0} bytes, version {VERSION} headers are {HEADER_SIZE} bytes")]
     HeaderSize(u32),
@@ -257,8 +319,10 @@ pub enum MctFileError {
         /// Faces of that block resolution.
         faces: u64,
     },
-    /// A reserved word of the band table is not zero.
-    #[error("band table entry of block resolution {resolution} at level {level}: word {word} is {value:#x}, must be 0")]
+    /// A reserved word of the band table is not zero, or a band skips a whole row.
+    #[error(
+        "band table entry of block resolution {resolution} at level {level}: word {word} is {value:#x}, must be 0 (word 2 of a band in use: fewer than its blocks per row)"
+    )]
     BandReserved {
         /// The block resolution.
         resolution: u32,

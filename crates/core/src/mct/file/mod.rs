@@ -6,9 +6,9 @@
 //!
 //! ```text
 //! offset 0     header (144 bytes, zero-padded to 256)
-//! offset 256·k positions     vertex_count × [f32; 3]
+//! offset 256·k positions     vertex_count × [f32; 4]: x, y, z and the LOD density
 //! offset 256·k indices       face_count × [u32; 3]
-//! offset 256·k face records  face_count × u32 (MctFaceRecord)
+//! offset 256·k face records  face_count × u32 (MctFaceRecord), then the strip-row masks (u32 each)
 //! offset 256·k band table    169 × [u32; 4] (MctBands, 2704 bytes)
 //! offset 256·k atlas texels  width × height × bytes_per_sample(format), row-major
 //! ```
@@ -62,7 +62,7 @@ pub use error::MctFileError;
 /// The first 8 bytes of every MCT file.
 pub const MAGIC: [u8; 8] = *b"MESHMCT\0";
 /// The format version this module writes and reads.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 3;
 /// Size of the version-1 header in bytes (zero-padded to [`SECTION_ALIGN`]).
 pub const HEADER_SIZE: usize = 144;
 /// Alignment of every section's offset in bytes.
@@ -78,8 +78,8 @@ pub const MAX_LEVELS: u32 = GROUPS as u32;
 
 /// Byte offset of the CRC-32 field in the header.
 const CHECKSUM_OFFSET: usize = 140;
-/// Bytes of one position (`[f32; 3]`).
-const POSITION_SIZE: u64 = 12;
+/// Bytes of one vertex (`[f32; 4]`: position and level-of-detail density).
+const POSITION_SIZE: u64 = 16;
 /// Bytes of one triangle's indices (`[u32; 3]`).
 const TRIANGLE_SIZE: u64 = 12;
 /// Bytes of one face record.
@@ -206,6 +206,12 @@ pub fn to_bytes(positions: &[[f32; 3]], indices: &[[u32; 3]], mct: &MeshColorTex
         .map_err(|_| MctFileError::TooMany { what: "vertices", count: positions.len() as u64 })?;
     let face_count = u32::try_from(indices.len())
         .map_err(|_| MctFileError::TooMany { what: "faces", count: indices.len() as u64 })?;
+    if mct.vertex_density.len() != positions.len() {
+        return Err(MctFileError::DensityCount {
+            densities: mct.vertex_density.len() as u64,
+            vertices: positions.len() as u64,
+        });
+    }
     if indices.len() != layout.records.len() {
         return Err(MctFileError::FaceCountMismatch {
             indices: indices.len() as u64,
@@ -225,8 +231,10 @@ pub fn to_bytes(positions: &[[f32; 3]], indices: &[[u32; 3]], mct: &MeshColorTex
     }
     let pairs = check_content(&Content {
         positions,
+        density: &mct.vertex_density,
         indices,
         records: &layout.records,
+        masks: &layout.masks,
         bands: &layout.bands,
         width: layout.width,
         height: layout.height,
@@ -237,7 +245,7 @@ pub fn to_bytes(positions: &[[f32; 3]], indices: &[[u32; 3]], mct: &MeshColorTex
     let lengths = [
         u64::from(vertex_count) * POSITION_SIZE,
         u64::from(face_count) * TRIANGLE_SIZE,
-        u64::from(face_count) * RECORD_SIZE,
+        (u64::from(face_count) + layout.masks.len() as u64) * RECORD_SIZE,
         BANDS_SIZE,
         texel_bytes,
     ];
@@ -271,11 +279,14 @@ pub fn to_bytes(positions: &[[f32; 3]], indices: &[[u32; 3]], mct: &MeshColorTex
         out.resize(usize::try_from(section.offset).unwrap_or(out.len()), 0);
     };
     pad_to(&mut out, sections[0]);
-    out.extend(positions.iter().flatten().flat_map(|c| c.to_le_bytes()));
+    for (position, density) in positions.iter().zip(&mct.vertex_density) {
+        out.extend(position.iter().chain([density]).flat_map(|c| c.to_le_bytes()));
+    }
     pad_to(&mut out, sections[1]);
     out.extend(indices.iter().flatten().flat_map(|i| i.to_le_bytes()));
     pad_to(&mut out, sections[2]);
     out.extend(layout.records.iter().flat_map(|r| r.0.to_le_bytes()));
+    out.extend(layout.masks.iter().flat_map(|m| m.to_le_bytes()));
     pad_to(&mut out, sections[3]);
     out.extend(layout.bands.bands.iter().flatten().flat_map(|w| w.to_le_bytes()));
     pad_to(&mut out, sections[4]);
@@ -399,6 +410,9 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
         return Err(truncated_header());
     };
     let header = Header::parse(header_bytes);
+    if header.version == 1 || header.version == 2 {
+        return Err(MctFileError::OldVersion(header.version));
+    }
     if header.version != VERSION {
         return Err(MctFileError::UnsupportedVersion(header.version));
     }
@@ -428,25 +442,36 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
     let [positions, indices, records, bands, texels] = header.sections;
     check_length(positions, 0, vertex_count, POSITION_SIZE, "vertices")?;
     check_length(indices, 1, face_count, TRIANGLE_SIZE, "faces")?;
-    check_length(records, 2, face_count, RECORD_SIZE, "faces")?;
+    // Face records, then the strip-row masks (their number is checked against the records).
+    let mask_count = (records.length / RECORD_SIZE).saturating_sub(face_count);
+    check_length(records, 2, face_count + mask_count, RECORD_SIZE, "faces and strip-row masks")?;
     check_length(bands, 3, 1, BANDS_SIZE, "band tables")?;
     check_length(texels, 4, texel_count, format.bytes_per_sample() as u64, "texels")?;
 
     // Every section now lies inside `bytes` with the length its count implies, so the
     // vectors below are no larger than the file.
-    let positions: Vec<[f32; 3]> =
-        le_words::<3>(section_bytes(bytes, positions)).into_iter().map(|words| words.map(f32::from_bits)).collect();
+    let (positions, density): (Vec<[f32; 3]>, Vec<f32>) = le_words::<4>(section_bytes(bytes, positions))
+        .into_iter()
+        .map(|[x, y, z, d]| ([x, y, z].map(f32::from_bits), f32::from_bits(d)))
+        .unzip();
     let indices = le_words::<3>(section_bytes(bytes, indices));
-    let records: Vec<MctFaceRecord> =
-        le_words::<1>(section_bytes(bytes, records)).into_iter().map(|[word]| MctFaceRecord(word)).collect();
+    let mut words = le_words::<1>(section_bytes(bytes, records));
+    let masks: Vec<u32> = words
+        .split_off(usize::try_from(face_count).unwrap_or(usize::MAX).min(words.len()))
+        .into_iter()
+        .map(|[word]| word)
+        .collect();
+    let records: Vec<MctFaceRecord> = words.into_iter().map(|[word]| MctFaceRecord(word)).collect();
     let mut band_table = MctBands::default();
     for (entry, words) in band_table.bands.iter_mut().zip(le_words::<4>(section_bytes(bytes, bands))) {
         *entry = words;
     }
     let pairs = check_content(&Content {
         positions: &positions,
+        density: &density,
         indices: &indices,
         records: &records,
+        masks: &masks,
         bands: &band_table,
         width: header.width,
         height: header.height,
@@ -459,9 +484,11 @@ pub fn from_bytes(bytes: &[u8]) -> Result<MctFile, MctFileError> {
         height: header.height,
         pairs,
         levels: header.levels,
+        masks,
     };
     let texels = section_bytes(bytes, texels).to_vec();
-    Ok(MctFile { positions, indices, mct: MeshColorTexture { layout, format, texels, stats: MctStats::default() } })
+    let mct = MeshColorTexture { layout, format, texels, stats: MctStats::default(), vertex_density: density };
+    Ok(MctFile { positions, indices, mct })
 }
 
 /// Writes the MCT file of `positions`, `indices` and `mct` to `path` atomically
