@@ -8,7 +8,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use crate::common::{TempDir, model};
+use crate::common::{TempDir, model, psnr_over_foreground as psnr};
 use crate::validator::validate;
 
 use meshpaint_core::camera::default_camera;
@@ -87,20 +87,6 @@ fn write_ply(path: &Path, positions: &[[f32; 3]], triangles: &[[u32; 3]]) {
         t.iter().for_each(|&v| bytes.extend_from_slice(&(v as i32).to_le_bytes()));
     }
     std::fs::write(path, bytes).unwrap();
-}
-
-/// PSNR in dB of `a` against `b` over the pixels where either is not the background.
-fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    let background = *a.get_pixel(0, 0);
-    let (mut sum, mut count) = (0.0f64, 0u64);
-    for (p, q) in a.pixels().zip(b.pixels()) {
-        if *p == background && *q == background {
-            continue;
-        }
-        sum += (0..3).map(|k| (f64::from(p[k]) - f64::from(q[k])).powi(2)).sum::<f64>();
-        count += 1;
-    }
-    10.0 * (255.0f64 * 255.0 / (sum / (3.0 * count.max(1) as f64)).max(1e-12)).log10()
 }
 
 #[test]

@@ -13,7 +13,7 @@ use meshpaint_core::io::document::Source;
 use meshpaint_render::{FilterMode, Shading};
 
 use crate::common;
-use common::workspace_path;
+use common::{psnr_over_foreground as psnr, workspace_path};
 
 const JOB_TIMEOUT: Duration = Duration::from_secs(60);
 
@@ -449,7 +449,7 @@ fn colors_of(editor: &Editor) -> Vec<[f32; 4]> {
 }
 
 /// Drags with the left button from `from` to `to` over the 3D view, in a few steps.
-fn left_drag(harness: &mut Harness<'static, Editor>, from: egui::Pos2, to: egui::Pos2) {
+pub(crate) fn left_drag(harness: &mut Harness<'static, Editor>, from: egui::Pos2, to: egui::Pos2) {
     harness.event(egui::Event::PointerMoved(from));
     harness.run_steps(1);
     let button = |pos, pressed| egui::Event::PointerButton {
@@ -1135,20 +1135,6 @@ fn stroke_messages_say_what_changed() {
     left_drag(&mut harness, center - egui::vec2(40.0, 0.0), center + egui::vec2(40.0, 0.0));
     let status = harness.state().status.text.clone();
     assert!(status.starts_with("Paint stroke: ") && status.contains("samples changed"), "{status}");
-}
-
-/// PSNR in dB of `a` against `b` over the pixels where either is not the background.
-fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    let background = *a.get_pixel(0, 0);
-    let (mut sum, mut count) = (0.0f64, 0u64);
-    for (p, q) in a.pixels().zip(b.pixels()) {
-        if *p == background && *q == background {
-            continue;
-        }
-        sum += (0..3).map(|k| (f64::from(p[k]) - f64::from(q[k])).powi(2)).sum::<f64>();
-        count += 1;
-    }
-    10.0 * (255.0f64 * 255.0 / (sum / (3.0 * count.max(1) as f64)).max(1e-12)).log10()
 }
 
 /// Paints the Duck's +X half with the core brush API: dabs of three colours centred on every

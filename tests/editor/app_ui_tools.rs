@@ -127,23 +127,7 @@ fn hex_entry_takes_three_spellings_and_refuses_the_rest() {
 /// Paints a short stroke across the middle of the 3D view.
 fn stroke(harness: &mut Harness<'static, Editor>, dy: f32) {
     let center = harness.state().viewport.rect.center() + egui::vec2(0.0, dy);
-    let (from, to) = (center - egui::vec2(40.0, 0.0), center + egui::vec2(40.0, 0.0));
-    harness.event(egui::Event::PointerMoved(from));
-    harness.run_steps(1);
-    let button = |pos, pressed| egui::Event::PointerButton {
-        pos,
-        button: egui::PointerButton::Primary,
-        pressed,
-        modifiers: egui::Modifiers::NONE,
-    };
-    harness.event(button(from, true));
-    harness.run_steps(1);
-    for step in 1..=4 {
-        harness.event(egui::Event::PointerMoved(from + (to - from) * (step as f32 / 4.0)));
-        harness.run_steps(1);
-    }
-    harness.event(button(to, false));
-    harness.run_steps(2);
+    crate::app_ui::left_drag(harness, center - egui::vec2(40.0, 0.0), center + egui::vec2(40.0, 0.0));
 }
 
 /// Only colours strokes painted with join the row, newest first and without repeats; a

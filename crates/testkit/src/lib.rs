@@ -170,3 +170,18 @@ impl WriteThrough for ColorStore {
         StoreWriter::new(self, &mut UndoHistory::new(0)).set_face_resolution(face, resolution)
     }
 }
+
+/// PSNR in dB of `a` against `b` over the RGB channels of the pixels where either differs
+/// from the background (`a`'s top-left pixel), written here from the definition.
+pub fn psnr_over_foreground(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    let background = *a.get_pixel(0, 0);
+    let (mut sum, mut count) = (0.0f64, 0u64);
+    for (p, q) in a.pixels().zip(b.pixels()) {
+        if *p == background && *q == background {
+            continue;
+        }
+        sum += (0..3).map(|k| (f64::from(p[k]) - f64::from(q[k])).powi(2)).sum::<f64>();
+        count += 1;
+    }
+    10.0 * (255.0f64 * 255.0 / (sum / (3.0 * count.max(1) as f64)).max(1e-12)).log10()
+}
