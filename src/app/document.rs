@@ -22,6 +22,7 @@ use meshpaint_core::io::document::{Document, Source, SourceKind};
 use meshpaint_core::packing::linear::PackedMesh;
 use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::paint::picking::MeshBvh;
+use meshpaint_core::progress::Reporter;
 use meshpaint_render::{BaselineMesh, DrawItem, Gpu, GpuMct, GpuMesh, MeshGeometry};
 
 use super::jobs::JobContext;
@@ -252,9 +253,10 @@ pub fn load(
     gpu: Option<&Gpu>,
     job: &JobContext,
 ) -> Result<OpenDocument> {
-    let progress = |fraction: f32, stage: &str| job.progress(fraction, stage);
+    let reporter =
+        Reporter::with_cancel_flag(|fraction: f32, stage: &str| job.progress(fraction, stage), job.cancel_flag());
     let upload = |packed: &_| gpu.map(|gpu| gpu.upload(packed)).transpose();
-    let displayed = open_for_display(source, &OpenOptions::new(rule, *budget), &progress, upload)?;
+    let displayed = open_for_display(source, &OpenOptions::new(rule, *budget), reporter.progress(), upload)?;
     let Displayed { document, cache, bvh, upload: gpu_mesh, timings } = displayed;
     let packed = cache.packed();
     let document_is_packed = matches!(document.source, SourceKind::Packed(_));

@@ -203,8 +203,10 @@ impl Editor {
 
     fn finish_job(&mut self, kind: JobKind, finished: Finished<JobOutput>) {
         let Finished::Done { value, elapsed } = finished else {
-            if let Finished::Failed(message) = finished {
-                self.finish_failed(kind, message);
+            match finished {
+                Finished::Failed(message) => self.finish_failed(kind, message),
+                Finished::Cancelled => self.finish_cancelled(kind),
+                Finished::Done { .. } => {}
             }
             return;
         };
@@ -267,6 +269,26 @@ impl Editor {
                 Some(problem) => self.set_status(Severity::Warning, format!("{text}. {problem}")),
                 None => self.set_status(Severity::Info, text),
             },
+        }
+    }
+
+    /// A job was cancelled: the open document stays (with nothing open, the built-in scene
+    /// opens, as after a failed start).
+    fn finish_cancelled(&mut self, kind: JobKind) {
+        if kind == JobKind::Write(WriteKind::Save) {
+            self.document.saving_generation = None;
+            self.after_save_finished(false);
+        }
+        match &self.document.open {
+            Some(open) => {
+                let text = format!("Cancelled; still showing {}", open.title);
+                self.set_status(Severity::Info, text);
+            }
+            None if matches!(kind, JobKind::Open { built_in: false }) => {
+                self.set_status(Severity::Info, "Cancelled; showing the built-in Duck");
+                self.open(Source::BuiltIn);
+            }
+            None => self.set_status(Severity::Info, "Cancelled"),
         }
     }
 
@@ -666,7 +688,11 @@ impl Editor {
         self.apply_all(chosen);
         egui::Panel::bottom("status line").show(ui, |ui| {
             let mode = self.mode();
-            self.panels.status_line.ui(ui, mode, &self.status, self.jobs.status());
+            // Opening reads its cancel flag (the conversion stops; the open document stays).
+            let cancellable = matches!(self.jobs.kind(), Some(JobKind::Open { .. })) && !self.jobs.is_cancelling();
+            if self.panels.status_line.ui(ui, mode, &self.status, self.jobs.status(), cancellable) {
+                self.jobs.cancel();
+            }
         });
         egui::Panel::left("side panel")
             .resizable(true)

@@ -4,10 +4,12 @@
 //! frame with [`Jobs::poll`] and draws its [`Progress`]; the worker reports progress and
 //! wakes the UI through a callback (the window's repaint request), so a finished job is
 //! noticed at once without redrawing continuously. A panic inside a job becomes an error
-//! message, never a crash.
+//! message, never a crash. A job that reads its cancel flag ([`JobContext::cancel_flag`],
+//! handed to the core's [`meshpaint_core::progress::Reporter`]) stops when [`Jobs::cancel`] is
+//! called, and its failure is then reported as [`Finished::Cancelled`].
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -55,6 +57,8 @@ pub type Waker = Arc<dyn Fn() + Send + Sync>;
 pub struct Progress {
     fraction_bits: AtomicU32,
     stage: Mutex<String>,
+    /// Set by [`Jobs::cancel`]; read by the job.
+    cancelled: AtomicBool,
 }
 
 impl Progress {
@@ -90,6 +94,12 @@ impl JobContext {
         self.progress.set(fraction, stage);
         (self.waker)();
     }
+
+    /// The flag [`Jobs::cancel`] sets, for the job's work to read (the core's
+    /// [`meshpaint_core::progress::Reporter::with_cancel_flag`]).
+    pub fn cancel_flag(&self) -> &AtomicBool {
+        &self.progress.cancelled
+    }
 }
 
 /// A job that is running.
@@ -113,6 +123,8 @@ pub enum Finished<T> {
     },
     /// The job failed (or panicked) with this message.
     Failed(String),
+    /// The job stopped because [`Jobs::cancel`] asked it to.
+    Cancelled,
 }
 
 /// The job runner: at most one job at a time.
@@ -136,6 +148,23 @@ impl<T: Send + 'static> Jobs<T> {
     /// Whether a job is running.
     pub fn is_busy(&self) -> bool {
         self.running.is_some()
+    }
+
+    /// Asks the running job to stop (it ends as [`Finished::Cancelled`] if it reads its flag).
+    pub fn cancel(&self) {
+        if let Some(job) = &self.running {
+            job.progress.cancelled.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// The running job's kind.
+    pub fn kind(&self) -> Option<JobKind> {
+        self.running.as_ref().map(|job| job.kind)
+    }
+
+    /// Whether the running job was asked to stop.
+    pub fn is_cancelling(&self) -> bool {
+        self.running.as_ref().is_some_and(|job| job.progress.cancelled.load(Ordering::Relaxed))
     }
 
     /// The running job's label, progress fraction, stage and age.
@@ -185,6 +214,7 @@ impl<T: Send + 'static> Jobs<T> {
         let job = self.running.as_ref()?;
         let outcome = match job.receiver.try_recv() {
             Ok(Ok(value)) => Finished::Done { value, elapsed: job.started.elapsed() },
+            Ok(Err(_)) if job.progress.cancelled.load(Ordering::Relaxed) => Finished::Cancelled,
             Ok(Err(message)) => Finished::Failed(message),
             Err(TryRecvError::Empty) => return None,
             Err(TryRecvError::Disconnected) => Finished::Failed("the worker thread stopped without an answer".into()),

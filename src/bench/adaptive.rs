@@ -184,6 +184,7 @@ pub fn bench_adaptive(
             path,
             &meshpaint_core::colors::budget::Budget::from_environment(),
             &mut phases,
+            meshpaint_core::progress::Reporter::silent().progress(),
         )?;
         let convert_seconds = started.elapsed().as_secs_f64();
         let packed = document.pack(ColorFormat::Rgba8Srgb)?;

@@ -26,6 +26,7 @@ use meshpaint_core::io::display::{Displayed, OpenError, OpenOptions, open_for_di
 use meshpaint_core::io::document::{DocumentError, Source};
 use meshpaint_core::packing::packer::PackError;
 use meshpaint_core::packing::paint_layout::PaintLayout;
+use meshpaint_core::progress::Reporter;
 use meshpaint_render::{DrawItem, Gpu, RenderError, RenderSettings};
 
 /// Errors of the load benchmark.
@@ -80,7 +81,7 @@ pub fn bench_load(
     let started = Instant::now();
     let options = OpenOptions { rule: resolution.into(), subdivide, budget };
     let source = Source::File(path.to_owned());
-    let displayed = open_for_display(&source, &options, &|_, _| {}, |packed| gpu.upload(packed))?;
+    let displayed = open_for_display(&source, &options, Reporter::silent().progress(), |packed| gpu.upload(packed))?;
     let Displayed { document, cache, bvh, upload: mesh, timings } = displayed;
     let format = document.display_format();
     let frame_started = Instant::now();

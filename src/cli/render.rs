@@ -9,6 +9,7 @@ use meshpaint_core::io::display::{OpenOptions, open_for_display};
 use meshpaint_core::io::document::Source;
 use meshpaint_core::mct::file::read_mct;
 use meshpaint_core::packing::lod::VertexLod;
+use meshpaint_core::progress::Reporter;
 use meshpaint_render::{DrawItem, FilterMode, Gpu, MeshGeometry, Overlays, RenderSettings, Shading};
 
 use super::args::{CameraArgs, LOG_TARGET, Representation, ResolutionArg, is_mct_file};
@@ -140,7 +141,7 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
         let source = Source::File(args.file.clone());
         let options = OpenOptions::new(args.resolution.rule()?, budget);
         let upload = |packed: &_| if args.position_colors { Ok(None) } else { gpu.upload(packed).map(Some) };
-        let displayed = open_for_display(&source, &options, &|_, _| {}, upload)?;
+        let displayed = open_for_display(&source, &options, Reporter::silent().progress(), upload)?;
         for warning in &displayed.document.warnings {
             log::warn!(target: LOG_TARGET, "{}: {warning}", args.file.display());
         }

@@ -172,6 +172,7 @@ fn worst_view(gpu: &Gpu, dir: &TempDir, r8: Resolution, fit: BakeFit, files: &[&
             &path,
             &Budget::from_environment(),
             &mut OpenPhases::default(),
+            meshpaint_core::progress::Reporter::silent().progress(),
         )
         .unwrap();
         let bake = bake_uv_texture(&document.store, &welded.corner_uvs, size, default_padding(size)).unwrap();

@@ -4,5 +4,6 @@
 mod common;
 
 mod app_ui;
+mod app_ui_convert;
 mod app_ui_tools;
 mod app_window;

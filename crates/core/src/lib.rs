@@ -23,6 +23,7 @@
 //! | [`synth`] | synthetic inputs for tests, benchmarks and the fuzzer: the deterministic random sources and small meshes built in code (one copy each) |
 //! | [`atomic_write`] | the one way files are written: temporary file, `sync_all`, rename, directory sync |
 //! | [`memory`] | fresh buffers a document's bulk is written into once (the store's chunks on open, packed colours, the paint layout's bytes): transparent huge pages advised before the first write |
+//! | [`progress`] | progress by phase and items done, and cooperative cancel, of long operations (open, convert, pack): the caller's [`progress::Reporter`], the operation's [`progress::Progress`] parts |
 //! | [`threads`] | the main thread's pool (the editor's UI thread works in it, so a small parallel call does not wait for sleeping workers); background jobs use rayon's global pool |
 //! | [`camera`] | the orbit camera: matrices, framing, pixel rays (shared by render, picking, replay) |
 //!
@@ -57,5 +58,6 @@ pub mod memory;
 pub mod mesh;
 pub mod packing;
 pub mod paint;
+pub mod progress;
 pub mod synth;
 pub mod threads;

@@ -11,6 +11,7 @@ use meshpaint_core::colors::budget::Budget;
 use meshpaint_core::colors::layout::Resolution;
 use meshpaint_core::io::display::{OpenOptions, open_for_display};
 use meshpaint_core::io::document::Source;
+use meshpaint_core::progress::Reporter;
 use meshpaint_render::{DrawItem, Gpu, RenderSettings};
 
 /// Renders `input` (glTF at R = 8, or packed; in its own colour format) lit and trilinear at `width × height` and
@@ -19,7 +20,7 @@ pub fn render_offscreen(input: &Path, output: &Path, width: u32, height: u32) ->
     let source = Source::File(input.to_owned());
     let gpu = Gpu::new_headless()?;
     let options = OpenOptions::new(Resolution::new(8)?, Budget::from_environment().with_gpu(gpu.budget_limits()));
-    let mesh = open_for_display(&source, &options, &|_, _| {}, |packed| gpu.upload(packed))?.upload;
+    let mesh = open_for_display(&source, &options, Reporter::silent().progress(), |packed| gpu.upload(packed))?.upload;
     let camera = default_camera(mesh.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
     let image = gpu.render_image(DrawItem::MeshColors(&mesh), &RenderSettings::new(camera), width, height)?;
     image.save(output)?;

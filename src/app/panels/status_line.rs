@@ -12,8 +12,17 @@ pub type JobProgress<'a> = (&'a str, f32, String, Duration);
 pub struct StatusLine;
 
 impl StatusLine {
-    /// The mode, then the running `job`'s progress if there is one, else `status`.
-    pub fn ui(&mut self, ui: &mut egui::Ui, mode: Mode, status: &Status, job: Option<JobProgress<'_>>) {
+    /// The mode, then the running `job`'s progress if there is one (with a Cancel button
+    /// when `cancellable`; returns whether it was clicked), else `status`.
+    pub fn ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        mode: Mode,
+        status: &Status,
+        job: Option<JobProgress<'_>>,
+        cancellable: bool,
+    ) -> bool {
+        let mut cancel = false;
         ui.horizontal(|ui| {
             let text = egui::RichText::new(format!("{} mode", mode.name())).strong();
             let text = match mode {
@@ -24,6 +33,9 @@ impl StatusLine {
             ui.separator();
             if let Some((label, fraction, stage, elapsed)) = job {
                 ui.add(egui::ProgressBar::new(fraction).desired_width(220.0).show_percentage().animate(true));
+                if cancellable {
+                    cancel = ui.button("Cancel").on_hover_text("Stop; the open document stays").clicked();
+                }
                 ui.label(format!("{label}: {stage} ({:.1} s)", elapsed.as_secs_f32()));
             } else {
                 let color = match status.severity {
@@ -41,5 +53,6 @@ impl StatusLine {
                 .on_hover_text(&status.text);
             }
         });
+        cancel
     }
 }

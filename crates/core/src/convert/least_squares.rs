@@ -57,6 +57,7 @@ use crate::convert::bake::{face_materials, interpolate_uv, material_color, world
 use crate::mesh::scene::Scene;
 use crate::mesh::weld::WeldedMesh;
 use crate::packing::sampler::{Filter, MeshColorSource, sample};
+use crate::progress::{Cancelled, Progress, Reporter};
 
 /// `ε` of the regularisation `Λ = ε · diag(A)` (module docs).
 pub const REGULARISATION: f64 = 1e-4;
@@ -278,10 +279,22 @@ impl Numbering {
 /// Moves every sample of `store` (the store of `mesh`, already point-baked by
 /// [`crate::convert::bake::bake_texture`]) to the least-squares fit of the module docs.
 /// `None` (and the store untouched) when it holds more than [`MAX_SAMPLES`] samples.
-/// Long: numbering, templates, assembly, the solve and the write-back.
 pub fn refine(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene) -> Option<RefineReport> {
+    let reporter = Reporter::silent();
+    refine_with(store, mesh, scene, reporter.progress()).ok().flatten()
+}
+
+/// [`refine`], reporting to `progress` (faces assembled, then the solve's iterations);
+/// [`Cancelled`], the store untouched, as soon as it is cancelled.
+/// Long: numbering, templates, assembly, the solve and the write-back.
+pub fn refine_with(
+    store: &mut ColorStore,
+    mesh: &WeldedMesh,
+    scene: &Scene,
+    progress: Progress<'_>,
+) -> Result<Option<RefineReport>, Cancelled> {
     if store.sample_count() > MAX_SAMPLES {
-        return None;
+        return Ok(None);
     }
     let face_count = store.topology().face_count() as usize;
     let (materials, pyramids) = face_materials(mesh, scene, face_count);
@@ -331,9 +344,14 @@ pub fn refine(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene) -> Optio
         indices: Vec<usize>,
         rhs: Vec<[f64; 4]>,
     }
+    let counter = progress.part(0.0, 0.5).counter("fitting: reading the texture", "faces", face_count);
     let faces: Vec<FaceSystem> = (0..face_count)
         .into_par_iter()
         .filter_map(|face| {
+            counter.add(1);
+            if counter.is_cancelled() {
+                return None;
+            }
             let template = face_template[face]?;
             let t = &templates[template];
             let area = world_area(mesh, face);
@@ -359,6 +377,7 @@ pub fn refine(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene) -> Optio
             Some(FaceSystem { template, area, indices, rhs })
         })
         .collect();
+    progress.check()?;
     let mut b = vec![[0.0f64; 4]; n];
     let mut triplets: Vec<(u32, u32, f64)> = Vec::new();
     for face in &faces {
@@ -384,13 +403,13 @@ pub fn refine(store: &mut ColorStore, mesh: &WeldedMesh, scene: &Scene) -> Optio
             x0[g] = color.map(f64::from);
         }
     });
-    let (x, iterations, objective) = solve(&matrix, &b, &x0);
+    let (x, iterations, objective) = solve(&matrix, &b, &x0, progress.part(0.55, 1.0))?;
     // Clamped to the range of what is fitted (texels and factors lie in [0, 1]): a fit
     // overshoots next to hard edges, and a texture never shows more than full range.
     let solved =
         |sample: SampleRef| numbering.index(sample).and_then(|g| x.get(g)).map(|c| c.map(|v| v.clamp(0.0, 1.0) as f32));
     store.fill_with(|site| solved(site.sample).unwrap_or([0.0; 4]));
-    Some(RefineReport { samples: n as u64, faces: taking_part, iterations, objective })
+    Ok(Some(RefineReport { samples: n as u64, faces: taking_part, iterations, objective }))
 }
 
 /// A symmetric sparse matrix in compressed rows.
@@ -448,8 +467,10 @@ impl Csr {
 
 /// Preconditioned conjugate gradients on `(A + Λ) x = b + Λ x₀` from `x₀`, each channel on
 /// its own; returns the solution, the iterations and the objective before and after.
+/// `progress` sees the iterations against [`MAX_ITERATIONS`] (most solves stop earlier).
 /// Long: the textbook loop, four channels at once.
-fn solve(a: &Csr, b: &[[f64; 4]], x0: &[[f64; 4]]) -> (Vec<[f64; 4]>, u32, (f64, f64)) {
+type Solution = (Vec<[f64; 4]>, u32, (f64, f64));
+fn solve(a: &Csr, b: &[[f64; 4]], x0: &[[f64; 4]], progress: Progress<'_>) -> Result<Solution, Cancelled> {
     let n = b.len();
     let lambda: Vec<f64> = a.diagonal.iter().map(|&d| if d > 0.0 { REGULARISATION * d } else { 1.0 }).collect();
     let inverse: Vec<f64> = a.diagonal.iter().zip(&lambda).map(|(&d, &l)| 1.0 / (d + l)).collect();
@@ -486,6 +507,11 @@ fn solve(a: &Csr, b: &[[f64; 4]], x0: &[[f64; 4]]) -> (Vec<[f64; 4]>, u32, (f64,
             break;
         }
         iterations += 1;
+        progress.check()?;
+        progress.report(
+            iterations as f32 / MAX_ITERATIONS as f32,
+            &format!("fitting: solving for {n} samples, iteration {iterations}"),
+        );
         a.apply(&p, &lambda, &mut ap);
         let pap = dot(&p, &ap);
         let alpha: [f64; 4] = std::array::from_fn(|c| if pap[c] > 0.0 { rz[c] / pap[c] } else { 0.0 });
@@ -499,7 +525,7 @@ fn solve(a: &Csr, b: &[[f64; 4]], x0: &[[f64; 4]]) -> (Vec<[f64; 4]>, u32, (f64,
     }
     a.apply(&x, &lambda, &mut ax);
     let end = objective(&x, &ax);
-    (x, iterations, (start, end))
+    Ok((x, iterations, (start, end)))
 }
 
 fn add4(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {

@@ -20,6 +20,7 @@ use crate::packing::file as packed_file;
 use crate::packing::linear::PackedMesh;
 use crate::packing::packer::{PackCache, PackError};
 use crate::paint::picking::{BvhPreset, MeshBvh};
+use crate::progress::Progress;
 
 use super::document::{
     BUILT_IN_GLB, BUILT_IN_NAME, Document, DocumentError, OpenPhases, Source, import_limits, import_scene_within,
@@ -109,23 +110,24 @@ pub enum OpenError<E> {
 /// Opens `source` for display: a mesh at the face resolutions of `options.rule` (after
 /// `options.subdivide` subdivisions) or a packed file, within `options.budget`; refuses a
 /// mesh without triangles; packs it in its display format and calls `upload` on the packed
-/// buffers while the BVH is built beside them. `progress(fraction, stage)` is told each
-/// stage (from either thread). Importer notes are in `document.warnings`.
+/// buffers while the BVH is built beside them. `progress` is told each stage and the
+/// conversion's faces done (from either thread); once cancelled, the conversion stops with
+/// [`DocumentError::Cancelled`]. Importer notes are in `document.warnings`.
 pub fn open_for_display<U: Send, E: Send>(
     source: &Source,
     options: &OpenOptions,
-    progress: &(dyn Fn(f32, &str) + Sync),
+    progress: Progress<'_>,
     upload: impl FnOnce(&PackedMesh) -> Result<U, E> + Send,
 ) -> Result<Displayed<U>, OpenError<E>> {
     let started = Instant::now();
     let mut timings = OpenTimings::default();
-    progress(0.05, "reading and importing");
-    let document = open_document(source, options, &mut timings)?;
+    progress.report(0.0, "reading and importing");
+    let document = open_document(source, options, &mut timings, progress.part(0.05, 0.85))?;
     let name = source.name();
     if document.store.topology().face_count() == 0 {
         return Err(DocumentError::NoTriangles { path: name.into() }.into());
     }
-    progress(0.45, "packing colours with MIP chains, building the picking BVH");
+    progress.report(0.85, "packing colours with MIP chains, building the picking BVH");
     let parallel = Instant::now();
     let (packed, (bvh, bvh_time)) = rayon::join(
         || -> Result<_, OpenError<E>> {
@@ -134,7 +136,7 @@ pub fn open_for_display<U: Send, E: Send>(
             let cache = PackCache::build(&document.store, &document.positions, document.display_format())
                 .map_err(pack_error)?;
             let pack = started.elapsed();
-            progress(0.65, "uploading");
+            progress.report(0.95, "uploading");
             let started = Instant::now();
             let uploaded = upload(cache.packed()).map_err(|source| OpenError::Upload { name: name.clone(), source })?;
             Ok((cache, uploaded, pack, started.elapsed()))
@@ -150,12 +152,17 @@ pub fn open_for_display<U: Send, E: Send>(
     timings.pack_upload_bvh = parallel.elapsed();
     (timings.pack, timings.upload, timings.bvh) = (pack, upload_time, bvh_time);
     timings.total = started.elapsed().saturating_sub(timings.subdivide);
-    progress(1.0, "done");
+    progress.report(1.0, "done");
     Ok(Displayed { document, cache, bvh, upload, timings })
 }
 
 /// The document of `source`, timing its phases into `timings`.
-fn open_document(source: &Source, options: &OpenOptions, timings: &mut OpenTimings) -> Result<Document, DocumentError> {
+fn open_document(
+    source: &Source,
+    options: &OpenOptions,
+    timings: &mut OpenTimings,
+    progress: Progress<'_>,
+) -> Result<Document, DocumentError> {
     let OpenOptions { rule, subdivide, ref budget } = *options;
     let started = Instant::now();
     let (scene, kind, name) = match source {
@@ -184,7 +191,7 @@ fn open_document(source: &Source, options: &OpenOptions, timings: &mut OpenTimin
         scene
     };
     let mut document =
-        Document::from_scene_phased(scene, rule, BakeFit::default(), &name, budget, &mut timings.phases)?;
+        Document::from_scene_phased(scene, rule, BakeFit::default(), &name, budget, &mut timings.phases, progress)?;
     document.source = kind;
     Ok(document)
 }

@@ -98,6 +98,12 @@ pub enum DocumentError {
         /// The cause.
         source: PackError,
     },
+    /// The caller cancelled the conversion ([`crate::progress::Reporter::cancel`]).
+    #[error("{path}: cancelled")]
+    Cancelled {
+        /// The file.
+        path: PathBuf,
+    },
 }
 
 /// What to open: the built-in scene or a file.
@@ -439,12 +445,22 @@ impl Document {
         name: &Path,
         budget: &Budget,
     ) -> Result<Self, DocumentError> {
-        Self::from_scene_phased(scene, rule, BakeFit::default(), name, budget, &mut OpenPhases::default())
+        let reporter = crate::progress::Reporter::silent();
+        Self::from_scene_phased(
+            scene,
+            rule,
+            BakeFit::default(),
+            name,
+            budget,
+            &mut OpenPhases::default(),
+            reporter.progress(),
+        )
     }
 
     /// [`Document::from_scene_within`] with the texture baked by `fit` (the default is the
     /// least-squares fit, [`crate::convert::least_squares`]), recording how long each phase took in
-    /// `phases` (`meshpaint bench load`, `bench adaptive`).
+    /// `phases` (`meshpaint bench load`, `bench adaptive`) and reporting to `progress`
+    /// (choosing the resolutions, then baking; [`DocumentError::Cancelled`] once cancelled).
     pub fn from_scene_phased(
         scene: Scene,
         rule: impl Into<ResolutionRule>,
@@ -452,9 +468,19 @@ impl Document {
         name: &Path,
         budget: &Budget,
         phases: &mut OpenPhases,
+        progress: crate::progress::Progress<'_>,
     ) -> Result<Self, DocumentError> {
         let rule = rule.into();
         let budget_error = |source| DocumentError::Budget { path: name.to_owned(), source };
+        let cancelled = |_| DocumentError::Cancelled { path: name.to_owned() };
+        // Where the time goes: a content-driven rule's choice, then the bake and fit.
+        let (choose, bake) = match rule {
+            ResolutionRule::Uniform(_) | ResolutionRule::WhereTextured(_) => {
+                (progress.part(0.0, 0.05), progress.part(0.05, 1.0))
+            }
+            _ => (progress.part(0.0, 0.6), progress.part(0.6, 1.0)),
+        };
+        progress.report(0.0, "welding");
         budget.check_triangles("the scene", scene.instanced_triangle_count() as u64).map_err(budget_error)?;
         let started = Instant::now();
         let welded = weld_scene(&scene);
@@ -487,7 +513,9 @@ impl Document {
                     rule,
                     fit,
                     &mut phases.rule,
-                );
+                    choose,
+                )
+                .map_err(cancelled)?;
                 let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);
                 budget.check(&rule.describe(), &counts, ColorFormat::default()).map_err(budget_error)?;
                 resolutions
@@ -502,7 +530,8 @@ impl Document {
             .map_err(|source| DocumentError::Store { path: name.to_owned(), source })?;
         if has_base_color {
             let baking = Instant::now();
-            crate::convert::adaptive::bake_and_verify(&mut store, &welded, &scene, rule, fit);
+            crate::convert::adaptive::bake_and_verify_with(&mut store, &welded, &scene, rule, fit, bake)
+                .map_err(cancelled)?;
             phases.bake = baking.elapsed();
         } else if neutral && uniform.is_none() {
             fill_neutral(&mut store, &welded.triangle_materials, &scene);
@@ -516,6 +545,7 @@ impl Document {
             .iter()
             .any(|m| m.and_then(|m| scene.materials.get(m as usize)).is_some_and(|m| m.base_color_texture.is_some()));
         phases.store = started.elapsed();
+        progress.report(1.0, "converted");
         Ok(Document {
             textured,
             positions: welded.positions_world,

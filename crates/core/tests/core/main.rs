@@ -19,6 +19,7 @@ mod packed_file;
 mod packer;
 mod paint_layout;
 mod picking;
+mod progress;
 mod repack;
 mod seams;
 mod store;

@@ -75,6 +75,7 @@ use crate::mesh::scene::Scene;
 use crate::mesh::topology::Topology;
 use crate::mesh::weld::WeldedMesh;
 use crate::packing::sampler::{Filter, sample};
+use crate::progress::{Cancelled, Progress, Reporter};
 
 /// Errors (RMS, sRGB-encoded colour units) at or below this are float rounding and count as
 /// zero: a constant colour baked and reconstructed differs from its texel by a few ulps.
@@ -153,10 +154,13 @@ pub fn face_resolutions(
     rule: ResolutionRule,
     fit: BakeFit,
 ) -> Vec<Resolution> {
-    face_resolutions_phased(mesh, scene, face_count, rule, fit, &mut RulePhases::default())
+    let reporter = Reporter::silent();
+    face_resolutions_phased(mesh, scene, face_count, rule, fit, &mut RulePhases::default(), reporter.progress())
+        .unwrap_or_else(|Cancelled| vec![Resolution::ONE; face_count])
 }
 
-/// [`face_resolutions`], recording how long each phase took in `phases`.
+/// [`face_resolutions`], recording how long each phase took in `phases` and reporting to
+/// `progress`; [`Cancelled`] as soon as it is cancelled.
 pub fn face_resolutions_phased(
     mesh: &WeldedMesh,
     scene: &Scene,
@@ -164,13 +168,17 @@ pub fn face_resolutions_phased(
     rule: ResolutionRule,
     fit: BakeFit,
     phases: &mut RulePhases,
-) -> Vec<Resolution> {
+    progress: Progress<'_>,
+) -> Result<Vec<Resolution>, Cancelled> {
     let started = Instant::now();
-    let resolutions = choose_resolutions(mesh, scene, face_count, rule, fit, phases);
+    let resolutions = choose_resolutions(mesh, scene, face_count, rule, fit, phases, progress);
     phases.predict += started.elapsed().saturating_sub(phases.calibrate + phases.allocate);
+    progress.check()?;
+    progress.report(1.0, "face resolutions chosen");
     resolutions
 }
 
+/// Long: one arm per rule.
 fn choose_resolutions(
     mesh: &WeldedMesh,
     scene: &Scene,
@@ -178,37 +186,44 @@ fn choose_resolutions(
     rule: ResolutionRule,
     fit: BakeFit,
     phases: &mut RulePhases,
-) -> Vec<Resolution> {
+    progress: Progress<'_>,
+) -> Result<Vec<Resolution>, Cancelled> {
     if let ResolutionRule::Uniform(r) = rule {
-        return vec![r; face_count];
+        return Ok(vec![r; face_count]);
     }
     let (materials, pyramids) = face_materials(mesh, scene, face_count);
     let shared = shared_uvs(mesh);
     if shared.len() != face_count {
-        return vec![Resolution::ONE; face_count];
+        return Ok(vec![Resolution::ONE; face_count]);
     }
     if let ResolutionRule::Budget { samples, max } = rule {
-        let faces = Faces::new(mesh, &materials, &shared, &pyramids, max);
+        let faces = Faces::new(mesh, &materials, &shared, &pyramids, max, progress.part(0.0, 0.1))?;
         // The calibration stores are dropped before the refinement allocates its own.
         let started = Instant::now();
-        let calibration = calibration_stores(mesh, scene, samples, max, fit);
+        let calibration = calibration_stores(mesh, scene, samples, max, fit, progress.part(0.1, 0.4))?;
         phases.calibrate = started.elapsed();
-        let mut distortion = faces.predicted_distortions(&calibration);
+        let mut distortion = faces.predicted_distortions(&calibration, progress.part(0.4, 0.6))?;
         drop(calibration);
         let started = Instant::now();
         let first = allocate_budget(mesh, &distortion, samples, max);
-        let resolutions = refine_allocation(&faces, scene, &mut distortion, first, samples, fit);
+        let resolutions =
+            refine_allocation(&faces, scene, &mut distortion, first, samples, fit, progress.part(0.6, 1.0))?;
         phases.allocate = started.elapsed();
-        return resolutions;
+        return Ok(resolutions);
     }
     let material_boundary = if matches!(rule, ResolutionRule::WhereTextured(_)) {
         faces_on_material_boundaries(mesh, face_count)
     } else {
         Vec::new()
     };
-    (0..face_count)
+    let counter = progress.counter("choosing face resolutions", "faces", face_count);
+    let resolutions = (0..face_count)
         .into_par_iter()
         .map(|face| {
+            counter.add(1);
+            if counter.is_cancelled() {
+                return Resolution::ONE;
+            }
             let material = &materials[face];
             if material.texture.is_none() {
                 // Shared vertices hold one colour: a face touching another material keeps
@@ -233,7 +248,9 @@ fn choose_resolutions(
                 }
             }
         })
-        .collect()
+        .collect();
+    progress.check()?;
+    Ok(resolutions)
 }
 
 /// For each face, whether one of its vertices is shared with a face of another material.
@@ -284,7 +301,8 @@ impl<'a> Faces<'a> {
         shared: &'a [SharedUvs],
         pyramids: &'a [Option<crate::convert::bake::TexturePyramid>],
         max: Resolution,
-    ) -> Self {
+        progress: Progress<'_>,
+    ) -> Result<Self, Cancelled> {
         let mut faces = Faces { mesh, materials, shared, pyramids, max, cache: Vec::new() };
         let bytes: u64 = materials
             .iter()
@@ -292,11 +310,18 @@ impl<'a> Faces<'a> {
             .map(|material| u64::from(dense_lattice(material, max)).pow(2) * std::mem::size_of::<TestPoint>() as u64)
             .sum();
         if bytes <= FIT_CACHE_BYTES {
-            let cache =
-                (0..materials.len()).into_par_iter().map(|face| faces.fit(face).map(FaceFit::into_points)).collect();
+            let counter = progress.counter("reading the texture under each face", "faces", materials.len());
+            let cache = (0..materials.len())
+                .into_par_iter()
+                .map(|face| {
+                    counter.add(1);
+                    if counter.is_cancelled() { None } else { faces.fit(face).map(FaceFit::into_points) }
+                })
+                .collect();
+            progress.check()?;
             faces.cache = cache;
         }
-        faces
+        Ok(faces)
     }
 
     /// Face `face`'s test points and texture; `None` for a face without a texture.
@@ -314,19 +339,29 @@ impl<'a> Faces<'a> {
     }
 
     /// Each face's predicted distortion at each level `R = 2^l` up to `max` (module docs).
-    fn predicted_distortions(&self, calibration: &[Option<ColorStore>]) -> Vec<Vec<f64>> {
+    fn predicted_distortions(
+        &self,
+        calibration: &[Option<ColorStore>],
+        progress: Progress<'_>,
+    ) -> Result<Vec<Vec<f64>>, Cancelled> {
         let levels = self.max.log2() as usize + 1;
-        (0..self.materials.len())
+        let counter = progress.counter("predicting each face's error", "faces", self.materials.len());
+        let distortions = (0..self.materials.len())
             .into_par_iter()
-            .map(|face| match self.fit(face) {
-                None => vec![0.0; levels],
-                Some(fit) => fit
-                    .predicted_errors(face as u32, self.max, calibration)
-                    .into_iter()
-                    .map(|error| self.distortion(face, error))
-                    .collect(),
+            .map(|face| {
+                counter.add(1);
+                match self.fit(face).filter(|_| !counter.is_cancelled()) {
+                    None => vec![0.0; levels],
+                    Some(fit) => fit
+                        .predicted_errors(face as u32, self.max, calibration)
+                        .into_iter()
+                        .map(|error| self.distortion(face, error))
+                        .collect(),
+                }
             })
-            .collect()
+            .collect();
+        progress.check()?;
+        Ok(distortions)
     }
 
     /// The error (module docs) of face `face` as `store` shows it, at the face's own `R`
@@ -337,11 +372,20 @@ impl<'a> Faces<'a> {
     }
 
     /// Each face's distortion as `store` shows it ([`Faces::shown_error`]).
-    fn shown_distortions(&self, store: &ColorStore) -> Vec<f64> {
-        (0..self.materials.len())
+    fn shown_distortions(&self, store: &ColorStore, progress: Progress<'_>) -> Result<Vec<f64>, Cancelled> {
+        let counter = progress.counter("measuring each face as fitted", "faces", self.materials.len());
+        let shown = (0..self.materials.len())
             .into_par_iter()
-            .map(|face| self.shown_error(store, face).map_or(0.0, |error| self.distortion(face, error)))
-            .collect()
+            .map(|face| {
+                counter.add(1);
+                if counter.is_cancelled() {
+                    return 0.0;
+                }
+                self.shown_error(store, face).map_or(0.0, |error| self.distortion(face, error))
+            })
+            .collect();
+        progress.check()?;
+        Ok(shown)
     }
 }
 
@@ -365,26 +409,34 @@ fn refine_allocation(
     first: Vec<Resolution>,
     budget: u64,
     fit: BakeFit,
-) -> Vec<Resolution> {
+    progress: Progress<'_>,
+) -> Result<Vec<Resolution>, Cancelled> {
     let mesh = faces.mesh;
     let topology = Topology::build(mesh.positions_world.len() as u32, &mesh.triangles).ok();
     let (Some(topology), BakeFit::LeastSquares) = (topology, fit) else {
-        return first;
+        return Ok(first);
     };
-    let measure = |resolutions: &[Resolution]| -> Option<Vec<f64>> {
+    let rounds = (REFINEMENT_ROUNDS + 1) as f32;
+    let measure = |resolutions: &[Resolution], round: usize| -> Result<Option<Vec<f64>>, Cancelled> {
+        let progress = progress.part(round as f32 / rounds, (round + 1) as f32 / rounds);
         let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);
         if counts.samples > budget.min(least_squares::MAX_SAMPLES) {
-            return None;
+            return Ok(None);
         }
-        let mut store = ColorStore::with_resolutions(topology.clone(), resolutions.to_vec(), [1.0; 4]).ok()?;
+        let Ok(mut store) = ColorStore::with_resolutions(topology.clone(), resolutions.to_vec(), [1.0; 4]) else {
+            return Ok(None);
+        };
+        progress.report(0.0, "baking the allocation");
         bake_texture(&mut store, mesh, scene);
-        least_squares::refine(&mut store, mesh, scene)?;
-        Some(faces.shown_distortions(&store))
+        if least_squares::refine_with(&mut store, mesh, scene, progress.part(0.05, 0.6))?.is_none() {
+            return Ok(None);
+        }
+        faces.shown_distortions(&store, progress.part(0.6, 1.0)).map(Some)
     };
     let mut current = first;
-    let Some(mut shown) = measure(&current) else { return current };
+    let Some(mut shown) = measure(&current, 0)? else { return Ok(current) };
     let mut best = (shown.iter().sum::<f64>(), current.clone());
-    for _ in 0..REFINEMENT_ROUNDS {
+    for round in 1..=REFINEMENT_ROUNDS {
         for (face, row) in distortion.iter_mut().enumerate() {
             let level = current[face].log2() as usize;
             let predicted = row.get(level).copied().unwrap_or(0.0);
@@ -394,14 +446,14 @@ fn refine_allocation(
             }
         }
         current = allocate_budget(mesh, distortion, budget, faces.max);
-        let Some(measured) = measure(&current) else { break };
+        let Some(measured) = measure(&current, round)? else { break };
         shown = measured;
         let total = shown.iter().sum::<f64>();
         if total < best.0 {
             best = (total, current.clone());
         }
     }
-    best.1
+    Ok(best.1)
 }
 
 /// Rate–distortion allocation (module docs): every face starts at `R = 1`; raises are taken
@@ -497,26 +549,37 @@ fn calibration_stores(
     budget: u64,
     max: Resolution,
     bake: BakeFit,
-) -> Vec<Option<ColorStore>> {
+    progress: Progress<'_>,
+) -> Result<Vec<Option<ColorStore>>, Cancelled> {
     let levels = max.log2() + 1;
     let topology = Topology::build(mesh.positions_world.len() as u32, &mesh.triangles).ok();
     let (Some(topology), BakeFit::LeastSquares) = (topology, bake) else {
-        return (0..levels).map(|_| None).collect();
+        return Ok((0..levels).map(|_| None).collect());
     };
     let limit = budget.saturating_mul(CALIBRATION_FACTOR).min(least_squares::MAX_SAMPLES);
-    (0..levels)
-        .map(|l| {
-            let r = Resolution::from_log2(l).ok()?;
-            if r.get() > least_squares::MAX_RESOLUTION || SampleCounts::uniform_on(&topology, r).samples > limit {
-                return None;
-            }
-            // Counted above, before the store is allocated.
-            let mut store = ColorStore::uniform(topology.clone(), r, [1.0; 4]);
-            bake_texture(&mut store, mesh, scene);
-            least_squares::refine(&mut store, mesh, scene)?;
-            Some(store)
+    let measured: Vec<Resolution> = (0..levels)
+        .filter_map(|l| Resolution::from_log2(l).ok())
+        .filter(|&r| {
+            r.get() <= least_squares::MAX_RESOLUTION && SampleCounts::uniform_on(&topology, r).samples <= limit
         })
-        .collect()
+        .collect();
+    // Each level's share of the progress: its samples' share of all the levels' samples.
+    let weight = |r: Resolution| SampleCounts::uniform_on(&topology, r).samples as f32;
+    let total: f32 = measured.iter().map(|&r| weight(r)).sum::<f32>().max(1.0);
+    let mut done = 0.0;
+    let mut stores: Vec<Option<ColorStore>> = (0..levels).map(|_| None).collect();
+    for r in measured {
+        let part = progress.part(done / total, (done + weight(r)) / total);
+        done += weight(r);
+        part.report(0.0, &format!("calibrating: baking at R = {r}"));
+        // Counted above, before the store is allocated.
+        let mut store = ColorStore::uniform(topology.clone(), r, [1.0; 4]);
+        bake_texture(&mut store, mesh, scene);
+        if least_squares::refine_with(&mut store, mesh, scene, part.part(0.1, 1.0))?.is_some() {
+            stores[r.log2() as usize] = Some(store);
+        }
+    }
+    Ok(stores)
 }
 
 /// A ratio ordered by `f64::total_cmp` (for the allocation's heap).
@@ -550,37 +613,64 @@ pub fn bake_and_verify(
     rule: ResolutionRule,
     fit: BakeFit,
 ) -> u32 {
-    let bake = |store: &mut ColorStore| {
+    let reporter = Reporter::silent();
+    bake_and_verify_with(store, mesh, scene, rule, fit, reporter.progress()).unwrap_or(0)
+}
+
+/// [`bake_and_verify`], reporting to `progress`; [`Cancelled`] (the store part-baked) as soon
+/// as it is cancelled. Each verification round takes half of what is left of `progress`.
+/// Long: the bake, then the verification loop.
+pub fn bake_and_verify_with(
+    store: &mut ColorStore,
+    mesh: &WeldedMesh,
+    scene: &Scene,
+    rule: ResolutionRule,
+    fit: BakeFit,
+    progress: Progress<'_>,
+) -> Result<u32, Cancelled> {
+    let bake = |store: &mut ColorStore, progress: Progress<'_>| -> Result<(), Cancelled> {
+        progress.report(0.0, "baking the texture");
         bake_texture(store, mesh, scene);
+        progress.check()?;
         if fit == BakeFit::LeastSquares {
-            least_squares::refine(store, mesh, scene);
+            least_squares::refine_with(store, mesh, scene, progress.part(0.1, 1.0))?;
         }
+        Ok(())
     };
-    bake(store);
     let ResolutionRule::ErrorBound { bound, max } = rule else {
-        return 0;
+        bake(store, progress)?;
+        return Ok(0);
     };
+    bake(store, progress.part(0.0, 0.5))?;
     let face_count = store.topology().face_count() as usize;
     let (materials, pyramids) = face_materials(mesh, scene, face_count);
     let shared = shared_uvs(mesh);
     if shared.len() != face_count {
-        return 0;
+        return Ok(0);
     }
-    let faces = Faces::new(mesh, &materials, &shared, &pyramids, max);
+    let faces = Faces::new(mesh, &materials, &shared, &pyramids, max, progress.part(0.5, 0.55))?;
     let mut rounds = 0;
+    // Round k verifies in [1 − 2^-k, 1 − 2^-(k+1)] of the whole (the bake had the first half).
+    let round_part = |k: i32| progress.part(1.0 - 0.5f32.powi(k), 1.0 - 0.5f32.powi(k + 1));
     loop {
         rounds += 1;
+        let part = round_part(rounds as i32);
         let shown: &ColorStore = store;
+        let counter = part.part(0.0, 0.2).counter("verifying the error bound", "faces", face_count);
         let over: Vec<u32> = (0..face_count)
             .into_par_iter()
             .filter(|&face| {
+                counter.add(1);
                 let r = shown.face_resolution(face as u32).unwrap_or(max);
-                r < max && faces.shown_error(shown, face).is_some_and(|error| error > bound.max(ROUNDING))
+                !counter.is_cancelled()
+                    && r < max
+                    && faces.shown_error(shown, face).is_some_and(|error| error > bound.max(ROUNDING))
             })
             .map(|face| face as u32)
             .collect();
+        progress.check()?;
         if over.is_empty() {
-            return rounds;
+            return Ok(rounds);
         }
         for face in over {
             let r = store.face_resolution(face).unwrap_or(max);
@@ -588,7 +678,7 @@ pub fn bake_and_verify(
             // The face exists and `raised` is a valid resolution, so this cannot fail.
             let _ = store.set_face_resolution(face, raised);
         }
-        bake(store);
+        bake(store, part.part(0.2, 1.0))?;
     }
 }
 
