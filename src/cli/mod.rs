@@ -11,6 +11,7 @@ mod pack;
 mod paint;
 mod render;
 mod soak;
+mod synth;
 
 use std::path::PathBuf;
 
@@ -53,6 +54,8 @@ enum Command {
     /// Uses the editor's camera, picking and brush code. OUT ending in .glb gets a
     /// tessellated vertex-colour glTF, any other name a packed file.
     Paint(paint::PaintArgs),
+    /// Write a production-like test asset (truck, materials, islands) as a .glb; prints JSON.
+    Synth(synth::SynthArgs),
     /// Test helper: writes a recovery file (and now and then a saved file) in a loop,
     /// printing each generation after its write returns, until killed.
     #[command(hide = true, name = "autosave-soak")]
@@ -72,6 +75,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => render::run(args),
         Command::Export(args) => export::run(args),
         Command::Paint(args) => paint::run(args),
+        Command::Synth(args) => synth::run(args),
         Command::AutosaveSoak(args) => soak::run(args),
     }
 }

@@ -20,6 +20,7 @@ mod extremes;
 mod formats;
 mod gpu_render;
 mod mct_file;
+mod production_assets;
 mod rule_flags;
 mod trade;
 mod validator;
