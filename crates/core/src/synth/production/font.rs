@@ -81,7 +81,7 @@ impl Text {
     pub fn covers(&self, x: f64, y: f64) -> bool {
         let fx = (x - self.origin[0]) / self.scale;
         let fy = (y - self.origin[1]) / self.scale;
-        if fx < 0.0 || fy < 0.0 || fy >= 7.0 {
+        if fx < 0.0 || !(0.0..7.0).contains(&fy) {
             return false;
         }
         let (cell, row) = ((fx / 6.0).floor(), fy.floor() as usize);

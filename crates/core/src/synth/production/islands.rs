@@ -45,14 +45,14 @@ fn axes(axis: usize) -> [usize; 2] {
 
 /// The lattice (and centroid splits) with exactly `triangles` triangles (module docs).
 fn lattice(triangles: u32) -> Result<([u32; 3], u32), SynthError> {
-    if triangles % 2 != 0 || triangles < 200 {
+    if !triangles.is_multiple_of(2) || triangles < 200 {
         return Err(SynthError::Options(format!("islands needs an even triangle count ≥ 200, got {triangles}")));
     }
     let n0 = (f64::from(triangles) / 12.0).sqrt();
     let (lo, hi) = (((n0 * 0.6) as u32).max(2), (n0 * 1.5) as u32 + 2);
     for splits in 0..64u32 {
         let rest = triangles - 2 * splits;
-        if rest % 4 != 0 {
+        if !rest.is_multiple_of(4) {
             continue;
         }
         let target = rest / 4;

@@ -4,7 +4,7 @@
 //! | # | material     | base colour texture                | factor            | vertex colours |
 //! |---|--------------|------------------------------------|-------------------|----------------|
 //! | 0 | wood         | 0: wood grain, 512²                | white             | no             |
-//! | 1 | dark wood    | 0 (shared with wood)               | (0.55, 0.42, 0.32)| no             |
+//! | 1 | dark wood    | 0 (shared with wood)               | (0.35, 0.25, 0.18)| no             |
 //! | 2 | marble       | 1: marble veins, 1024²             | white             | no             |
 //! | 3 | label        | 2: a printed label, 256 × 128      | white             | no             |
 //! | 4 | metal        | none                               | (0.75, 0.75, 0.78)| no             |
@@ -35,7 +35,7 @@ pub fn materials() -> Asset {
         |factor: [f32; 4], texture: Option<u32>| Material { base_color_factor: factor, base_color_texture: texture };
     let materials = vec![
         material([1.0; 4], Some(0)),
-        material(factor(0.55, 0.42, 0.32), Some(0)),
+        material(factor(0.35, 0.25, 0.18), Some(0)),
         material([1.0; 4], Some(1)),
         material([1.0; 4], Some(2)),
         material(factor(0.75, 0.75, 0.78), None),
