@@ -4,11 +4,13 @@
 
 mod args;
 mod bench;
+mod convert;
 mod export;
 mod info;
 mod optimize;
 mod pack;
 mod paint;
+mod progress_bar;
 mod render;
 mod soak;
 mod synth;
@@ -41,6 +43,9 @@ enum Command {
     },
     /// Pack a mesh's colours into linear buffers with MIP chains and write a packed file.
     Pack(pack::PackArgs),
+    /// Pack a library: files, directories and list files in, one packed file per asset out
+    /// (resumable, shardable with --shard I/N); one JSON line per asset on stdout.
+    Convert(convert::ConvertArgs),
     /// Lower each face's resolution while every shown colour stays within an error bound
     /// (0 = lossless) and write the result (.glb tessellated, any other name packed).
     Optimize(optimize::OptimizeArgs),
@@ -71,6 +76,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Info(args) => info::run(args),
         Command::Pack(args) => pack::run(args),
         Command::Bench { what } => bench::run(what),
+        Command::Convert(args) => convert::run(args),
         Command::Optimize(args) => optimize::run(args),
         Command::Render(args) => render::run(args),
         Command::Export(args) => export::run(args),

@@ -11,6 +11,7 @@ mod bench_cli;
 mod brush;
 mod budget;
 mod cli;
+mod convert;
 mod durability;
 mod examples;
 mod export_fit;
