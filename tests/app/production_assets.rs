@@ -1,8 +1,8 @@
 //! The production-like test assets (`meshpaint synth`, crates/core/src/synth/production):
-//! every class opens (`meshpaint info`), passes the Khronos glTF-Validator with no errors,
-//! has the counts its documentation gives (read back with the gltf crate, not with our
-//! importer), is closed and consistently wound where it should be, and the same options
-//! write the same bytes.
+//! every class opens (`meshpaint info`), passes the Khronos glTF-Validator with no errors
+//! or warnings, has the counts its documentation gives (read back with the gltf crate, not
+//! with our importer), is closed and consistently wound where it should be, and the same
+//! options write the same bytes.
 
 use std::path::Path;
 use std::process::Command;
@@ -38,6 +38,7 @@ fn synth(dir: &TempDir, class: &str, extra: &[&str]) -> (Value, Value, gltf::Glt
     assert!(bytes == std::fs::read(&second).unwrap(), "{class}: two runs wrote different bytes");
     let report = validate(&first);
     assert_eq!(report["numErrors"], 0, "{class}: validator errors: {report}");
+    assert_eq!(report["numWarnings"], 0, "{class}: validator warnings: {report}");
     let info: Value = serde_json::from_str(run(&["info", first.to_str().unwrap(), "--json"]).trim()).unwrap();
     let document = gltf::Gltf::from_slice(&bytes).unwrap();
     (summaries.remove(0), info, document)
