@@ -4,13 +4,16 @@
 
 mod args;
 mod bench;
+mod convert;
 mod export;
 mod info;
 mod optimize;
 mod pack;
 mod paint;
+mod progress_bar;
 mod render;
 mod soak;
+mod synth;
 
 use std::path::PathBuf;
 
@@ -40,6 +43,9 @@ enum Command {
     },
     /// Pack a mesh's colours into linear buffers with MIP chains and write a packed file.
     Pack(pack::PackArgs),
+    /// Pack a library: files, directories and list files in, one packed file per asset out
+    /// (resumable, shardable with --shard I/N); one JSON line per asset on stdout.
+    Convert(convert::ConvertArgs),
     /// Lower each face's resolution while every shown colour stays within an error bound
     /// (0 = lossless) and write the result (.glb tessellated, any other name packed).
     Optimize(optimize::OptimizeArgs),
@@ -53,6 +59,8 @@ enum Command {
     /// Uses the editor's camera, picking and brush code. OUT ending in .glb gets a
     /// tessellated vertex-colour glTF, any other name a packed file.
     Paint(paint::PaintArgs),
+    /// Write a production-like test asset (truck, materials, islands) as a .glb; prints JSON.
+    Synth(synth::SynthArgs),
     /// Test helper: writes a recovery file (and now and then a saved file) in a loop,
     /// printing each generation after its write returns, until killed.
     #[command(hide = true, name = "autosave-soak")]
@@ -68,10 +76,12 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Info(args) => info::run(args),
         Command::Pack(args) => pack::run(args),
         Command::Bench { what } => bench::run(what),
+        Command::Convert(args) => convert::run(args),
         Command::Optimize(args) => optimize::run(args),
         Command::Render(args) => render::run(args),
         Command::Export(args) => export::run(args),
         Command::Paint(args) => paint::run(args),
+        Command::Synth(args) => synth::run(args),
         Command::AutosaveSoak(args) => soak::run(args),
     }
 }

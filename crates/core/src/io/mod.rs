@@ -11,6 +11,7 @@ pub mod document;
 pub mod export_baked;
 pub mod export_fit;
 pub mod export_gltf;
+pub mod export_scene;
 pub mod export_textured;
 
 pub use document::{Document, SourceKind};

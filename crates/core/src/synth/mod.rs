@@ -1,7 +1,9 @@
 //! Synthetic inputs shared by the tests, the benchmarks and the fuzzer: deterministic
-//! random sources ([`rng`]) and small meshes built in code ([`shapes`]). One copy of each,
-//! so a seed draws the same inputs wherever it is used.
+//! random sources ([`rng`]), small meshes built in code ([`shapes`]) and production-like
+//! test assets written as glTF ([`production`]). One copy of each, so a seed draws the
+//! same inputs wherever it is used.
 
+pub mod production;
 pub mod rng;
 pub mod shapes;
 
