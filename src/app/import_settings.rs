@@ -55,7 +55,7 @@ impl ImportMode {
                  resolution follows the brush where you paint)"
             }
             ImportMode::Uniform => "The same R on every face",
-            ImportMode::MatchTexture => "One sample per texel along each face's longest UV edge, up to the largest R",
+            ImportMode::MatchTexture => "About one sample per texel each face covers, up to the largest R",
             ImportMode::ErrorBound => {
                 "The lowest R per face whose linear reconstruction stays within E of the texture \
                  (RMS of sRGB-encoded differences, 0..1), up to the largest R"
@@ -92,7 +92,8 @@ impl Default for ImportSettings {
             resolution: Resolution::from_log2(3).unwrap_or(Resolution::ONE),
             error_bound: 0.01,
             sample_budget: 100_000,
-            max_resolution: Resolution::from_log2(6).unwrap_or(Resolution::ONE),
+            // The layout's largest: faces are held by their texels and the rule, not a cap.
+            max_resolution: Resolution::MAX,
             up_axis: UpAxis::Y,
         }
     }

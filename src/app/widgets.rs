@@ -4,7 +4,7 @@
 use meshpaint_core::colors::layout::Resolution;
 
 /// The resolutions the combo box offers: `R` = 1 … 64.
-const LOG2_RANGE: std::ops::RangeInclusive<u32> = 0..=6;
+const LOG2_RANGE: std::ops::RangeInclusive<u32> = 0..=meshpaint_core::colors::layout::MAX_LOG2_RESOLUTION;
 
 /// A combo box of resolutions 1 … 64 after `label` (its accessible name), editing
 /// `resolution` in place.

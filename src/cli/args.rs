@@ -13,6 +13,7 @@ use meshpaint_core::io::document::{Document, SourceKind};
 use meshpaint_core::io::export_gltf::ExportSummary;
 use meshpaint_core::packing::file as packed_file;
 use meshpaint_core::packing::linear::PackedMesh;
+use meshpaint_core::progress::Reporter;
 
 /// The help of `-r/--resolution` (one text for both groups below).
 const RESOLUTION_HELP: &str = "Uniform face resolution R for glTF input (a power of two, 1..=4096)";
@@ -32,19 +33,21 @@ pub(super) struct ResolutionArg {
 #[derive(Debug, Clone, Copy, Default, clap::Args)]
 pub(super) struct AdaptiveArgs {
     /// Per-face R for textured glTF: the lowest R whose reconstruction stays within E of the
-    /// texture (RMS over the face, linear light, 0..1); replaces -r.
+    /// texture (RMS over the face of sRGB-encoded differences, 0..1); replaces -r.
     #[arg(long, conflicts_with_all = ["resolution", "texel_density"])]
     pub(super) error: Option<f32>,
-    /// Per-face R for textured glTF: one sample per texel along each face's longest UV edge;
-    /// replaces -r.
+    /// Per-face R for textured glTF: about one sample per texel each face covers (its UV
+    /// area), the total near the texels in use; replaces -r.
     #[arg(long, conflicts_with = "resolution")]
     pub(super) texel_density: bool,
     /// Per-face R for textured glTF within a budget of N level-0 samples: the resolutions
     /// with the least texture error (area-weighted) that fit; replaces -r.
     #[arg(long, value_name = "N", conflicts_with_all = ["resolution", "texel_density", "error"])]
     pub(super) samples: Option<u64>,
-    /// The largest R that --error, --texel-density and --samples give a face.
-    #[arg(long, default_value_t = 64)]
+    /// The largest R that --error, --texel-density and --samples give a face. By default
+    /// the layout's largest: a face is held by its texels (two samples a texel at most) and
+    /// by the rule, not by a fixed cap.
+    #[arg(long, default_value_t = u64::from(meshpaint_core::colors::layout::MAX_RESOLUTION))]
     pub(super) max_resolution: u64,
 }
 
@@ -218,8 +221,24 @@ pub(super) fn budget(format: Option<ColorFormat>) -> Budget {
 
 /// Opens a glTF or packed file at `resolution` within `budget`, logging the importer's
 /// warnings.
+/// A long conversion shows a progress bar on stderr when it is a terminal.
 pub(super) fn open(path: &Path, resolution: ResolutionArg, budget: &Budget) -> Result<Document> {
-    let document = Document::open_within(path, resolution.rule()?, budget)?;
+    let bar = super::progress_bar::ProgressBar::new();
+    let name = path.file_name().unwrap_or(path.as_os_str()).to_string_lossy();
+    let reporter = Reporter::new(|fraction, stage: &str| bar.set(fraction, &format!("{name}: {stage}")));
+    let document = open_with(path, resolution, budget, reporter.progress());
+    bar.finish();
+    document
+}
+
+/// [`open`], reporting the conversion to `progress` (no bar of its own).
+pub(super) fn open_with(
+    path: &Path,
+    resolution: ResolutionArg,
+    budget: &Budget,
+    progress: meshpaint_core::progress::Progress<'_>,
+) -> Result<Document> {
+    let document = Document::open_reporting(path, resolution.rule()?, budget, progress)?;
     for warning in &document.warnings {
         log::warn!(target: LOG_TARGET, "{}: {warning}", path.display());
     }

@@ -91,8 +91,8 @@ pub(super) enum BenchCommand {
     Adaptive {
         /// A textured .glb / .gltf file.
         file: PathBuf,
-        /// The largest R the adaptive rules give.
-        #[arg(long, default_value_t = 64)]
+        /// The largest R the adaptive rules give (default: the layout's largest, as `pack`).
+        #[arg(long, default_value_t = u64::from(meshpaint_core::colors::layout::MAX_RESOLUTION))]
         max_resolution: u64,
         /// Image size (each view is rendered at --supersample × and box-filtered).
         #[arg(long, default_value_t = 256)]

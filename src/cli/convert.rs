@@ -21,7 +21,9 @@ use anyhow::{Context, Result};
 use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::packing::file as packed_file;
 
-use super::args::{ResolutionArg, budget, open, packed_format, parse_format};
+use meshpaint_core::progress::Reporter;
+
+use super::args::{ResolutionArg, budget, open_with, packed_format, parse_format};
 use super::progress_bar::ProgressBar;
 
 /// Extensions a directory is searched for (lower case).
@@ -141,7 +143,12 @@ struct Report {
     bytes: u64,
 }
 
-fn convert_one(args: &ConvertArgs, asset: &Asset, output: &Path, progress: &dyn Fn(&str, f32)) -> Result<Outcome> {
+fn convert_one(
+    args: &ConvertArgs,
+    asset: &Asset,
+    output: &Path,
+    progress: &(dyn Fn(&str, f32) + Sync),
+) -> Result<Outcome> {
     if !args.force && up_to_date(&asset.input, output)? {
         return Ok(Outcome::UpToDate);
     }
@@ -150,12 +157,13 @@ fn convert_one(args: &ConvertArgs, asset: &Asset, output: &Path, progress: &dyn 
     let resolution = args.resolution;
     let format = args.format;
     // The importers contain the panics they know of; any other stays within this asset.
-    let opened = std::panic::catch_unwind(move || -> Result<_> {
-        let document = open(&input, resolution, &budget(format))?;
+    let opened = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || -> Result<_> {
+        let reporter = Reporter::new(|fraction, stage: &str| progress(stage, 0.05 + 0.85 * fraction));
+        let document = open_with(&input, resolution, &budget(format), reporter.progress())?;
         let format = packed_format(format, document.source);
         let packed = document.pack(format).with_context(|| format!("packing {}", input.display()))?;
         Ok((document.store.sample_count(), packed))
-    });
+    }));
     let (samples, packed) = match opened {
         Ok(result) => result?,
         Err(panic) => anyhow::bail!("the conversion panicked: {}", panic_text(&panic)),

@@ -169,7 +169,21 @@ fn gltf_info(path: &Path, resolution_arg: ResolutionArg, json: bool) -> Result<(
                 }
                 rule => {
                     let fit = meshpaint_core::convert::least_squares::BakeFit::default();
-                    meshpaint_core::convert::adaptive::face_resolutions(&mesh, &scene, face_count, rule, fit)
+                    let mut phases = meshpaint_core::convert::adaptive::RulePhases::default();
+                    let reporter = meshpaint_core::progress::Reporter::silent();
+                    let resolutions = meshpaint_core::convert::adaptive::face_resolutions_phased(
+                        &mesh,
+                        &scene,
+                        face_count,
+                        rule,
+                        fit,
+                        &mut phases,
+                        reporter.progress(),
+                    )?;
+                    if let ResolutionRule::Budget { .. } = rule {
+                        extra.insert("faces_held_by_budget".into(), phases.faces_held_by_budget.into());
+                    }
+                    resolutions
                 }
             };
             let counts = SampleCounts::of_resolutions(&topology, |f| resolutions[f as usize]);

@@ -98,8 +98,13 @@ fn error_bound_holds_on_every_face_below_the_cap_and_tighter_bounds_cost_more() 
         let document = convert(&scene, ResolutionRule::ErrorBound { bound, max: r(64) });
         let errors = face_errors(&scene, &document, 64);
         let resolutions = document.store.face_resolutions();
-        let below_cap: Vec<f32> =
-            errors.iter().zip(resolutions).filter(|(_, res)| res.get() < 64).map(|(e, _)| *e).collect();
+        // A face's cap: `max`, or two samples a texel along its longest UV edge (at least 8),
+        // past which no R removes more than rounding (crates/core/src/convert/adaptive).
+        let caps = content_caps(&scene, 64);
+        let below_cap: Vec<f32> = (errors.iter().zip(resolutions).zip(&caps))
+            .filter(|((_, res), cap)| res.get() < **cap)
+            .map(|((e, _), _)| *e)
+            .collect();
         let worst = below_cap.iter().copied().fold(0.0f32, f32::max);
         let over = below_cap.iter().filter(|&&e| e > bound * 1.5).count();
         eprintln!(
@@ -118,6 +123,35 @@ fn error_bound_holds_on_every_face_below_the_cap_and_tighter_bounds_cost_more() 
         assert!(document.store.sample_count() > previous_samples, "a tighter bound must not cost less");
         previous_samples = document.store.sample_count();
     }
+}
+
+/// Each face's longest UV edge in texels of its base-colour texture (0 without one).
+fn longest_uv_edges(scene: &Scene) -> Vec<f64> {
+    let welded = weld_scene(scene);
+    (0..welded.triangles.len())
+        .map(|face| {
+            let material = welded.triangle_materials[face].and_then(|m| scene.materials.get(m as usize));
+            let Some(texture) = material.and_then(|m| m.base_color_texture).map(|t| &scene.textures[t as usize]) else {
+                return 0.0;
+            };
+            let uvs = welded.corner_uvs[face];
+            (0..3)
+                .map(|k| {
+                    let (a, b) = (uvs[k], uvs[(k + 1) % 3]);
+                    let du = f64::from(b[0] - a[0]) * f64::from(texture.width);
+                    let dv = f64::from(b[1] - a[1]) * f64::from(texture.height);
+                    (du * du + dv * dv).sqrt()
+                })
+                .fold(0.0f64, f64::max)
+        })
+        .collect()
+}
+
+/// Each face's content cap (the module docs' closed form): `2 · T`, `T` the smallest power
+/// of two ≥ its longest UV edge in texels, at least 8, at most `max`.
+fn content_caps(scene: &Scene, max: u32) -> Vec<u32> {
+    let power = |x: f64| (x.ceil().max(1.0) as u32).next_power_of_two();
+    longest_uv_edges(scene).iter().map(|&longest| (2 * power(longest)).max(8).min(max)).collect()
 }
 
 #[test]
@@ -253,16 +287,19 @@ fn texel_density_follows_the_closed_form_and_untextured_faces_stay_at_one() {
         let material = welded.triangle_materials[face].and_then(|m| scene.materials.get(m as usize)).unwrap();
         let texture = &scene.textures[material.base_color_texture.unwrap() as usize];
         let uvs = welded.corner_uvs[face];
-        let longest = (0..3)
-            .map(|k| {
-                let (a, b) = (uvs[k], uvs[(k + 1) % 3]);
-                let du = f64::from(b[0] - a[0]) * f64::from(texture.width);
-                let dv = f64::from(b[1] - a[1]) * f64::from(texture.height);
-                (du * du + dv * dv).sqrt()
+        // One sample per texel covered: R²/2 samples on a face of A texels of UV area; of
+        // the powers of two around √(2A), the one whose R²/2 is nearer A.
+        let [w, h] = [f64::from(texture.width), f64::from(texture.height)];
+        let d = |k: usize| [f64::from(uvs[k][0] - uvs[0][0]) * w, f64::from(uvs[k][1] - uvs[0][1]) * h];
+        let area = 0.5 * (d(1)[0] * d(2)[1] - d(2)[0] * d(1)[1]).abs();
+        let want = [1u64, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096]
+            .into_iter()
+            .min_by(|&a, &b| {
+                let off = |r: u64| ((r * r) as f64 / 2.0 - area).abs();
+                off(a).total_cmp(&off(b)).then(a.cmp(&b))
             })
-            .fold(0.0f64, f64::max);
-        let want = (longest.ceil().max(1.0) as u64).next_power_of_two();
-        assert_eq!(u64::from(res.get()), want, "face {face}: longest UV edge {longest} texels");
+            .unwrap();
+        assert_eq!(u64::from(res.get()), want, "face {face}: {area} texels of UV area");
     }
     // A material without a texture holds one constant: R = 1 under every content rule.
     let mut flat = scene.clone();

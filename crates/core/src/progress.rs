@@ -178,7 +178,7 @@ mod tests {
         // A phase that starts again below what was shown does not move the fraction back.
         whole.part(0.0, 0.5).report(0.0, "c");
         second.part(0.5, 1.0).report(1.0, "d");
-        let seen = seen.into_inner().unwrap();
+        let seen = seen.lock().unwrap().clone();
         let fractions: Vec<f32> = seen.iter().map(|(f, _)| *f).collect();
         assert_eq!(fractions, vec![0.25, 0.75, 0.75, 1.0]);
         assert_eq!(seen[2].1, "c");
@@ -191,7 +191,7 @@ mod tests {
         let progress = reporter.progress();
         let counter = progress.counter("fitting", "faces", 10_000);
         (0..10_000).into_par_iter().for_each(|_| counter.add(1));
-        let seen = seen.into_inner().unwrap();
+        let seen = seen.lock().unwrap().clone();
         // One report a percent (two threads may both see the same percent crossed).
         assert!(seen.len() <= 1 + 2 * 101, "{} reports", seen.len());
         assert!(seen.contains(&(1.0, "fitting (10000 of 10000 faces)".to_owned())));

@@ -221,6 +221,8 @@ pub(crate) struct FaceMaterial {
     /// Second-longest UV edge of the face in texels of level 0 (0 without a texture): the
     /// lattice spacing at `R` is this over `R` (module docs, Filtering).
     pub(crate) spacing_uv_edge_texels: f32,
+    /// Area of the face's UV triangle in texels of level 0 (0 without a texture).
+    pub(crate) uv_area_texels: f32,
 }
 
 /// Each face's material (by face id, `face_count` of them) and the pyramids of the
@@ -242,6 +244,7 @@ pub(crate) fn face_materials(
                     texture: None,
                     longest_uv_edge_texels: 0.0,
                     spacing_uv_edge_texels: 0.0,
+                    uv_area_texels: 0.0,
                 };
             };
             let texture = material.base_color_texture.map(|t| t as usize).filter(|&t| {
@@ -250,18 +253,19 @@ pub(crate) fn face_materials(
                 };
                 slot.get_or_insert_with(|| scene.textures.get(t).and_then(TexturePyramid::new)).is_some()
             });
-            let [_, second, longest] = match (texture, mesh.corner_uvs.get(face)) {
+            let ([_, second, longest], area) = match (texture, mesh.corner_uvs.get(face)) {
                 (Some(t), Some(uvs)) => {
                     let (w, h) = scene.textures.get(t).map_or((0, 0), |tex| (tex.width, tex.height));
-                    uv_edges_texels(*uvs, w, h)
+                    (uv_edges_texels(*uvs, w, h), uv_area_texels(*uvs, w, h))
                 }
-                _ => [0.0; 3],
+                _ => ([0.0; 3], 0.0),
             };
             FaceMaterial {
                 factor: material.base_color_factor,
                 texture,
                 longest_uv_edge_texels: longest,
                 spacing_uv_edge_texels: second,
+                uv_area_texels: area,
             }
         })
         .collect();
@@ -352,6 +356,14 @@ fn uv_edges_texels(uvs: [[f32; 2]; 3], width: u32, height: u32) -> [f32; 3] {
     });
     edges.sort_by(f32::total_cmp);
     edges
+}
+
+/// The area of a UV triangle in texels of a `width × height` image (0 when not finite).
+fn uv_area_texels(uvs: [[f32; 2]; 3], width: u32, height: u32) -> f32 {
+    let (w, h) = (f64::from(width), f64::from(height));
+    let d = |k: usize, a: usize| f64::from(uvs[k][a]) - f64::from(uvs[0][a]);
+    let area = 0.5 * ((d(1, 0) * w) * (d(2, 1) * h) - (d(2, 0) * w) * (d(1, 1) * h)).abs();
+    if area.is_finite() { area as f32 } else { 0.0 }
 }
 
 /// World-space area of `face` of `mesh` (0 for a missing face).

@@ -18,9 +18,10 @@
 //!
 //! - **Quadrature.** On each face, the centroids of the `D²` sub-triangles of a lattice
 //!   `D`, each weighted `area_f / D²`: `D = max(2 · max(R_f, R_e of its edges),
-//!   min(2 · T, MAX_DENSE))` with `T` the face's longest UV edge in texels rounded up to a
-//!   power of two (so every texel holds several points, as the fit's test points in
-//!   [`crate::convert::adaptive`]). The texture at a quadrature point is read as the bake reads a
+//!   min(T, MAX_DENSE))` with `T` the face's longest UV edge in texels rounded up to a
+//!   power of two (so every texel the face covers holds at least two points, as the fit's
+//!   test points in [`crate::convert::adaptive`]; `2·T`, eight or more a texel, cost four
+//!   times the reads for a fit within 0.1 dB, docs/ADAPTIVE.md). The texture at a quadrature point is read as the bake reads a
 //!   sample of resolution `D`: level 0 bilinear once `D` resolves the texels, prefiltered to
 //!   the spacing where [`MAX_DENSE`] caps it, so the integral does not alias. (A quadrature
 //!   from the resolution alone read the texture prefiltered to a coarse face's spacing,
@@ -308,7 +309,7 @@ pub fn refine_with(
         let finest = edges.iter().map(|e| e.get()).max().unwrap_or(1).max(r.get());
         let texels = materials.get(face as usize).map_or(0.0, |m| m.longest_uv_edge_texels);
         let texels = if texels.is_finite() && texels > 1.0 { (texels.ceil() as u32).next_power_of_two() } else { 1 };
-        let dense = (2 * finest).max((2 * texels).min(MAX_DENSE));
+        let dense = (2 * finest).max(texels.min(MAX_DENSE));
         (finest <= MAX_RESOLUTION).then_some((r, edges, dense))
     };
     let mut templates: HashMap<(Resolution, [Resolution; 3], u32), usize> = HashMap::new();

@@ -386,7 +386,20 @@ impl Document {
     /// instancing), nodes and textures are checked while it is read, its samples before the
     /// store is allocated; a packed file's samples before it is unpacked.
     pub fn open_within(path: &Path, rule: impl Into<ResolutionRule>, budget: &Budget) -> Result<Self, DocumentError> {
+        let reporter = crate::progress::Reporter::silent();
+        Self::open_reporting(path, rule, budget, reporter.progress())
+    }
+
+    /// [`Document::open_within`], reporting the conversion's progress to `progress`
+    /// ([`DocumentError::Cancelled`] once it is cancelled).
+    pub fn open_reporting(
+        path: &Path,
+        rule: impl Into<ResolutionRule>,
+        budget: &Budget,
+        progress: crate::progress::Progress<'_>,
+    ) -> Result<Self, DocumentError> {
         let rule = rule.into();
+        progress.report(0.0, "reading and importing");
         let head = read_head(path)?;
         if packed_file::looks_like_packed(&head) {
             let packed = packed_file::read_file(path)?;
@@ -396,7 +409,15 @@ impl Document {
             });
         }
         let (scene, kind) = import_scene_after(path, &head, budget)?;
-        let mut document = Self::from_scene_within(scene, rule, path, budget)?;
+        let mut document = Self::from_scene_phased(
+            scene,
+            rule,
+            BakeFit::default(),
+            path,
+            budget,
+            &mut OpenPhases::default(),
+            progress.part(0.05, 1.0),
+        )?;
         document.source = kind;
         Ok(document)
     }

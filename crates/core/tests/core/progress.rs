@@ -39,7 +39,7 @@ fn a_conversion_reports_its_phases_in_order_and_ends_at_one() {
         let seen = Mutex::new(Vec::<(f32, String)>::new());
         let reporter = Reporter::new(|fraction, stage: &str| seen.lock().unwrap().push((fraction, stage.to_owned())));
         convert(rule, &reporter).unwrap();
-        let seen = seen.into_inner().unwrap();
+        let seen = seen.lock().unwrap().clone();
         assert!(seen.windows(2).all(|w| w[0].0 <= w[1].0), "{rule:?}: went back");
         assert_eq!(seen.first().map(|s| s.0), Some(0.0), "{rule:?}");
         assert_eq!(seen.last().map(|s| s.0), Some(1.0), "{rule:?}");

@@ -68,8 +68,7 @@ pub(super) struct FaceFit<'a> {
     material: &'a FaceMaterial,
     pyramids: &'a [Option<crate::convert::bake::TexturePyramid>],
     uvs: [[f32; 2]; 3],
-    /// The test lattice from the texture alone: twice the face's longest UV edge in
-    /// texels (a power of two), at least 8, at most `2·max`.
+    /// The test lattice from the texture alone ([`dense_lattice`]).
     dense: u32,
     /// Barycentrics of the test points of `dense` and the truth there, encoded as
     /// [`difference`] compares it ([`encoded`]).
@@ -77,10 +76,11 @@ pub(super) struct FaceFit<'a> {
 }
 
 /// The test lattice of a face of `material` from the texture alone: twice its longest UV
-/// edge in texels (a power of two), at least 8, at most `2·max`.
+/// edge in texels (a power of two: at least two points a texel the face covers), at least
+/// 8, at most `2·max`.
 pub(super) fn dense_lattice(material: &FaceMaterial, max: Resolution) -> u32 {
     let texels = power_of_two_at_least(material.longest_uv_edge_texels, Resolution::MAX).get();
-    (2 * texels).clamp(8, 2 * max.get())
+    texels.clamp(8, 2 * max.get())
 }
 
 impl<'a> FaceFit<'a> {
@@ -134,9 +134,8 @@ impl<'a> FaceFit<'a> {
         }
         let n = fine as f32;
         // Strip: the smallest lattice coordinate of the centroid below 2 (one spacing of `r`).
-        let strip: Vec<[f32; 3]> = layout::sub_triangle_centroids(fine)
-            .filter(|bary| bary.iter().fold(f32::MAX, |m, &b| m.min(b)) * n < 2.0)
-            .collect();
+        let strip: Vec<[f32; 3]> =
+            strip_centroids(fine).filter(|bary| bary.iter().fold(f32::MAX, |m, &b| m.min(b)) * n < 2.0).collect();
         let inside: Vec<TestPoint> = self
             .points
             .iter()
@@ -227,39 +226,84 @@ impl<'a> FaceFit<'a> {
 
     /// The error (module docs) of face `face` at each `R = 2^l` up to `max` that a budget
     /// allocation predicts: measured on the calibration store of that level where there is
-    /// one; above the finest calibrated level, the point bake's error scaled by the gain the
-    /// fit made there; the point bake's error where nothing is calibrated.
+    /// one; elsewhere the point bake's error scaled by the gain the fit made at the nearest
+    /// calibrated level (the finer one of two as near); the point bake's error where nothing
+    /// is calibrated.
     pub(super) fn predicted_errors(&self, face: u32, max: Resolution, calibration: &[Option<ColorStore>]) -> Vec<f32> {
-        let resolutions: Vec<Resolution> = (0..=max.log2()).map(|l| Resolution::from_log2(l).unwrap_or(max)).collect();
-        let measured = |l: usize| {
-            let store = calibration.get(l)?.as_ref()?;
-            Some(self.error_of(resolutions[l], |bary| sample(store, face, bary, Filter::Linear, 0).unwrap_or([0.0; 4])))
-        };
-        let mut gain = 1.0;
-        let mut errors = Vec::with_capacity(resolutions.len());
-        for (l, &r) in resolutions.iter().enumerate() {
-            match measured(l) {
-                Some(error) => {
-                    let point = self.error(r);
-                    gain = if point > ROUNDING { error / point } else { 1.0 };
-                    errors.push(error);
+        // Past the face's content cap, no level removes more error: each predicts its cap's.
+        let top = content_cap(self.material, max).log2() as usize;
+        let resolutions: Vec<Resolution> =
+            (0..=top).map(|l| Resolution::from_log2(l as u32).unwrap_or(Resolution::ONE)).collect();
+        let point: Vec<f32> = resolutions.iter().map(|&r| self.error(r)).collect();
+        // (level, measured error, gain) of every calibrated level.
+        let calibrated: Vec<(usize, f32, f32)> = (0..resolutions.len())
+            .filter_map(|l| {
+                let store = calibration.get(l)?.as_ref()?;
+                let error = self.error_in(store, face, resolutions[l]);
+                let gain = if point[l] > ROUNDING { error / point[l] } else { 1.0 };
+                Some((l, error, gain))
+            })
+            .collect();
+        let levels = max.log2() as usize + 1;
+        (0..levels)
+            .map(|l| l.min(top))
+            .map(|l| match calibrated.iter().find(|c| c.0 == l) {
+                Some(&(_, error, _)) => error,
+                None => {
+                    let nearest = calibrated.iter().min_by_key(|c| (c.0.abs_diff(l), std::cmp::Reverse(c.0)));
+                    nearest.map_or(1.0, |c| c.2) * point[l]
                 }
-                None => errors.push(gain * self.error(r)),
-            }
-        }
-        errors
+            })
+            .collect()
     }
 
     /// The error (module docs) of the face alone, baked and reconstructed at `r`.
     pub(super) fn error(&self, r: Resolution) -> f32 {
         let res = r.get();
-        let row = |j: u32| (j * (2 * res + 3 - j) / 2) as usize;
         let mut lattice = Vec::with_capacity(((res + 1) * (res + 2) / 2) as usize);
         for j in 0..=res {
             for i in 0..=res - j {
                 lattice.push(self.lattice_color(i, j, res));
             }
         }
+        self.error_of_lattice(r, &lattice)
+    }
+
+    /// The error (module docs) of face `face` as `store` shows it at its resolution `r`
+    /// there. When its three edges hold `r` too, no sub-triangle has a finer side, so the
+    /// reference sampler's linear filter is eq. 2.4 on the face's lattice (bit for bit,
+    /// [`crate::packing::sampler`]): the lattice is read from the store once and
+    /// interpolated here. Otherwise (fans towards finer edges) every point goes through the
+    /// sampler.
+    pub(super) fn error_in(&self, store: &ColorStore, face: u32, r: Resolution) -> f32 {
+        let through_sampler =
+            || self.error_of(r, |bary| sample(store, face, bary, Filter::Linear, 0).unwrap_or([0.0; 4]));
+        let topology = store.topology();
+        let plain = topology
+            .face_edges
+            .get(face as usize)
+            .is_some_and(|edges| edges.iter().all(|&e| store.edge_resolution(e) == Some(r)));
+        if !plain {
+            return through_sampler();
+        }
+        let res = r.get();
+        let mut lattice = Vec::with_capacity(((res + 1) * (res + 2) / 2) as usize);
+        for j in 0..=res {
+            for i in 0..=res - j {
+                match store.face_sample_ref(face, i, j).and_then(|s| store.get(s)) {
+                    Some(color) => lattice.push(color),
+                    None => return through_sampler(),
+                }
+            }
+        }
+        self.error_of_lattice(r, &lattice)
+    }
+
+    /// The error of the lattice of resolution `r` (`(i, j)` row by row, `j` outer),
+    /// reconstructed with eq. 2.4 at the test points of a face shown at `r`.
+    fn error_of_lattice(&self, r: Resolution, lattice: &[Rgba]) -> f32 {
+        let res = r.get();
+        let row = |j: u32| (j * (2 * res + 3 - j) / 2) as usize;
         self.points_for(r).rms(|bary, truth| {
             let mut shown = [0.0f32; 4];
             for s in layout::linear_samples(r, bary) {
@@ -271,6 +315,39 @@ impl<'a> FaceFit<'a> {
             difference(shown, truth)
         })
     }
+}
+
+/// The centroids of [`layout::sub_triangle_centroids`]`(n)` that can lie within two lattice
+/// spacings of an edge, in its order: the cells of the rows `j ≤ 1`, and of the others those
+/// with `i ≤ 1` or `i + j ≥ n − 3` (a centroid's coordinates are its cell's plus 1/3 or 2/3).
+/// `O(n)` of the `n²`, so a face's strips at a fine `R` cost no full lattice.
+fn strip_centroids(n: u32) -> impl Iterator<Item = [f32; 3]> {
+    let nf = n as f32;
+    (0..n).flat_map(move |j| {
+        let row = n - j;
+        let cells: Box<dyn Iterator<Item = u32>> = if j <= 1 || row <= 5 {
+            Box::new(0..row)
+        } else {
+            Box::new((0..2).chain(row.saturating_sub(3).max(2)..row))
+        };
+        cells.flat_map(move |i| {
+            let (u, v) = (i as f32, j as f32);
+            let upper = (i + j + 2 <= n).then_some((u + 2.0 / 3.0, v + 2.0 / 3.0));
+            std::iter::once((u + 1.0 / 3.0, v + 1.0 / 3.0))
+                .chain(upper)
+                .map(move |(cu, cv)| [(nf - cu - cv) / nf, cu / nf, cv / nf])
+        })
+    })
+}
+
+/// The finest `R` worth trying on a face of `material` (at most `max`): two samples a texel
+/// along its longest UV edge, at least 8. Finer, a sample spacing is under half a texel of
+/// a bilinear texture, and the error cannot fall by more than rounding; without this bound
+/// every face would be tried at every level up to `max` (up to [`Resolution::MAX`]), whose
+/// lattices grow as `R²`.
+pub(super) fn content_cap(material: &FaceMaterial, max: Resolution) -> Resolution {
+    let texels = power_of_two_at_least(material.longest_uv_edge_texels, Resolution::MAX).get();
+    Resolution::new(u64::from((2 * texels).max(8))).unwrap_or(Resolution::MAX).min(max)
 }
 
 /// Test points in parts, each with the weight of one of its points (the weights sum to 1

@@ -74,7 +74,6 @@ use crate::convert::least_squares::{self, BakeFit};
 use crate::mesh::scene::Scene;
 use crate::mesh::topology::Topology;
 use crate::mesh::weld::WeldedMesh;
-use crate::packing::sampler::{Filter, sample};
 use crate::progress::{Cancelled, Progress, Reporter};
 
 /// Errors (RMS, sRGB-encoded colour units) at or below this are float rounding and count as
@@ -143,6 +142,10 @@ pub struct RulePhases {
     pub predict: Duration,
     /// A budget's allocations, and its refinement rounds (bake, fit and measure each).
     pub allocate: Duration,
+    /// Faces a budget held below what their texels could use: a finer `R` (up to the
+    /// face's content cap, two samples a texel) was predicted to show less error, but the
+    /// samples went where they removed more. Zero for the other rules.
+    pub faces_held_by_budget: u64,
 }
 
 /// Each face's resolution under `rule` (`face_count` faces of `mesh`).
@@ -209,7 +212,16 @@ fn choose_resolutions(
         let resolutions =
             refine_allocation(&faces, scene, &mut distortion, first, samples, fit, progress.part(0.6, 1.0))?;
         phases.allocate = started.elapsed();
+        phases.faces_held_by_budget = (distortion.iter().zip(&resolutions))
+            .filter(|(row, r)| {
+                let at = row.get(r.log2() as usize).copied().unwrap_or(0.0);
+                row.last().is_some_and(|&finest| finest < at * (1.0 - 1e-6))
+            })
+            .count() as u64;
         return Ok(resolutions);
+    }
+    if let ResolutionRule::TexelDensity { max } = rule {
+        return Ok(texel_density(&materials, max));
     }
     let material_boundary = if matches!(rule, ResolutionRule::WhereTextured(_)) {
         faces_on_material_boundaries(mesh, face_count)
@@ -238,19 +250,44 @@ fn choose_resolutions(
                 ResolutionRule::Uniform(r)
                 | ResolutionRule::WhereTextured(r)
                 | ResolutionRule::Budget { max: r, .. } => r,
-                ResolutionRule::TexelDensity { max } => power_of_two_at_least(material.longest_uv_edge_texels, max),
+                ResolutionRule::TexelDensity { max } => max,
                 ResolutionRule::ErrorBound { bound, max } => {
                     let fit = FaceFit::new(&materials, face, shared[face], &pyramids, uvs, max, None);
-                    (0..=max.log2())
+                    let cap = face_fit::content_cap(material, max);
+                    (0..=cap.log2())
                         .filter_map(|log2| Resolution::from_log2(log2).ok())
                         .find(|&r| fit.error(r) <= bound.max(ROUNDING))
-                        .unwrap_or(max)
+                        .unwrap_or(cap)
                 }
             }
         })
         .collect();
     progress.check()?;
     Ok(resolutions)
+}
+
+/// The texel-density rule: about one sample per texel a face covers. A face at `R` holds
+/// about `R²/2` samples (its interior, half of each edge's, a share of its vertices), so
+/// `√(2·A)` for `A` texels of UV area; of the two powers of two around it, each face takes
+/// the one whose `R²/2` is nearer `A` (each face on its own: a whole-period shift of its
+/// UVs, which moves `A` by float rounding only, changes nothing). Faces without a texture
+/// get `R = 1`; at most `max`.
+fn texel_density(materials: &[FaceMaterial], max: Resolution) -> Vec<Resolution> {
+    materials
+        .iter()
+        .map(|material| {
+            if material.texture.is_none() {
+                return Resolution::ONE;
+            }
+            let texels = f64::from(material.uv_area_texels);
+            let ideal = (2.0 * texels).sqrt().max(1.0);
+            let log2 = (ideal.log2().floor() as u32).min(max.log2());
+            let low = Resolution::from_log2(log2).unwrap_or(max);
+            let high = Resolution::from_log2(log2 + 1).unwrap_or(max).min(max);
+            let off = |r: Resolution| (f64::from(r.get()).powi(2) / 2.0 - texels).abs();
+            if off(low) <= off(high) { low } else { high }
+        })
+        .collect()
 }
 
 /// For each face, whether one of its vertices is shared with a face of another material.
@@ -368,7 +405,7 @@ impl<'a> Faces<'a> {
     /// there; `None` for a face without a texture.
     fn shown_error(&self, store: &ColorStore, face: usize) -> Option<f32> {
         let (fit, r) = (self.fit(face)?, store.face_resolution(face as u32)?);
-        Some(fit.error_of(r, |bary| sample(store, face as u32, bary, Filter::Linear, 0).unwrap_or([0.0; 4])))
+        Some(fit.error_in(store, face as u32, r))
     }
 
     /// Each face's distortion as `store` shows it ([`Faces::shown_error`]).
@@ -557,12 +594,18 @@ fn calibration_stores(
         return Ok((0..levels).map(|_| None).collect());
     };
     let limit = budget.saturating_mul(CALIBRATION_FACTOR).min(least_squares::MAX_SAMPLES);
-    let measured: Vec<Resolution> = (0..levels)
+    // The three finest levels within the limit only (about the budget's own `R`, the next
+    // coarser and the next finer): a fit of the whole mesh each, their gains carried to the
+    // other levels (module docs). Every level took one before, most of a budget's time on
+    // large meshes; the finest alone or two missed the gains of the coarse levels where
+    // small budgets put faces (Fox at a third of R = 4's samples fell below uniform R = 4).
+    let within: Vec<Resolution> = (0..levels)
         .filter_map(|l| Resolution::from_log2(l).ok())
         .filter(|&r| {
             r.get() <= least_squares::MAX_RESOLUTION && SampleCounts::uniform_on(&topology, r).samples <= limit
         })
         .collect();
+    let measured = within[within.len().saturating_sub(3)..].to_vec();
     // Each level's share of the progress: its samples' share of all the levels' samples.
     let weight = |r: Resolution| SampleCounts::uniform_on(&topology, r).samples as f32;
     let total: f32 = measured.iter().map(|&r| weight(r)).sum::<f32>().max(1.0);
@@ -657,13 +700,14 @@ pub fn bake_and_verify_with(
         let part = round_part(rounds as i32);
         let shown: &ColorStore = store;
         let counter = part.part(0.0, 0.2).counter("verifying the error bound", "faces", face_count);
+        let cap = |face: usize| materials.get(face).map_or(max, |m| face_fit::content_cap(m, max));
         let over: Vec<u32> = (0..face_count)
             .into_par_iter()
             .filter(|&face| {
                 counter.add(1);
                 let r = shown.face_resolution(face as u32).unwrap_or(max);
                 !counter.is_cancelled()
-                    && r < max
+                    && r < cap(face)
                     && faces.shown_error(shown, face).is_some_and(|error| error > bound.max(ROUNDING))
             })
             .map(|face| face as u32)
