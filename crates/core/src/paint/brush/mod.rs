@@ -25,7 +25,7 @@
 //! | file | what |
 //! |---|---|
 //! | `error.rs` | [`BrushError`] |
-//! | `settings.rs` | [`BrushSettings`], [`Tool`], [`Falloff`], [`BlendMode`], [`BrushRadius`], [`ResolutionOp`], [`PressureResponse`], [`StrokePoint`], validation |
+//! | `settings.rs` | [`BrushSettings`], [`Tool`], [`Falloff`], [`BlendMode`], [`BrushRadius`], [`ResolutionOp`], [`PressureResponse`], [`StrokePoint`], [`HardEdges`], validation |
 //! | `footprint.rs` | where a dab reaches: the `Coverage` trait, the dab's spheres, fill's "everywhere", [`visible`] |
 //! | `stencil.rs` | the blur's lattice stencils, one per face resolution (neighbours and holders of every lattice point) |
 //! | `scratch.rs` | per-mesh scratch reused across dabs, mask accumulation (pass 1 of a dab) |
@@ -127,7 +127,7 @@ pub use kernels::DabStats;
 pub use painter::{Dab, MAX_DABS_PER_SEGMENT, MIN_SPACING_PX, PaintView, Painter, StrokeUpdate};
 pub use replay::{parse_hex_color, parse_stroke, replay_stroke, samples_within};
 pub use settings::{
-    BlendMode, BrushRadius, BrushSettings, FOLLOW_BRUSH_MAX_RESOLUTION, Falloff, PressureResponse, ResolutionOp,
-    StrokePoint, Tool, resolution_for_brush,
+    BlendMode, BrushRadius, BrushSettings, FOLLOW_BRUSH_MAX_RESOLUTION, Falloff, HARD_EDGE_SPACINGS_PER_RADIUS,
+    HardEdges, PressureResponse, ResolutionOp, StrokePoint, Tool, resolution_for_brush, resolution_for_spacing,
 };
 pub use tools::{FillScope, connected_faces, eyedropper, fill, set_resolution};
