@@ -79,6 +79,12 @@
 //!    colour (Mix), `old + colour` (Add, RGB), `old × colour` (Multiply, RGB) or the base
 //!    snapshot's colour at the sample (Erase to base).
 //!
+//! Before painting, resolution follows the brush (when on) raises the dab's faces that cannot
+//! resolve a quarter of the radius, and a hard brush (constant falloff) raises those coarser
+//! than a sixteenth of it, up to `R = 64` within the budget, textured documents too
+//! ([`HardEdges`]; without it a hard rim is a staircase of samples, docs/PAINT_MODE.md "Hard
+//! edges" has the measurement that chose it over anti-aliasing the rim, which stays an option).
+//!
 //! The blur brush moves each sample towards the mean of its lattice neighbours (the six
 //! neighbours in every face whose lattice contains it, at that face's resolution) by `w`,
 //! computed from the colours before the dab (each face's lattice gathered once, shared
