@@ -338,7 +338,7 @@ impl Scene<'_> {
         };
         let mut painter = Painter::new(&self.document.positions);
         painter.set_settings(hard_brush(self.options.radius_px));
-        painter.set_budget(Some((self.budget.clone(), ColorFormat::Rgba8Srgb)));
+        painter.set_budget(Some((self.budget, ColorFormat::Rgba8Srgb)));
         painter.set_hard_edges(variant.hard_edges);
         let mut history = UndoHistory::default();
         let points = stroke_points(self.options.size);
