@@ -2,6 +2,7 @@
 //! each measures what the editor really does.
 
 pub mod adaptive;
+pub mod brush_edge;
 pub mod extremes;
 pub mod load;
 pub mod pack;

@@ -147,6 +147,32 @@ pub(super) enum BenchCommand {
         #[arg(long, value_delimiter = ',')]
         rows: Vec<String>,
     },
+    /// A hard stroke's edge on a close-up against the ideal stroke (the dabs' spheres on the
+    /// surface, supersampled): edge-band PSNR and mean error, samples and stroke time, as
+    /// painted today, anti-aliased, with resolution following the brush, and both; one JSON
+    /// object per variant.
+    BrushEdge {
+        /// A .glb / .gltf / OBJ / PLY / STL file.
+        file: PathBuf,
+        /// The document's uniform R.
+        #[arg(short, long, default_value_t = 8)]
+        resolution: u64,
+        /// Image side, pixels.
+        #[arg(long, default_value_t = 320)]
+        size: u32,
+        /// Subsamples per pixel per axis (renders and truth).
+        #[arg(long, default_value_t = 8)]
+        supersample: u32,
+        /// The close-up: the framing distance divided by this.
+        #[arg(long, default_value_t = 4.0)]
+        zoom: f64,
+        /// Brush radius, pixels.
+        #[arg(long, default_value_t = 20.0)]
+        radius_px: f64,
+        /// Write the images (truth and each variant) into DIR.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
     /// A generated UV atlas (`export --texture SIZE --uvs new`): seconds, charts, share of the
     /// texture used, texels inside two faces' UVs, texel density over the surface; one JSON
     /// object.
@@ -235,6 +261,21 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
     match what {
         BenchCommand::Extremes { json } => extremes(json),
         BenchCommand::Unwrap { file, size, subdivide } => unwrap(&file, size, subdivide),
+        BenchCommand::BrushEdge { file, resolution, size, supersample, zoom, radius_px, out } => {
+            let resolution = meshpaint_core::colors::layout::Resolution::new(resolution).context("--resolution")?;
+            anyhow::ensure!(size >= 16 && zoom.is_finite() && zoom > 0.0, "--size ≥ 16 and --zoom > 0");
+            let options = meshpaint::bench::brush_edge::BrushEdgeOptions {
+                resolution,
+                size,
+                supersample,
+                zoom,
+                radius_px,
+                out,
+                ..Default::default()
+            };
+            meshpaint::bench::brush_edge::bench_brush_edge(&file, &options, &mut |row| println!("{row}"))?;
+            Ok(())
+        }
         BenchCommand::Trade(args) => trade(&args),
         BenchCommand::Adaptive { file, max_resolution, size, views, supersample, bake, rules } => {
             adaptive(file, max_resolution, size, views, supersample, bake, rules)

@@ -2,7 +2,9 @@
 //! sample (world positions from `for_each_site`), closed-form falloff and blend values,
 //! analytic visibility (occlusion, backface culling), mirror symmetry on an x-symmetric mesh,
 //! gap-free fast strokes, blur against its neighbour mean, the resolution brush against a
-//! brute-force sphere/triangle test, fill, eyedropper, and repacking after painting.
+//! brute-force sphere/triangle test, fill, eyedropper, and repacking after painting. The
+//! hard (constant-falloff) brushes here paint at the store's own `R` (`HardEdges::SAMPLED`):
+//! their default raise is tested in crates/core/tests/core/hard_edge.rs.
 
 // Colour channels are indexed 0..4 in parallel arrays; an index reads clearest.
 #![allow(clippy::needless_range_loop)]
@@ -17,7 +19,7 @@ use meshpaint_core::colors::store::{ColorStore, SampleRef};
 use meshpaint_core::mesh::topology::Topology;
 use meshpaint_core::packing::packer;
 use meshpaint_core::paint::brush::{
-    self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, PaintView, Painter, PressureResponse,
+    self, BlendMode, BrushRadius, BrushSettings, Falloff, FillScope, HardEdges, PaintView, Painter, PressureResponse,
     ResolutionOp, StrokePoint, Tool,
 };
 use meshpaint_core::paint::picking::{BvhPreset, MeshBvh};
@@ -108,6 +110,7 @@ impl Scene {
     fn stroke<P: Copy + Into<StrokePoint>>(&mut self, settings: BrushSettings, points: &[P]) -> Vec<brush::Dab> {
         let mut painter = Painter::new(&self.positions);
         painter.set_settings(settings);
+        painter.set_hard_edges(HardEdges::SAMPLED);
         let mut history = UndoHistory::default();
         let mut store = self.store.clone();
         let view = self.view(None);
@@ -253,6 +256,7 @@ fn each_shared_sample_is_updated_once(resolution: u64, radius: f64, min_covered:
     let mut painter = Painter::new(&scene.positions);
     let add = [0.25, 0.125, 0.0625, 0.0];
     painter.set_settings(BrushSettings { blend: BlendMode::Add, ..plain(Tool::Paint, add, BrushRadius::default()) });
+    painter.set_hard_edges(HardEdges::SAMPLED);
     let mut history = UndoHistory::default();
     let center = DVec3::from_array(scene.positions[0].map(f64::from));
     let stats = painter.dab_at(&scene.view(None), &mut store, &mut history, center, radius).unwrap();
@@ -348,6 +352,7 @@ fn erase_to_base_restores_the_snapshot_even_after_a_resolution_change() {
     let mut store = scene.store.clone();
     let mut history = UndoHistory::default();
     let mut painter = Painter::new(&scene.positions);
+    painter.set_hard_edges(HardEdges::SAMPLED);
     let view = scene.view(Some(&base));
     let center = DVec3::from_array(scene.positions[5].map(f64::from));
     painter.set_settings(plain(Tool::Paint, GREEN, BrushRadius::default()));

@@ -9,6 +9,7 @@ mod autosave;
 mod bake_uv;
 mod bench_cli;
 mod brush;
+mod brush_edge;
 mod budget;
 mod cli;
 mod convert;

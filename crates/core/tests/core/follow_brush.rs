@@ -45,6 +45,8 @@ fn stroke(start: u32, follow: Option<Resolution>, radius: f64) -> Stroke {
         follow_resolution: follow,
         pressure: meshpaint_core::paint::brush::PressureResponse::default(),
     });
+    // This is resolution-follows-the-brush's rule alone, not a hard brush's own raise.
+    painter.set_hard_edges(meshpaint_core::paint::brush::HardEdges::SAMPLED);
     let mut history = UndoHistory::default();
     let centers: Vec<DVec3> = (0..8)
         .map(|k| {

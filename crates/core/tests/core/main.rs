@@ -8,6 +8,7 @@ mod bake;
 mod examples;
 mod follow_brush;
 mod fuzz;
+mod hard_edge;
 mod import;
 mod layout;
 mod least_squares;

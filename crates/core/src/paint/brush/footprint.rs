@@ -81,11 +81,57 @@ pub(super) struct Footprint<'a> {
     pub(super) centers: [DVec3; 2],
     pub(super) eyes: [DVec3; 2],
     count: usize,
+    /// The squared radius within which a point can weigh anything (the outer rim with
+    /// [`Footprint::with_edge`]).
     radius_sq: f64,
     inv_radius: f64,
     strength: f32,
     falloff: Falloff,
     occlusion: Option<Occlusion<'a>>,
+    /// The anti-aliased rim of a constant falloff ([`Footprint::with_edge`]).
+    edge: Option<Edge>,
+    /// The anti-aliased rims the stroke's earlier dabs painted near this one
+    /// ([`Footprint::with_earlier`]).
+    earlier: &'a [Rim],
+}
+
+/// The anti-aliased rim of one sphere of an earlier dab of the stroke: what it covered.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Rim {
+    center: DVec3,
+    edge: Edge,
+}
+
+impl Rim {
+    /// Whether this rim's sphere can reach within `reach` of `center`.
+    pub(super) fn near(&self, center: DVec3, reach: f64) -> bool {
+        (self.center - center).length() <= self.edge.outer + reach
+    }
+}
+
+/// The anti-aliased rim of a constant falloff: the weight ramps from the strength to 0 over
+/// `width` centred on the radius, the coverage of a sample's cell of that width by the disc.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Edge {
+    /// `radius + width / 2`: where the ramp reaches 0.
+    outer: f64,
+    /// `1 / width`.
+    inv_width: f64,
+}
+
+impl Edge {
+    /// The ramp's coverage at distance `d` (NaN and points past `outer` weigh 0).
+    #[inline(always)]
+    fn coverage(self, d: f64) -> f32 {
+        let c = (self.outer - d) * self.inv_width;
+        if c >= 1.0 {
+            1.0
+        } else if c > 0.0 {
+            c as f32
+        } else {
+            0.0
+        }
+    }
 }
 
 impl<'a> Footprint<'a> {
@@ -109,13 +155,77 @@ impl<'a> Footprint<'a> {
             strength,
             falloff,
             occlusion,
+            edge: None,
+            earlier: &[],
         }
+    }
+
+    /// The rims the stroke's earlier dabs painted (from their [`Footprint::rims`]): with an
+    /// anti-aliased rim, a point they covered by `a` and this dab covers by `c > a` weighs
+    /// `strength · (c − a) / (1 − a)`, and nothing when `c ≤ a`. A stroke's rim then ends at
+    /// the largest coverage of its dabs, as one dab shaped like their union would paint it,
+    /// instead of building up where dabs overlap (with strength 1 and Mix, exactly).
+    pub(super) fn with_earlier<'b>(self, rims: &'b [Rim]) -> Footprint<'b>
+    where
+        'a: 'b,
+    {
+        Footprint { earlier: rims, ..self }
+    }
+
+    /// This dab's anti-aliased rims (one per sphere), for the stroke's later dabs.
+    pub(super) fn rims(&self) -> impl Iterator<Item = Rim> + '_ {
+        let edge = self.edge;
+        self.centers.iter().take(self.count).filter_map(move |&center| Some(Rim { center, edge: edge? }))
+    }
+
+    /// Anti-aliases the rim of a [`Falloff::Constant`] footprint over `width` (one sample
+    /// spacing): a point at distance `d` weighs `strength · clamp((radius + width/2 − d) /
+    /// width, 0, 1)`, so the weight is ½ on the sphere and the weights integrate to the
+    /// disc's area. Other falloffs (already 0 at the rim) and widths that are not positive
+    /// and finite are left as they are.
+    pub(super) fn with_edge(mut self, width: f64) -> Self {
+        if self.falloff != Falloff::Constant || !(width.is_finite() && width > 0.0) {
+            return self;
+        }
+        let radius = 1.0 / self.inv_radius;
+        let outer = radius + 0.5 * width;
+        self.radius_sq = outer * outer;
+        self.edge = Some(Edge { outer, inv_width: 1.0 / width });
+        self
+    }
+
+    /// The radius within which a point can weigh anything (the outer rim of an anti-aliased
+    /// edge): what the dab's face query must reach.
+    pub(super) fn reach(&self) -> f64 {
+        self.radius_sq.sqrt()
     }
 
     /// The weight for one sphere and no occlusion: the common case, kept small to inline.
     #[inline(always)]
     fn weight_single(&self, p: DVec3) -> f32 {
-        self.weight_single_sq((p - self.centers[0]).length_squared())
+        let w = self.weight_single_sq((p - self.centers[0]).length_squared());
+        if self.earlier.is_empty() { w } else { self.beyond_earlier(p, w) }
+    }
+
+    /// The weight `w = strength · c` of `p` on the anti-aliased rim (`0 < c < 1`) less what
+    /// the stroke's earlier dabs covered ([`Footprint::with_earlier`]).
+    #[inline(never)]
+    fn beyond_earlier(&self, p: DVec3, w: f32) -> f32 {
+        if self.strength <= 0.0 {
+            return w;
+        }
+        let c = w / self.strength;
+        if !(c > 0.0 && c < 1.0) {
+            return w;
+        }
+        let mut covered = 0.0f32;
+        for rim in self.earlier {
+            covered = covered.max(rim.edge.coverage((p - rim.center).length()));
+            if covered >= c {
+                return 0.0;
+            }
+        }
+        self.strength * (c - covered) / (1.0 - covered)
     }
 
     /// [`Footprint::weight_single`] at squared distance `d2` from the centre.
@@ -123,6 +233,9 @@ impl<'a> Footprint<'a> {
     fn weight_single_sq(&self, d2: f64) -> f32 {
         if d2.is_nan() || d2 > self.radius_sq {
             return 0.0;
+        }
+        if let Some(edge) = self.edge {
+            return self.strength * edge.coverage(d2.max(0.0).sqrt());
         }
         self.strength * self.falloff.weight_of_squared((d2 * self.inv_radius * self.inv_radius) as f32)
     }
@@ -148,10 +261,10 @@ impl<'a> Footprint<'a> {
                 continue;
             }
             let d2 = (p - self.centers[k]).length_squared();
-            if d2.is_nan() || d2 > self.radius_sq {
-                continue;
+            let mut w = self.weight_single_sq(d2);
+            if !self.earlier.is_empty() && w > best {
+                w = self.beyond_earlier(p, w);
             }
-            let w = self.strength * self.falloff.weight_of_squared((d2 * self.inv_radius * self.inv_radius) as f32);
             if w <= best {
                 continue;
             }
@@ -239,7 +352,8 @@ impl Coverage for Footprint<'_> {
 
     #[inline(always)]
     fn row_distance(&self, a: DVec3, b: DVec3) -> Option<[f64; 3]> {
-        (self.count == 1).then(|| {
+        // Earlier rims make the weight depend on the point, not only on its distance.
+        (self.count == 1 && self.earlier.is_empty()).then(|| {
             let d = a - self.centers[0];
             [d.length_squared(), 2.0 * d.dot(b), b.length_squared()]
         })
@@ -252,6 +366,14 @@ impl Coverage for Footprint<'_> {
 
     #[inline]
     fn weights_of_distance_sq(&self, d2: &[f64], out: &mut [f32]) {
+        if let Some(edge) = self.edge {
+            for (w, &d2) in out.iter_mut().zip(d2) {
+                let inside = d2 <= self.radius_sq;
+                let weight = self.strength * edge.coverage(d2.max(0.0).sqrt());
+                *w = if inside { weight } else { 0.0 };
+            }
+            return;
+        }
         // One loop per falloff, with no branch inside (the compiler vectorises it).
         match self.falloff {
             Falloff::Smooth => self.weights_with(d2, out, |s| Falloff::Smooth.shape(s)),

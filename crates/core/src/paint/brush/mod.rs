@@ -25,7 +25,7 @@
 //! | file | what |
 //! |---|---|
 //! | `error.rs` | [`BrushError`] |
-//! | `settings.rs` | [`BrushSettings`], [`Tool`], [`Falloff`], [`BlendMode`], [`BrushRadius`], [`ResolutionOp`], [`PressureResponse`], [`StrokePoint`], validation |
+//! | `settings.rs` | [`BrushSettings`], [`Tool`], [`Falloff`], [`BlendMode`], [`BrushRadius`], [`ResolutionOp`], [`PressureResponse`], [`StrokePoint`], [`HardEdges`], validation |
 //! | `footprint.rs` | where a dab reaches: the `Coverage` trait, the dab's spheres, fill's "everywhere", [`visible`] |
 //! | `stencil.rs` | the blur's lattice stencils, one per face resolution (neighbours and holders of every lattice point) |
 //! | `scratch.rs` | per-mesh scratch reused across dabs, mask accumulation (pass 1 of a dab) |
@@ -79,6 +79,12 @@
 //!    colour (Mix), `old + colour` (Add, RGB), `old × colour` (Multiply, RGB) or the base
 //!    snapshot's colour at the sample (Erase to base).
 //!
+//! Before painting, resolution follows the brush (when on) raises the dab's faces that cannot
+//! resolve a quarter of the radius, and a hard brush (constant falloff) raises those coarser
+//! than a sixteenth of it, up to `R = 64` within the budget, textured documents too
+//! ([`HardEdges`]; without it a hard rim is a staircase of samples, docs/PAINT_MODE.md "Hard
+//! edges" has the measurement that chose it over anti-aliasing the rim, which stays an option).
+//!
 //! The blur brush moves each sample towards the mean of its lattice neighbours (the six
 //! neighbours in every face whose lattice contains it, at that face's resolution) by `w`,
 //! computed from the colours before the dab (each face's lattice gathered once, shared
@@ -127,7 +133,7 @@ pub use kernels::DabStats;
 pub use painter::{Dab, MAX_DABS_PER_SEGMENT, MIN_SPACING_PX, PaintView, Painter, StrokeUpdate};
 pub use replay::{parse_hex_color, parse_stroke, replay_stroke, samples_within};
 pub use settings::{
-    BlendMode, BrushRadius, BrushSettings, FOLLOW_BRUSH_MAX_RESOLUTION, Falloff, PressureResponse, ResolutionOp,
-    StrokePoint, Tool, resolution_for_brush,
+    BlendMode, BrushRadius, BrushSettings, FOLLOW_BRUSH_MAX_RESOLUTION, Falloff, HARD_EDGE_SPACINGS_PER_RADIUS,
+    HardEdges, PressureResponse, ResolutionOp, StrokePoint, Tool, resolution_for_brush, resolution_for_spacing,
 };
 pub use tools::{FillScope, connected_faces, eyedropper, fill, set_resolution};

@@ -13,10 +13,12 @@ use crate::paint::undo::{StepSummary, StoreWriter, UndoHistory};
 
 use super::blur::blur_faces;
 use super::error::BrushError;
-use super::footprint::{Footprint, Occlusion};
+use super::footprint::{Footprint, Occlusion, Rim};
 use super::kernels::{DabStats, PaintOp, paint_faces};
 use super::scratch::{Scratch, position};
-use super::settings::{BlendMode, BrushRadius, BrushSettings, ResolutionOp, StrokePoint, Tool, resolution_for_brush};
+use super::settings::{
+    BlendMode, BrushRadius, BrushSettings, Falloff, HardEdges, ResolutionOp, StrokePoint, Tool, resolution_for_spacing,
+};
 use crate::colors::layout::Resolution;
 use crate::paint::occlusion::DepthMap;
 
@@ -111,6 +113,10 @@ pub struct Painter {
     /// Whether the last colour or blur dab ran on the thread pool (`None` before the
     /// first): a stroke keeps its radius, so the next one likely does too.
     last_dab_parallel: Option<bool>,
+    /// What hard brushes do at their rim ([`Painter::set_hard_edges`]).
+    hard_edges: HardEdges,
+    /// The anti-aliased rims of the stroke's dabs so far (see [`Footprint::with_earlier`]).
+    rims: Vec<Rim>,
 }
 
 impl Painter {
@@ -132,6 +138,8 @@ impl Painter {
             tracker: None,
             last_dab_parallel: None,
             depth_maps: [None, None],
+            hard_edges: HardEdges::default(),
+            rims: Vec::new(),
         }
     }
 
@@ -166,6 +174,18 @@ impl Painter {
     pub fn set_budget(&mut self, budget: Option<(Budget, ColorFormat)>) {
         self.budget = budget;
         self.tracker = None;
+    }
+
+    /// What hard brushes (paint with a constant falloff) do so that their rim is not a
+    /// staircase of samples ([`HardEdges::default`]: raise the faces under them); applies
+    /// from the next dab.
+    pub fn set_hard_edges(&mut self, hard_edges: HardEdges) {
+        self.hard_edges = hard_edges;
+    }
+
+    /// What hard brushes do at their rim ([`Painter::set_hard_edges`]).
+    pub fn hard_edges(&self) -> HardEdges {
+        self.hard_edges
     }
 
     /// The settings the next stroke uses.
@@ -208,6 +228,7 @@ impl Painter {
         self.scratch.fit(store);
         self.scratch.next_stroke();
         self.tracker = None;
+        self.rims.clear();
         self.stroke = Some(StrokeState {
             settings,
             last_cursor_px: point.px,
@@ -348,6 +369,7 @@ impl Painter {
             self.scratch.fit(store);
             self.scratch.next_stroke();
             self.tracker = None;
+            self.rims.clear();
         }
         self.dab_with(&settings, view, &mut StoreWriter::new(store, history), center_world, radius_world)
     }
@@ -397,12 +419,11 @@ impl Painter {
         radius_world: f64,
         maps: Option<&[Option<DepthMap>; 2]>,
     ) -> Result<DabStats, BrushError> {
-        let store = writer.store();
-        self.scratch.fit(store);
+        self.scratch.fit(writer.store());
         let eye = view.camera.eye();
         let mirror = |p: DVec3| DVec3::new(2.0 * self.mirror_plane_x - p.x, p.y, p.z);
         let count = if settings.mirror_x { 2 } else { 1 };
-        let footprint = Footprint::new(
+        let mut footprint = Footprint::new(
             [center, mirror(center)],
             [eye, mirror(eye)],
             count,
@@ -414,47 +435,35 @@ impl Painter {
                 maps: [maps[0].as_ref(), maps[1].as_ref().filter(|_| count == 2)],
             }),
         );
-        // The faces of both spheres, sorted and unique.
-        let mut faces = view.bvh.faces_in_sphere(center, radius_world);
-        if count == 2 {
-            faces.extend(view.bvh.faces_in_sphere(footprint.centers[1], radius_world));
-            faces.sort_unstable();
-            faces.dedup();
-        }
-        let all_mask = (1u8 << count) - 1;
-        let mut masks = std::mem::take(&mut self.scratch.face_masks);
-        masks.clear();
-        if settings.backface_culling {
-            // The side the ray hits is the front: faces are oriented consistently with their
-            // component, then the hit face's side towards the eye decides (inside-out and
-            // mixed-winding meshes paint what the cursor shows).
-            let flips = self.scratch.face_flips(store);
-            let hit = view.bvh.cast(eye, center - eye, f64::INFINITY);
-            let hit_side = hit.map_or(1.0, |hit| {
-                let flipped = flips.get(hit.face as usize).copied().unwrap_or(false);
-                if hit.front_facing != flipped { 1.0 } else { -1.0 }
-            });
-            for &face in &faces {
-                let corners = store.topology().face_vertices.get(face as usize).copied().unwrap_or_default();
-                let [p0, p1, p2] = corners.map(|v| position(view.positions, v));
-                let side = if flips.get(face as usize).copied().unwrap_or(false) { -hit_side } else { hit_side };
-                let normal = (p1 - p0).cross(p2 - p0) * side;
-                masks.push(
-                    (0..count).filter(|&k| normal.dot(footprint.eyes[k] - p0) > 0.0).fold(0u8, |m, k| m | 1 << k),
-                );
+        let raises = self.raises(settings, radius_world);
+        self.collect_faces(view, writer.store(), &footprint, count, radius_world, settings.backface_culling);
+        self.raise_faces(&raises, view, writer)?;
+        let hard = settings.tool == Tool::Paint && settings.falloff == Falloff::Constant;
+        if let (true, Some(spacings)) = (hard, self.hard_edges.antialias_spacings) {
+            // The rim blends over the sample spacing of the faces it crosses (after they were
+            // raised), so the faces the outer rim reaches are collected (and raised) again.
+            footprint = footprint.with_edge(spacings * edge_width(&self.scratch, writer.store(), view.positions));
+            let reach = footprint.reach();
+            if reach > radius_world {
+                self.collect_faces(view, writer.store(), &footprint, count, reach, settings.backface_culling);
+                self.raise_faces(&raises, view, writer)?;
             }
-        } else {
-            masks.resize(faces.len(), all_mask);
-        }
-        self.scratch.face_masks = masks;
-        self.scratch.faces = faces;
-        if let (Some(max), Tool::Paint | Tool::Blur) = (settings.follow_resolution, settings.tool) {
-            self.follow_brush(max, radius_world, view, writer)?;
         }
         let stats = match settings.tool {
             Tool::Paint => {
                 let op = PaintOp { blend: settings.blend, color: settings.color, base: view.base };
-                paint_faces(&footprint, &op, view.positions, writer, &mut self.scratch)
+                // The earlier rims this dab can reach, so the stroke's rim does not build up.
+                let reach = footprint.reach();
+                let earlier: Vec<Rim> = self
+                    .rims
+                    .iter()
+                    .filter(|rim| footprint.centers.iter().take(count).any(|&c| rim.near(c, reach)))
+                    .copied()
+                    .collect();
+                let footprint = footprint.with_earlier(&earlier);
+                let stats = paint_faces(&footprint, &op, view.positions, writer, &mut self.scratch);
+                self.rims.extend(footprint.rims());
+                stats
             }
             Tool::Blur => blur_faces(&footprint, view.positions, writer, &mut self.scratch),
             Tool::Resolution(op) => {
@@ -476,39 +485,145 @@ impl Painter {
 }
 
 impl Painter {
-    /// Resolution follows the brush ([`BrushSettings::follow_resolution`]): raises the faces
-    /// of the dab (those facing the eye, `scratch.face_masks` ≠ 0) that cannot resolve
-    /// `radius_world`, each checked against the budget first.
-    fn follow_brush(
+    /// The faces within `radius` of the footprint's spheres (`count` of them), sorted and
+    /// unique, into `scratch.faces`, with their sphere masks (with `culling`, only the spheres
+    /// whose eye sees the face's front) into `scratch.face_masks`.
+    fn collect_faces(
         &mut self,
-        max: Resolution,
-        radius_world: f64,
+        view: &PaintView,
+        store: &ColorStore,
+        footprint: &Footprint,
+        count: usize,
+        radius: f64,
+        culling: bool,
+    ) {
+        let mut faces = view.bvh.faces_in_sphere(footprint.centers[0], radius);
+        if count == 2 {
+            faces.extend(view.bvh.faces_in_sphere(footprint.centers[1], radius));
+            faces.sort_unstable();
+            faces.dedup();
+        }
+        let all_mask = (1u8 << count) - 1;
+        let mut masks = std::mem::take(&mut self.scratch.face_masks);
+        masks.clear();
+        if culling {
+            // The side the ray hits is the front: faces are oriented consistently with their
+            // component, then the hit face's side towards the eye decides (inside-out and
+            // mixed-winding meshes paint what the cursor shows).
+            let eye = footprint.eyes[0];
+            let flips = self.scratch.face_flips(store);
+            let hit = view.bvh.cast(eye, footprint.centers[0] - eye, f64::INFINITY);
+            let hit_side = hit.map_or(1.0, |hit| {
+                let flipped = flips.get(hit.face as usize).copied().unwrap_or(false);
+                if hit.front_facing != flipped { 1.0 } else { -1.0 }
+            });
+            for &face in &faces {
+                let corners = store.topology().face_vertices.get(face as usize).copied().unwrap_or_default();
+                let [p0, p1, p2] = corners.map(|v| position(view.positions, v));
+                let side = if flips.get(face as usize).copied().unwrap_or(false) { -hit_side } else { hit_side };
+                let normal = (p1 - p0).cross(p2 - p0) * side;
+                masks.push(
+                    (0..count).filter(|&k| normal.dot(footprint.eyes[k] - p0) > 0.0).fold(0u8, |m, k| m | 1 << k),
+                );
+            }
+        } else {
+            masks.resize(faces.len(), all_mask);
+        }
+        self.scratch.face_masks = masks;
+        self.scratch.faces = faces;
+    }
+
+    /// The raises a dab of `radius_world` makes before painting: resolution follows the brush
+    /// ([`BrushSettings::follow_resolution`], paint and blur; over the budget stops the dab),
+    /// then a hard brush's ([`HardEdges::raise_to`]; a face over the budget keeps its `R`).
+    fn raises(&self, settings: &BrushSettings, radius_world: f64) -> [Option<Raise>; 2] {
+        let follow = match (settings.follow_resolution, settings.tool) {
+            (Some(max), Tool::Paint | Tool::Blur) => Some(Raise { max, spacing: radius_world / 4.0, strict: true }),
+            _ => None,
+        };
+        let per_radius = self.hard_edges.spacings_per_radius;
+        let hard = match (self.hard_edges.raise_to, settings.tool, settings.falloff) {
+            (Some(max), Tool::Paint, Falloff::Constant) if per_radius.is_finite() && per_radius > 0.0 => {
+                Some(Raise { max, spacing: radius_world / per_radius, strict: false })
+            }
+            _ => None,
+        };
+        [follow, hard]
+    }
+
+    /// Raises the faces of the dab (those facing the eye, `scratch.face_masks` ≠ 0) whose
+    /// sample spacing is coarser than each raise's, each checked against the budget first.
+    fn raise_faces(
+        &mut self,
+        raises: &[Option<Raise>; 2],
         view: &PaintView,
         writer: &mut StoreWriter,
     ) -> Result<(), BrushError> {
-        for (k, &face) in self.scratch.faces.iter().enumerate() {
-            if self.scratch.face_masks.get(k).copied().unwrap_or(0) == 0 {
-                continue;
+        for raise in raises.iter().flatten() {
+            for (k, &face) in self.scratch.faces.iter().enumerate() {
+                if self.scratch.face_masks.get(k).copied().unwrap_or(0) == 0 {
+                    continue;
+                }
+                let store = writer.store();
+                let Some(current) = store.face_resolution(face) else { continue };
+                let corners = store.topology().face_vertices.get(face as usize).copied().unwrap_or_default();
+                let [p0, p1, p2] = corners.map(|v| position(view.positions, v));
+                let longest = (p1 - p0).length().max((p2 - p1).length()).max((p0 - p2).length());
+                let target = resolution_for_spacing(longest, raise.spacing, raise.max);
+                if target <= current {
+                    continue;
+                }
+                if let Some((budget, format)) = &self.budget {
+                    let tracker = self.tracker.get_or_insert_with(|| SampleTracker::new(writer.store()));
+                    match tracker.admit(writer.store(), face, target, budget, *format) {
+                        Ok(()) => {}
+                        Err(error) if raise.strict => return Err(error.into()),
+                        Err(_) => continue,
+                    }
+                }
+                writer.set_face_resolution(face, target)?;
             }
-            let store = writer.store();
-            let Some(current) = store.face_resolution(face) else { continue };
-            let corners = store.topology().face_vertices.get(face as usize).copied().unwrap_or_default();
-            let [p0, p1, p2] = corners.map(|v| position(view.positions, v));
-            let longest = (p1 - p0).length().max((p2 - p1).length()).max((p0 - p2).length());
-            let target = resolution_for_brush(longest, radius_world, max);
-            if target <= current {
-                continue;
-            }
-            if let Some((budget, format)) = &self.budget {
-                let tracker = self.tracker.get_or_insert_with(|| SampleTracker::new(writer.store()));
-                tracker.admit(writer.store(), face, target, budget, *format)?;
-            }
-            writer.set_face_resolution(face, target)?;
         }
         // The sample scratch follows the resized store.
         self.scratch.fit(writer.store());
         Ok(())
     }
+}
+
+/// One rule that raises the faces under a dab: to the smallest power-of-two `R` whose spacing
+/// (longest edge / R) is at most `spacing`, up to `max`; `strict`: a face over the budget
+/// stops the dab (else it keeps its `R`).
+#[derive(Debug, Clone, Copy)]
+struct Raise {
+    max: Resolution,
+    spacing: f64,
+    strict: bool,
+}
+
+/// The width a dab's anti-aliased rim blends over: the median sample spacing (longest edge /
+/// R) of the faces in `scratch.faces` some sphere reaches (0 when there are none).
+fn edge_width(scratch: &Scratch, store: &ColorStore, positions: &[[f32; 3]]) -> f64 {
+    let topology = store.topology();
+    let mut spacings: Vec<f64> = scratch
+        .faces
+        .iter()
+        .zip(&scratch.face_masks)
+        .filter(|&(_, &mask)| mask != 0)
+        .filter_map(|(&face, _)| {
+            let r = store.face_resolution(face)?;
+            let corners = topology.face_vertices.get(face as usize)?;
+            let [p0, p1, p2] = corners.map(|v| position(positions, v));
+            let longest = (p1 - p0).length().max((p2 - p1).length()).max((p0 - p2).length());
+            Some(longest / f64::from(r.get()))
+        })
+        .filter(|spacing| spacing.is_finite())
+        .collect();
+    if spacings.is_empty() {
+        return 0.0;
+    }
+    let middle = spacings.len() / 2;
+    let (_, median, _) = spacings.select_nth_unstable_by(middle, f64::total_cmp);
+    *median
 }
 
 /// The resolution dab: applies `op` to every face in `scratch.faces` not yet changed in this

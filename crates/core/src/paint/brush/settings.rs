@@ -269,6 +269,51 @@ impl From<[f64; 2]> for StrokePoint {
 /// The largest `R` resolution-follows-the-brush raises a face to (the editor's setting).
 pub const FOLLOW_BRUSH_MAX_RESOLUTION: Resolution = Resolution::SIXTY_FOUR;
 
+/// The sample spacing a hard brush raises its faces to, as a fraction of the radius: at most
+/// `radius / HARD_EDGE_SPACINGS_PER_RADIUS` (the knee of docs/PAINT_MODE.md's "Hard edges"
+/// table: 16 per radius at `R` up to 64 brings a hard stroke's rim from 21 to 36 dB on the
+/// Duck; 32 adds 0.4 dB for half as many samples again).
+pub const HARD_EDGE_SPACINGS_PER_RADIUS: f64 = 16.0;
+
+/// What a hard brush (the paint tool with [`Falloff::Constant`]) does so that its rim is not
+/// a staircase of samples: raise the faces under it (the default, chosen with `meshpaint bench
+/// brush-edge`, docs/PAINT_MODE.md) and / or anti-alias the rim over the sample spacing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HardEdges {
+    /// Before each hard dab, every face under it facing the eye whose sample spacing (longest
+    /// edge / R) is coarser than `radius / spacings_per_radius` is raised to the smallest
+    /// power of two that resolves it, up to this `R`, within the budget (a face the budget
+    /// refuses keeps its `R`; the stroke goes on). Independent of
+    /// [`BrushSettings::follow_resolution`], so textured documents too. `None`: off.
+    pub raise_to: Option<Resolution>,
+    /// See `raise_to`.
+    pub spacings_per_radius: f64,
+    /// Anti-alias the rim over this many sample spacings (the median spacing of the dab's
+    /// faces): the weight ramps from the strength to 0 across the sphere, ½ on it, so one
+    /// dab's paint integrates to its disc's area; within a stroke the rim keeps the largest
+    /// coverage of its dabs instead of building up. `None`: off.
+    pub antialias_spacings: Option<f64>,
+}
+
+impl Default for HardEdges {
+    /// Raise to [`FOLLOW_BRUSH_MAX_RESOLUTION`] at [`HARD_EDGE_SPACINGS_PER_RADIUS`], no
+    /// anti-aliasing.
+    fn default() -> Self {
+        HardEdges {
+            raise_to: Some(FOLLOW_BRUSH_MAX_RESOLUTION),
+            spacings_per_radius: HARD_EDGE_SPACINGS_PER_RADIUS,
+            antialias_spacings: None,
+        }
+    }
+}
+
+impl HardEdges {
+    /// Neither: every sample inside the sphere painted at full strength, none outside, at
+    /// the faces' own `R` (the behaviour before issue 43).
+    pub const SAMPLED: HardEdges =
+        HardEdges { raise_to: None, spacings_per_radius: HARD_EDGE_SPACINGS_PER_RADIUS, antialias_spacings: None };
+}
+
 /// Brush settings. A stroke uses the settings it began with.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BrushSettings {
@@ -304,7 +349,13 @@ pub struct BrushSettings {
 /// The resolution a face needs to resolve a brush of `radius_world` (sample spacing at most a
 /// quarter of the radius along its longest edge), capped at `max`.
 pub fn resolution_for_brush(longest_edge: f64, radius_world: f64, max: Resolution) -> Resolution {
-    let wanted = 4.0 * longest_edge / radius_world;
+    resolution_for_spacing(longest_edge, radius_world / 4.0, max)
+}
+
+/// The smallest power-of-two resolution whose sample spacing along the longest edge
+/// (`longest_edge / R`) is at most `spacing`, capped at `max`.
+pub fn resolution_for_spacing(longest_edge: f64, spacing: f64, max: Resolution) -> Resolution {
+    let wanted = longest_edge / spacing;
     if !(wanted.is_finite() && wanted > 1.0) {
         return if wanted.is_finite() { Resolution::ONE } else { max };
     }
