@@ -152,11 +152,11 @@ fn strip_place(g: u32, pair: u32) -> vec3<u32> {
     let log2_row = strips & 7u;
     let k = pair >> log2_row;
     let j = pair & ((1u << log2_row) - 1u);
-    var before = 0u;
-    if u.vertex_levels > 1u {
-        let mask = textureLoad(mct_records, data_texel(u.face_count + (strips >> 9u) + k), 0).x;
-        before = countOneBits(mask & ((2u << j) - 2u));
-    }
+    // Loaded without a branch: on lavapipe a texel fetch under a branch, even a uniform
+    // one, doubled the vertex stage's time. A mesh of one level has no masks; the fetch
+    // is out of range there (robust access: zero or some texel) and its count unused.
+    let mask = textureLoad(mct_records, data_texel(u.face_count + (strips >> 9u) + k), 0).x;
+    let before = select(0u, countOneBits(mask & ((2u << j) - 2u)), u.vertex_levels > 1u);
     return vec3<u32>(k, j, before);
 }
 
@@ -196,11 +196,10 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
     let place = strip_place(g, mct_pair(record));
     out.block = vec4<u32>(g, place);
     let level = select(0u, min(u.level, max(u.vertex_levels, 1u) - 1u), LEVEL_MODE == 0u);
-    var point = tent_corner(record, corner);
-    if level > 0u {
-        let entry = mct_bands_at(g, level);
-        point = square_point(g, place, square, level, entry.x, entry.z & 0xffffu, entry.w);
-    }
+    // Both placed and one selected: no memory read under a branch (see `strip_place`).
+    let entry = mct_bands_at(g, max(level, 1u));
+    let on_square = square_point(g, place, square, max(level, 1u), entry.x, entry.z & 0xffffu, entry.w);
+    let point = select(tent_corner(record, corner), on_square, level > 0u);
     out.uv_square = vec4<f32>((point + 0.5) / vec2<f32>(textureDimensions(mct_atlas)), square);
     return out;
 }
