@@ -31,7 +31,7 @@ use meshpaint_render::{
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeTiming {
     /// `baseline-uv`, `nearest`, `linear`, `mip-1`, `trilinear`, `mct-linear`, `mct-mip-1`,
-    /// `mct-trilinear`.
+    /// `mct-trilinear`, `mct-anisotropic`.
     pub name: String,
     /// `uv-texture`, `mesh-colors` or `mct`.
     pub representation: &'static str,
@@ -52,6 +52,8 @@ pub struct ModeTiming {
 pub struct RenderBench {
     /// Adapter description.
     pub adapter: String,
+    /// Whether the adapter filters anisotropically (else `mct-anisotropic` draws trilinear).
+    pub anisotropic: bool,
     /// Image size.
     pub width: u32,
     /// Image size.
@@ -92,6 +94,7 @@ impl RenderBench {
         serde_json::json!({
             "bench": "render",
             "adapter": self.adapter,
+            "anisotropic": self.anisotropic,
             "width": self.width,
             "height": self.height,
             "frames_per_mode": self.frames,
@@ -206,7 +209,7 @@ pub fn bench_render(
     let timer = FrameTimer::new(&gpu, width, height);
 
     let geometry_bytes = mesh.gpu_bytes() - mesh.atlas_bytes() - mesh.face_record_bytes();
-    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 8] = [
+    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 9] = [
         ("baseline-uv", "uv-texture", DrawItem::Baseline(&baseline), FilterMode::Linear, baseline.gpu_bytes()),
         ("nearest", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Nearest, mesh.gpu_bytes()),
         ("linear", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Linear, mesh.gpu_bytes()),
@@ -215,6 +218,8 @@ pub fn bench_render(
         ("mct-linear", "mct", DrawItem::Mct(&mct), FilterMode::Linear, geometry_bytes + mct.gpu_bytes()),
         ("mct-mip-1", "mct", DrawItem::Mct(&mct), FilterMode::MipLevel(1), geometry_bytes + mct.gpu_bytes()),
         ("mct-trilinear", "mct", DrawItem::Mct(&mct), FilterMode::Trilinear, geometry_bytes + mct.gpu_bytes()),
+        // Trilinear where the adapter has no anisotropic filtering (`anisotropic` in the report).
+        ("mct-anisotropic", "mct", DrawItem::Mct(&mct), FilterMode::Anisotropic, geometry_bytes + mct.gpu_bytes()),
     ];
     let mut times: Vec<Vec<f64>> = vec![Vec::with_capacity(frames); paths.len()];
     let mut cpu_times: Vec<Vec<f64>> = vec![Vec::with_capacity(frames); paths.len()];
@@ -247,6 +252,7 @@ pub fn bench_render(
         .collect();
     Ok(RenderBench {
         adapter: ctx.describe(),
+        anisotropic: ctx.anisotropic(),
         width,
         height,
         frames: frames.max(1),
