@@ -534,7 +534,7 @@ impl Editor {
                 view.filter = match view.filter {
                     FilterMode::Nearest | FilterMode::NearestMipLevel(_) => FilterMode::Linear,
                     FilterMode::Linear | FilterMode::MipLevel(_) => FilterMode::Trilinear,
-                    FilterMode::Trilinear => FilterMode::Nearest,
+                    FilterMode::Trilinear | FilterMode::Anisotropic => FilterMode::Nearest,
                 }
             }
             Action::ToggleRepresentation => {

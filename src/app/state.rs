@@ -157,7 +157,9 @@ impl ViewSettings {
         if level0_only {
             settings.filter = match self.filter {
                 FilterMode::Nearest | FilterMode::NearestMipLevel(_) => FilterMode::Nearest,
-                FilterMode::Linear | FilterMode::MipLevel(_) | FilterMode::Trilinear => FilterMode::Linear,
+                FilterMode::Linear | FilterMode::MipLevel(_) | FilterMode::Trilinear | FilterMode::Anisotropic => {
+                    FilterMode::Linear
+                }
             };
         }
         settings.shading = self.shading;

@@ -31,7 +31,7 @@ use meshpaint_render::{
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeTiming {
     /// `baseline-uv`, `nearest`, `linear`, `mip-1`, `trilinear`, `mct-linear`, `mct-mip-1`,
-    /// `mct-trilinear`.
+    /// `mct-trilinear`, `mct-anisotropic`.
     pub name: String,
     /// `uv-texture`, `mesh-colors` or `mct`.
     pub representation: &'static str,
@@ -39,6 +39,10 @@ pub struct ModeTiming {
     pub median_seconds: f64,
     /// Fastest frame, seconds.
     pub best_seconds: f64,
+    /// Median CPU time the process spent on a frame (every thread: lavapipe's rasteriser
+    /// threads and the submitting one), seconds; on a software rasteriser sharing the
+    /// machine with other work this is steadier than the wall clock.
+    pub median_cpu_seconds: f64,
     /// Bytes of GPU buffers and textures this path needs.
     pub gpu_bytes: u64,
 }
@@ -48,6 +52,8 @@ pub struct ModeTiming {
 pub struct RenderBench {
     /// Adapter description.
     pub adapter: String,
+    /// Whether the adapter filters anisotropically (else `mct-anisotropic` draws trilinear).
+    pub anisotropic: bool,
     /// Image size.
     pub width: u32,
     /// Image size.
@@ -68,6 +74,7 @@ impl RenderBench {
     /// As JSON, with each mode's ratio to the baseline.
     pub fn to_json(&self) -> serde_json::Value {
         let baseline = self.modes.first().map_or(f64::NAN, |m| m.median_seconds);
+        let baseline_cpu = self.modes.first().map_or(f64::NAN, |m| m.median_cpu_seconds);
         let modes: Vec<serde_json::Value> = self
             .modes
             .iter()
@@ -78,6 +85,8 @@ impl RenderBench {
                     "median_ms": m.median_seconds * 1e3,
                     "best_ms": m.best_seconds * 1e3,
                     "ratio_to_baseline": m.median_seconds / baseline,
+                    "median_cpu_ms": m.median_cpu_seconds * 1e3,
+                    "cpu_ratio_to_baseline": m.median_cpu_seconds / baseline_cpu,
                     "gpu_bytes": m.gpu_bytes,
                 })
             })
@@ -85,6 +94,7 @@ impl RenderBench {
         serde_json::json!({
             "bench": "render",
             "adapter": self.adapter,
+            "anisotropic": self.anisotropic,
             "width": self.width,
             "height": self.height,
             "frames_per_mode": self.frames,
@@ -141,20 +151,38 @@ impl<'a> FrameTimer<'a> {
 
     /// Seconds of one unlit frame of `item` with `filter` seen by `camera`.
     pub fn frame(&self, item: DrawItem<'_>, filter: FilterMode, camera: OrbitCamera) -> f64 {
+        self.frame_with_cpu(item, filter, camera).0
+    }
+
+    /// [`Self::frame`] and the CPU seconds the process spent on it ([`process_cpu_seconds`]).
+    pub fn frame_with_cpu(&self, item: DrawItem<'_>, filter: FilterMode, camera: OrbitCamera) -> (f64, f64) {
         let (ctx, renderer) = (&*self.gpu.ctx, &self.gpu.renderer);
         let target =
             RenderTarget { color: &self.color_view, depth: &self.depth_view, width: self.width, height: self.height };
         let mut settings = RenderSettings::new(camera);
         settings.filter = filter;
         settings.shading = Shading::Unlit;
+        let cpu_start = process_cpu_seconds();
         let start = Instant::now();
         let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
         renderer.draw(ctx, &mut encoder, &target, item, &settings);
         ctx.queue.submit([encoder.finish()]);
         // A failed wait leaves the timing as measured so far; the report still compares.
         let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
-        start.elapsed().as_secs_f64()
+        (start.elapsed().as_secs_f64(), process_cpu_seconds() - cpu_start)
     }
+}
+
+/// CPU time of the whole process (all threads) so far, seconds; NaN where the clock is
+/// unavailable.
+pub fn process_cpu_seconds() -> f64 {
+    let mut now = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `now` is a valid, writable timespec for the duration of the call.
+    let status = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut now) };
+    if status != 0 {
+        return f64::NAN;
+    }
+    now.tv_sec as f64 + now.tv_nsec as f64 * 1e-9
 }
 
 /// Runs the benchmark on `document` (opened from `path`, which is re-imported for its UVs).
@@ -181,7 +209,7 @@ pub fn bench_render(
     let timer = FrameTimer::new(&gpu, width, height);
 
     let geometry_bytes = mesh.gpu_bytes() - mesh.atlas_bytes() - mesh.face_record_bytes();
-    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 8] = [
+    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 9] = [
         ("baseline-uv", "uv-texture", DrawItem::Baseline(&baseline), FilterMode::Linear, baseline.gpu_bytes()),
         ("nearest", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Nearest, mesh.gpu_bytes()),
         ("linear", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Linear, mesh.gpu_bytes()),
@@ -190,33 +218,47 @@ pub fn bench_render(
         ("mct-linear", "mct", DrawItem::Mct(&mct), FilterMode::Linear, geometry_bytes + mct.gpu_bytes()),
         ("mct-mip-1", "mct", DrawItem::Mct(&mct), FilterMode::MipLevel(1), geometry_bytes + mct.gpu_bytes()),
         ("mct-trilinear", "mct", DrawItem::Mct(&mct), FilterMode::Trilinear, geometry_bytes + mct.gpu_bytes()),
+        // Trilinear where the adapter has no anisotropic filtering (`anisotropic` in the report).
+        // Last and timed after the interleaved rounds (`INTERLEAVED`): on lavapipe it is ~100×
+        // the others and would leave the frame after it with cold caches.
+        ("mct-anisotropic", "mct", DrawItem::Mct(&mct), FilterMode::Anisotropic, geometry_bytes + mct.gpu_bytes()),
     ];
     let mut times: Vec<Vec<f64>> = vec![Vec::with_capacity(frames); paths.len()];
+    let mut cpu_times: Vec<Vec<f64>> = vec![Vec::with_capacity(frames); paths.len()];
     // One warm-up frame per path (pipeline and cache warm-up), then interleaved rounds.
     for &(_, _, item, filter, _) in &paths {
         timer.frame(item, filter, camera);
     }
-    for _ in 0..frames.max(1) {
-        for (k, &(_, _, item, filter, _)) in paths.iter().enumerate() {
-            times[k].push(timer.frame(item, filter, camera));
+    const INTERLEAVED: usize = 8;
+    for modes in [0..INTERLEAVED, INTERLEAVED..paths.len()] {
+        for _ in 0..frames.max(1) {
+            for k in modes.clone() {
+                let (_, _, item, filter, _) = paths[k];
+                let (wall, cpu) = timer.frame_with_cpu(item, filter, camera);
+                times[k].push(wall);
+                cpu_times[k].push(cpu);
+            }
         }
     }
     let modes = paths
         .iter()
-        .zip(times)
-        .map(|(&(name, representation, _, _, gpu_bytes), mut samples)| {
+        .zip(times.into_iter().zip(cpu_times))
+        .map(|(&(name, representation, _, _, gpu_bytes), (mut samples, mut cpu))| {
             samples.sort_by(f64::total_cmp);
+            cpu.sort_by(f64::total_cmp);
             ModeTiming {
                 name: name.to_owned(),
                 representation,
                 median_seconds: samples.get(samples.len() / 2).copied().unwrap_or(f64::NAN),
                 best_seconds: samples.first().copied().unwrap_or(f64::NAN),
+                median_cpu_seconds: cpu.get(cpu.len() / 2).copied().unwrap_or(f64::NAN),
                 gpu_bytes,
             }
         })
         .collect();
     Ok(RenderBench {
         adapter: ctx.describe(),
+        anisotropic: ctx.anisotropic(),
         width,
         height,
         frames: frames.max(1),

@@ -29,7 +29,8 @@ pub(super) struct RenderArgs {
     /// Image height in pixels.
     #[arg(long, default_value_t = 768)]
     height: u32,
-    /// Filter: nearest, linear, mip (linear at --level) or trilinear (automatic level).
+    /// Filter: nearest, linear, mip (linear at --level), trilinear (automatic level) or
+    /// anisotropic (Mesh Color Textures, where the GPU offers it; otherwise trilinear).
     #[arg(long, value_enum, default_value_t = RenderFilter::Trilinear)]
     filter: RenderFilter,
     /// MIP level for --filter mip (also selects a level for nearest or linear).
@@ -69,6 +70,9 @@ enum RenderFilter {
     Linear,
     Mip,
     Trilinear,
+    /// Mesh Color Textures: the GPU's anisotropic sampler where the adapter has one (mesh
+    /// colors: trilinear).
+    Anisotropic,
 }
 
 /// `--shading` values.
@@ -93,6 +97,8 @@ fn filter_mode(filter: RenderFilter, level: Option<u32>) -> Result<FilterMode> {
         (RenderFilter::Mip, None) => anyhow::bail!("--filter mip needs --level N"),
         (RenderFilter::Trilinear, None) => FilterMode::Trilinear,
         (RenderFilter::Trilinear, Some(_)) => anyhow::bail!("--level does not apply to --filter trilinear"),
+        (RenderFilter::Anisotropic, None) => FilterMode::Anisotropic,
+        (RenderFilter::Anisotropic, Some(_)) => anyhow::bail!("--level does not apply to --filter anisotropic"),
     })
 }
 

@@ -136,7 +136,11 @@ fn bench_render_reports_every_mode_against_the_baseline() {
     for mode in modes {
         assert!(mode["median_ms"].as_f64().unwrap() > 0.0, "{mode}");
         assert!(mode["ratio_to_baseline"].as_f64().unwrap() > 0.0, "{mode}");
+        assert!(mode["cpu_ratio_to_baseline"].as_f64().unwrap() > 0.0, "{mode}");
     }
+    // The anisotropic MCT row is there whether or not the adapter filters anisotropically.
+    assert!(report["anisotropic"].is_boolean(), "{report}");
+    assert!(modes.iter().any(|m| m["mode"] == "mct-anisotropic" && m["representation"] == "mct"), "{report}");
 }
 
 #[test]

@@ -316,6 +316,7 @@ fn filter_name(filter: FilterMode) -> String {
         FilterMode::MipLevel(level) => format!("linear L{level}"),
         FilterMode::NearestMipLevel(level) => format!("nearest L{level}"),
         FilterMode::Trilinear => "trilinear".into(),
+        FilterMode::Anisotropic => "anisotropic".into(),
     }
 }
 

@@ -15,8 +15,13 @@
 // crates/core/src/mct/sample.rs (`sample_level`, `sample_trilinear`, the CPU evaluation the
 // GPU is tested against).
 
-// 0 = fixed level `u.level` (bilinear), 1 = automatic level (trilinear), as mesh colors.
+// 0 = fixed level `u.level` (bilinear), 1 = automatic level (trilinear), as mesh colors;
+// 2 = anisotropic: the hardware's anisotropic sampler at the two levels around trilinear's
+// level made finer by log2 of the taps (crates/render/src/renderer.rs `MCT_LEVEL_ANISOTROPIC`).
 override LEVEL_MODE: u32 = 1u;
+
+// Keep in sync with `MAX_ANISOTROPY` in crates/render/src/mct.rs.
+const MCT_MAX_ANISOTROPY: f32 = 16.0;
 
 // The FLAG_* bits this pipeline draws with (the renderer builds one pipeline per set of
 // flags it meets and ignores `u.flags` here): a disabled overlay or lighting costs nothing,
@@ -31,6 +36,9 @@ const MCT_GROUPS: u32 = 13u;
 @group(0) @binding(3) var mct_records: texture_2d<u32>;
 @group(0) @binding(4) var mct_atlas: texture_2d<f32>;
 @group(0) @binding(6) var mct_sampler: sampler;
+// Linear in all three filters with an anisotropy clamp of MCT_MAX_ANISOTROPY (1 where the
+// adapter has no anisotropic filtering; the renderer then draws LEVEL_MODE 1 instead).
+@group(0) @binding(8) var mct_anisotropic: sampler;
 // The band table (`MctBands` in crates/core/src/mct/layout.rs) as crates/render/src/mct.rs
 // uploads it (`gpu_bands`): at index g · levels + l, the bands of group g at level l (x) and
 // at the next level min(l + 1, last) (y), each packed as y | per_row << 16 (per_row ≥ 1;
@@ -152,11 +160,11 @@ fn strip_place(g: u32, pair: u32) -> vec3<u32> {
     let log2_row = strips & 7u;
     let k = pair >> log2_row;
     let j = pair & ((1u << log2_row) - 1u);
-    var before = 0u;
-    if u.vertex_levels > 1u {
-        let mask = textureLoad(mct_records, data_texel(u.face_count + (strips >> 9u) + k), 0).x;
-        before = countOneBits(mask & ((2u << j) - 2u));
-    }
+    // Loaded without a branch: on lavapipe a texel fetch under a branch, even a uniform
+    // one, doubled the vertex stage's time. A mesh of one level has no masks; the fetch
+    // is out of range there (robust access: zero or some texel) and its count unused.
+    let mask = textureLoad(mct_records, data_texel(u.face_count + (strips >> 9u) + k), 0).x;
+    let before = select(0u, countOneBits(mask & ((2u << j) - 2u)), u.vertex_levels > 1u);
     return vec3<u32>(k, j, before);
 }
 
@@ -178,7 +186,7 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
     let face = vertex_index / 3u;
     let corner = vertex_index % 3u;
     let lit = (MCT_FLAGS & (FLAG_LIT | FLAG_SMOOTH)) != 0u;
-    let pulled = pull_corner_with(face, corner, LEVEL_MODE == 1u, MCT_FLAGS, lit);
+    let pulled = pull_corner_with(face, corner, LEVEL_MODE != 0u, MCT_FLAGS, lit);
     let record = textureLoad(mct_records, data_texel(min(face, max(u.face_count, 1u) - 1u)), 0).x;
     let g = mct_log2_block(record);
     var out: VertexOut;
@@ -196,11 +204,10 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOut {
     let place = strip_place(g, mct_pair(record));
     out.block = vec4<u32>(g, place);
     let level = select(0u, min(u.level, max(u.vertex_levels, 1u) - 1u), LEVEL_MODE == 0u);
-    var point = tent_corner(record, corner);
-    if level > 0u {
-        let entry = mct_bands_at(g, level);
-        point = square_point(g, place, square, level, entry.x, entry.z & 0xffffu, entry.w);
-    }
+    // Both placed and one selected: no memory read under a branch (see `strip_place`).
+    let entry = mct_bands_at(g, max(level, 1u));
+    let on_square = square_point(g, place, square, max(level, 1u), entry.x, entry.z & 0xffffu, entry.w);
+    let point = select(tent_corner(record, corner), on_square, level > 0u);
     out.uv_square = vec4<f32>((point + 0.5) / vec2<f32>(textureDimensions(mct_atlas)), square);
     return out;
 }
@@ -212,12 +219,25 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
         bary_width = fwidth(in.bary);
     }
     var color: vec4<f32>;
-    if LEVEL_MODE == 1u {
+    if LEVEL_MODE != 0u {
         // The level of detail of mesh colors (crates/core/src/packing/lod.rs), clamped to
         // the last level (sample.rs `sample_trilinear`); levels l0 and l1 blended, each
         // placed without a branch (level 0 is the tent's interpolated coordinate).
         let last = max(u.vertex_levels, 1u) - 1u;
         var lod = log2(max(in.lod.x, 1e-30)) + in.lod.y;
+        // Anisotropic: the footprint's axes from the derivatives of the square frame (the
+        // tent's at level 0 is the same up to axes and scale), as many taps as the one is
+        // longer than the other (at most MCT_MAX_ANISOTROPY), the level finer by log2 of them.
+        let dx = dpdx(in.uv_square.zw);
+        let dy = dpdy(in.uv_square.zw);
+        let dx_tent = dpdx(in.uv_square.xy);
+        let dy_tent = dpdy(in.uv_square.xy);
+        if LEVEL_MODE == 2u {
+            let major = max(length(dx), length(dy));
+            let minor = min(length(dx), length(dy));
+            let taps = clamp(ceil(major / max(minor, 1e-30)), 1.0, MCT_MAX_ANISOTROPY);
+            lod -= log2(select(taps, 1.0, is_nan(taps)));
+        }
         lod = clamp(select(lod, 0.0, is_nan(lod)), 0.0, f32(last));
         let l0 = u32(lod);
         let t = lod - f32(l0);
@@ -231,6 +251,19 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
         let c0 = textureSampleLevel(mct_atlas, mct_sampler, select(s0, in.uv_square.xy, l0 == 0u), 0.0);
         let c1 = textureSampleLevel(mct_atlas, mct_sampler, select(s1, in.uv_square.xy, l1 == 0u), 0.0);
         color = mix(c0, c1, t);
+        if LEVEL_MODE == 2u {
+            // The same points with the footprint scaled to each level's texels: the sampler
+            // takes its taps along the long axis at the atlas's one level. Taps leave the
+            // face's block where the footprint does (docs/MCT.md, anisotropic).
+            let r0 = f32(1u << (g - min(l0, g))) * inv_size;
+            let r1 = f32(1u << (g - min(l1, g))) * inv_size;
+            let a0 = textureSampleGrad(mct_atlas, mct_anisotropic, select(s0, in.uv_square.xy, l0 == 0u), select(dx * r0, dx_tent, l0 == 0u), select(dy * r0, dy_tent, l0 == 0u));
+            let a1 = textureSampleGrad(mct_atlas, mct_anisotropic, select(s1, in.uv_square.xy, l1 == 0u), select(dx * r1, dx_tent, l1 == 0u), select(dy * r1, dy_tent, l1 == 0u));
+            // Where the footprint's long axis at l0 covers at most one texel the sampler
+            // magnifies, which lavapipe's anisotropic filter does blockily: trilinear there.
+            let magnified = max(length(dx), length(dy)) * f32(1u << (g - min(l0, g))) <= 1.0;
+            color = select(mix(a0, a1, t), color, magnified);
+        }
     } else {
         color = textureSampleLevel(mct_atlas, mct_sampler, in.uv_square.xy, 0.0);
     }

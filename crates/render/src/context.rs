@@ -101,6 +101,12 @@ impl GpuContext {
         self.device.limits()
     }
 
+    /// Whether the adapter filters anisotropically (wgpu's `ANISOTROPIC_FILTERING`; without
+    /// it a sampler's anisotropy clamp is 1).
+    pub fn anisotropic(&self) -> bool {
+        self.adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::ANISOTROPIC_FILTERING)
+    }
+
     /// One line describing the adapter, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu)`.
     pub fn describe(&self) -> String {
         format!("{} ({:?}, {:?})", self.adapter_info.name, self.adapter_info.backend, self.adapter_info.device_type)

@@ -93,6 +93,12 @@ impl BindLayouts {
                     wgpu::ShaderStages::FRAGMENT,
                     wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                 ),
+                // The anisotropic sampler (`LEVEL_MODE` 2; anisotropy 1 where the adapter has none).
+                layout_entry(
+                    8,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                ),
                 layout_entry(
                     7,
                     wgpu::ShaderStages::VERTEX_FRAGMENT,

@@ -12,6 +12,10 @@ use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::mct::layout::GROUPS;
 use meshpaint_core::mct::{MctFaceRecord, MctLayout, MeshColorTexture};
 
+/// The anisotropic sampler's largest number of taps (wgpu's and Vulkan's usual limit).
+/// Keep in sync with `MCT_MAX_ANISOTROPY` in shaders/mct.wgsl.
+pub const MAX_ANISOTROPY: u16 = 16;
+
 /// A Mesh Color Texture uploaded for the MCT pipeline, drawn with its mesh's geometry.
 #[derive(Debug)]
 pub struct GpuMct {
@@ -91,6 +95,18 @@ impl GpuMct {
             mipmap_filter: wgpu::MipmapFilterMode::Nearest,
             ..Default::default()
         });
+        // All three filters linear, as anisotropy needs (the atlas has one level); wgpu sets
+        // the clamp to 1 where the adapter has no anisotropic filtering.
+        let anisotropic = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("MCT anisotropic"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            anisotropy_clamp: MAX_ANISOTROPY,
+            ..Default::default()
+        });
         let uniforms = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("MCT uniforms"),
             size: std::mem::size_of::<super::FrameUniforms>() as u64,
@@ -111,6 +127,7 @@ impl GpuMct {
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&view(normals)) },
                 wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(&sampler) },
                 wgpu::BindGroupEntry { binding: 7, resource: bands.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 8, resource: wgpu::BindingResource::Sampler(&anisotropic) },
             ],
         });
         Ok(GpuMct {

@@ -55,6 +55,11 @@ pub enum FilterMode {
     /// blended between the two nearest levels.
     #[default]
     Trilinear,
+    /// Mesh Color Textures: the GPU's anisotropic sampler (up to 16 taps along the pixel
+    /// footprint's long axis) at a level finer than trilinear's by log2 of the taps, where
+    /// the adapter offers it ([`GpuContext::anisotropic`]); otherwise, and for mesh colors
+    /// (software filter), trilinear.
+    Anisotropic,
 }
 
 impl FilterMode {
@@ -65,7 +70,9 @@ impl FilterMode {
             FilterMode::Linear => (FrameUniforms::FILTER_LINEAR, FrameUniforms::LEVEL_FIXED, 0),
             FilterMode::MipLevel(level) => (FrameUniforms::FILTER_LINEAR, FrameUniforms::LEVEL_FIXED, level),
             FilterMode::NearestMipLevel(level) => (FrameUniforms::FILTER_NEAREST, FrameUniforms::LEVEL_FIXED, level),
-            FilterMode::Trilinear => (FrameUniforms::FILTER_LINEAR, FrameUniforms::LEVEL_AUTO, 0),
+            FilterMode::Trilinear | FilterMode::Anisotropic => {
+                (FrameUniforms::FILTER_LINEAR, FrameUniforms::LEVEL_AUTO, 0)
+            }
         }
     }
 }
@@ -199,13 +206,16 @@ pub struct Renderer {
 const MCT_FLAG_BITS: u32 =
     FrameUniforms::FLAG_LIT | FrameUniforms::FLAG_WIREFRAME | FrameUniforms::FLAG_HEATMAP | FrameUniforms::FLAG_SMOOTH;
 
-/// MCT pipelines: `LEVEL_MODE` fixed or automatic, times every set of [`MCT_FLAG_BITS`].
-const MCT_PIPELINES: usize = 2 * (MCT_FLAG_BITS as usize + 1);
+/// MCT pipelines: `LEVEL_MODE` fixed, automatic or anisotropic ([`MCT_LEVEL_ANISOTROPIC`]),
+/// times every set of [`MCT_FLAG_BITS`].
+const MCT_PIPELINES: usize = 3 * (MCT_FLAG_BITS as usize + 1);
 
-/// The index of the MCT pipeline for `level_mode` (automatic unless fixed) and `flags`.
+/// The MCT shader's `LEVEL_MODE` for [`FilterMode::Anisotropic`] (shaders/mct.wgsl).
+const MCT_LEVEL_ANISOTROPIC: u32 = 2;
+
+/// The index of the MCT pipeline for `level_mode` (fixed, automatic or anisotropic) and `flags`.
 fn mct_pipeline_index(level_mode: u32, flags: u32) -> usize {
-    usize::from(level_mode != FrameUniforms::LEVEL_FIXED) * (MCT_FLAG_BITS as usize + 1)
-        + (flags & MCT_FLAG_BITS) as usize
+    level_mode.min(MCT_LEVEL_ANISOTROPIC) as usize * (MCT_FLAG_BITS as usize + 1) + (flags & MCT_FLAG_BITS) as usize
 }
 
 /// The `(filter_kind, level_mode)` combinations the mesh-colors shader is specialised for,
@@ -277,7 +287,7 @@ impl Renderer {
     /// The MCT pipeline for `level_mode` and `flags`, built on first use.
     fn mct_pipeline(&self, ctx: &GpuContext, level_mode: u32, flags: u32) -> &wgpu::RenderPipeline {
         let flags = flags & MCT_FLAG_BITS;
-        let level_mode = if level_mode == FrameUniforms::LEVEL_FIXED { level_mode } else { FrameUniforms::LEVEL_AUTO };
+        let level_mode = level_mode.min(MCT_LEVEL_ANISOTROPIC);
         self.mct_pipelines[mct_pipeline_index(level_mode, flags)].get_or_init(|| {
             let constants = [("LEVEL_MODE", f64::from(level_mode)), ("MCT_FLAGS", f64::from(flags))];
             let label = format!("mesh color textures (level mode {level_mode}, flags {flags})");
@@ -433,7 +443,11 @@ impl Renderer {
                 (&mesh.uniforms, &self.mesh_pipelines[mesh_pipeline_index(uniforms.filter_kind, uniforms.level_mode)])
             }
             DrawItem::Baseline(mesh) => (&mesh.uniforms, &self.baseline_pipeline),
-            DrawItem::Mct(mct) => (&mct.uniforms, self.mct_pipeline(ctx, uniforms.level_mode, uniforms.flags)),
+            DrawItem::Mct(mct) => {
+                let anisotropic = settings.filter == FilterMode::Anisotropic && ctx.anisotropic();
+                let level_mode = if anisotropic { MCT_LEVEL_ANISOTROPIC } else { uniforms.level_mode };
+                (&mct.uniforms, self.mct_pipeline(ctx, level_mode, uniforms.flags))
+            }
         };
         ctx.queue.write_buffer(uniform_buffer, 0, bytemuck::bytes_of(&uniforms));
         let [r, g, b, a] = settings.background.map(f64::from);

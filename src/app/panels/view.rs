@@ -98,6 +98,9 @@ impl ViewPanel {
         ui.horizontal(|ui| {
             let label = ui.label("Filter:");
             let combo = egui::ComboBox::from_id_salt("filter").selected_text(filter_name(view.filter));
+            // Anisotropic only for Mesh Color Textures (the GPU's sampler; mesh colors would
+            // draw it as trilinear).
+            let mct = view.representation == Representation::MeshColorTexture;
             let response = combo.show_ui(ui, |ui| {
                 for filter in [
                     FilterMode::Nearest,
@@ -105,7 +108,10 @@ impl ViewPanel {
                     FilterMode::Trilinear,
                     FilterMode::MipLevel(1.min(max_level)),
                     FilterMode::NearestMipLevel(1.min(max_level)),
-                ] {
+                ]
+                .into_iter()
+                .chain(mct.then_some(FilterMode::Anisotropic))
+                {
                     let selected = std::mem::discriminant(&view.filter) == std::mem::discriminant(&filter);
                     if ui.selectable_label(selected, filter_name(filter)).clicked() {
                         view.filter = filter;
@@ -307,6 +313,7 @@ pub fn filter_name(filter: FilterMode) -> String {
         FilterMode::Nearest => "Nearest".into(),
         FilterMode::Linear => "Linear".into(),
         FilterMode::Trilinear => "Trilinear (auto MIP)".into(),
+        FilterMode::Anisotropic => "Anisotropic (MCT, hardware)".into(),
         FilterMode::MipLevel(level) => format!("Linear, MIP level {level}"),
         FilterMode::NearestMipLevel(level) => format!("Nearest, MIP level {level}"),
     }

@@ -220,7 +220,10 @@ fn every_mct_pipeline_draws_as_mesh_colors_at_resolution_1() {
     let gpu_mct = GpuMct::upload(&gpu.ctx, gpu.renderer.layouts(), &mesh.geometry(), &texture).unwrap();
     let camera = OrbitCamera::framing(BoundingSphere::of_points(&packed.positions), 30.0, 20.0);
     let mut failures = Vec::new();
-    for filter in [FilterMode::Linear, FilterMode::Trilinear] {
+    // Anisotropic: where the sampler magnifies the pipeline draws trilinear, equal to mesh
+    // colors; where the footprint is longer than a texel its taps leave the face's one-texel
+    // block (docs/MCT.md): counted, and bounded to the few pixels at grazing angles.
+    for filter in [FilterMode::Linear, FilterMode::Trilinear, FilterMode::Anisotropic] {
         for shading in [Shading::Unlit, Shading::Lit, Shading::Smooth] {
             for (wireframe, heatmap) in [(false, false), (true, false), (false, true), (true, true)] {
                 let mut settings = RenderSettings::new(camera);
@@ -230,14 +233,17 @@ fn every_mct_pipeline_draws_as_mesh_colors_at_resolution_1() {
                 let render = |item| gpu.renderer.render_image(&gpu.ctx, item, &settings, SIZE, SIZE).unwrap();
                 let (a, b) = (render(DrawItem::MeshColors(&mesh)), render(DrawItem::Mct(&gpu_mct)));
                 let background: [u8; 3] = settings.background.map(encode_srgb8)[..3].try_into().unwrap();
-                let (mut covered, mut worst) = (0usize, 0u8);
+                let (mut covered, mut worst, mut off) = (0usize, 0u8, 0usize);
                 for (p, q) in a.pixels().zip(b.pixels()) {
                     covered += usize::from(p.0[..3] != background);
-                    worst = worst.max((0..3).map(|c| p.0[c].abs_diff(q.0[c])).max().unwrap_or(0));
+                    let d = (0..3).map(|c| p.0[c].abs_diff(q.0[c])).max().unwrap_or(0);
+                    worst = worst.max(d);
+                    off += usize::from(d > 1);
                 }
                 let name = format!("{filter:?} {shading:?} wireframe {wireframe} heat map {heatmap}");
-                println!("{name}: {covered} px covered, worst {worst} steps");
-                if worst > 1 || covered < 5000 {
+                println!("{name}: {covered} px covered, worst {worst} steps, {off} px off by more than 1");
+                let anisotropic = filter == FilterMode::Anisotropic;
+                if (worst > 1 && !anisotropic) || off * 20 > covered || covered < 5000 {
                     failures.push(format!("{name}: {covered} px covered, worst {worst} steps"));
                 }
             }

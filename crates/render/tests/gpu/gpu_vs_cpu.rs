@@ -44,7 +44,9 @@ fn compare(packed: &PackedMesh, camera: OrbitCamera, filter: FilterMode) -> Comp
         FilterMode::Linear => (Filter::Linear, 0),
         FilterMode::MipLevel(level) => (Filter::Linear, level),
         FilterMode::NearestMipLevel(level) => (Filter::Nearest, level),
-        FilterMode::Trilinear => panic!("trilinear needs screen derivatives; tested analytically in gpu_render"),
+        FilterMode::Trilinear | FilterMode::Anisotropic => {
+            panic!("trilinear needs screen derivatives; tested analytically in gpu_render")
+        }
     };
     let mut result =
         Comparison { compared: 0, skipped_near_edges: 0, coverage_mismatch: 0, max_steps: 0, mean_steps: 0.0 };

@@ -43,7 +43,7 @@ fn every_shader_parses_and_validates() {
 
 #[test]
 fn shaders_have_the_entry_points_and_bindings_the_renderer_uses() {
-    for ((name, source), bindings) in SOURCES.into_iter().zip([0..6u32, 0..3u32, 0..8u32]) {
+    for ((name, source), bindings) in SOURCES.into_iter().zip([0..6u32, 0..3u32, 0..9u32]) {
         let (module, _) = validate(name, source);
         let entry_points: Vec<&str> = module.entry_points.iter().map(|entry| entry.name.as_str()).collect();
         assert!(entry_points.contains(&"vs_main") && entry_points.contains(&"fs_main"), "{name}: {entry_points:?}");
