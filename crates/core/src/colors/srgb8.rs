@@ -12,7 +12,9 @@
 //! gathers. crates/core/tests/core/repack.rs checks every f32 in `[0, 1]` against the f64
 //! formula, through the dispatched slice encoder and the scalar one.
 
-use super::format::Rgba;
+/// A linear RGBA colour (the format module's `Rgba`, spelled out so that this codec, which the
+/// format module uses, does not depend on it).
+type Color = [f32; 4];
 
 /// Buckets of `bits >> BUCKET_SHIFT`.
 const BUCKET_SHIFT: u32 = 15;
@@ -55,6 +57,7 @@ fn unorm8(x: f32) -> u8 {
 /// `x` clamped to `[0, 1]`, NaN and −0 to +0 (`f32::max` returns the other operand for NaN;
 /// the sign bit is cleared for −0, which `max` may return).
 #[inline(always)]
+#[allow(clippy::manual_clamp)] // `clamp` keeps NaN; `max` turns it into 0
 fn unit(x: f32) -> f32 {
     f32::from_bits(x.max(0.0).min(1.0).to_bits() & 0x7fff_ffff)
 }
@@ -104,12 +107,12 @@ impl SrgbTables {
     /// A colour's RGBA8 bytes: RGB sRGB-encoded, alpha linear (clamped, rounded half away
     /// from zero).
     #[inline(always)]
-    pub(crate) fn encode_rgba8(&self, color: Rgba) -> [u8; 4] {
+    pub(crate) fn encode_rgba8(&self, color: Color) -> [u8; 4] {
         [self.encode(color[0]), self.encode(color[1]), self.encode(color[2]), unorm8(unit(color[3]))]
     }
 
     #[inline(always)]
-    pub(crate) fn decode_rgba8(&self, bytes: [u8; 4]) -> Rgba {
+    pub(crate) fn decode_rgba8(&self, bytes: [u8; 4]) -> Color {
         [
             self.decode[usize::from(bytes[0])],
             self.decode[usize::from(bytes[1])],
@@ -121,7 +124,7 @@ impl SrgbTables {
     /// Encodes `colors` into `out` (4 bytes each) and, when given, writes what decoding
     /// gives to `quantized`, as far as all of them reach: with AVX2 where the CPU has it,
     /// else [`SrgbTables::encode_slice_portable`]; the same bytes either way.
-    pub(crate) fn encode_slice(&self, colors: &[Rgba], out: &mut [u8], quantized: Option<&mut [Rgba]>) {
+    pub(crate) fn encode_slice(&self, colors: &[Color], out: &mut [u8], quantized: Option<&mut [Color]>) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2 (checked above).
@@ -132,7 +135,7 @@ impl SrgbTables {
     }
 
     /// [`SrgbTables::encode_slice`] one channel at a time.
-    pub(crate) fn encode_slice_portable(&self, colors: &[Rgba], out: &mut [u8], quantized: Option<&mut [Rgba]>) {
+    pub(crate) fn encode_slice_portable(&self, colors: &[Color], out: &mut [u8], quantized: Option<&mut [Color]>) {
         let out = out.chunks_exact_mut(4).zip(colors);
         match quantized {
             Some(quantized) => {
@@ -155,7 +158,7 @@ impl SrgbTables {
 mod avx2 {
     use std::arch::x86_64::*;
 
-    use super::{BUCKET_SHIFT, Rgba, SrgbTables};
+    use super::{BUCKET_SHIFT, Color, SrgbTables};
 
     /// Two samples (eight channels) a step: clamped to `[0, 1]` (`max` with zero first
     /// returns zero for NaN and for −0), each RGB channel's entry gathered (threshold and
@@ -166,7 +169,12 @@ mod avx2 {
     /// # Safety
     /// The CPU must have AVX2.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn encode(tables: &SrgbTables, colors: &[Rgba], out: &mut [u8], quantized: Option<&mut [Rgba]>) {
+    pub(super) unsafe fn encode(
+        tables: &SrgbTables,
+        colors: &[Color],
+        out: &mut [u8],
+        quantized: Option<&mut [Color]>,
+    ) {
         let n = colors.len().min(out.len() / 4).min(quantized.as_ref().map_or(usize::MAX, |q| q.len()));
         let src = colors.as_ptr().cast::<f32>();
         let dst = out.as_mut_ptr();
@@ -215,7 +223,7 @@ mod avx2 {
             out[4 * last..4 * last + 4].copy_from_slice(&code);
             if let Some(decoded) = decoded {
                 // SAFETY: sample `last` is below `n`, within `quantized`.
-                unsafe { decoded.add(4 * last).cast::<Rgba>().write_unaligned(tables.decode_rgba8(code)) };
+                unsafe { decoded.add(4 * last).cast::<Color>().write_unaligned(tables.decode_rgba8(code)) };
             }
         }
     }
@@ -223,8 +231,7 @@ mod avx2 {
 
 #[cfg(test)]
 mod tests {
-    use super::srgb_tables;
-    use crate::colors::format::Rgba;
+    use super::{Color, srgb_tables};
 
     /// The dispatched slice encoder (AVX2 on this CPU, if it has it) equals the portable
     /// one bit for bit, bytes and decoded copy, on runs of every length around its step
@@ -254,14 +261,14 @@ mod tests {
         ];
         let tables = srgb_tables();
         for len in [0, 1, 2, 3, 7, 8, 31, 33] {
-            let colors: Vec<Rgba> =
+            let colors: Vec<Color> =
                 (0..len).map(|i| std::array::from_fn(|c| values[(4 * i + c + len) % values.len()])).collect();
             let (mut portable, mut dispatched) = (vec![0u8; 4 * len], vec![0u8; 4 * len]);
             let (mut portable_q, mut dispatched_q) = (vec![[0.0f32; 4]; len], vec![[0.0f32; 4]; len]);
             tables.encode_slice_portable(&colors, &mut portable, Some(&mut portable_q));
             tables.encode_slice(&colors, &mut dispatched, Some(&mut dispatched_q));
             assert_eq!(portable, dispatched, "length {len}");
-            let bits = |q: &[Rgba]| q.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+            let bits = |q: &[Color]| q.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&portable_q), bits(&dispatched_q), "length {len}");
             let mut bytes_only = vec![0u8; 4 * len];
             tables.encode_slice(&colors, &mut bytes_only, None);
