@@ -3,6 +3,7 @@
 
 pub mod adaptive;
 pub mod extremes;
+pub mod latency;
 pub mod load;
 pub mod pack;
 pub mod paint;

@@ -6,3 +6,4 @@ mod common;
 mod app_ui;
 mod app_ui_tools;
 mod app_window;
+mod partial_redraw;
