@@ -18,6 +18,7 @@ use meshpaint_core::camera::OrbitCamera;
 use meshpaint_core::colors::budget::Budget;
 use meshpaint_core::colors::layout::Resolution;
 use meshpaint_core::colors::store::{ColorStore, DirtyAccumulator};
+use meshpaint_core::mesh::topology::VertexFaces;
 use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::packing::paint_layout::PaintLayout;
 use meshpaint_core::paint::brush::{
@@ -117,6 +118,7 @@ impl DocumentState {
             pack_cache: if unpacked_changes { None } else { open.pack_cache.take() },
             compact_gpu_mesh,
             repack_dirty: DirtyAccumulator::new(document.store.topology()),
+            vertex_faces: VertexFaces::of(document.store.topology()),
         });
         self.gpu_paint_layout = true;
         ctx.viewport.scene_generation += 1;
@@ -294,13 +296,18 @@ impl DocumentState {
         let plan = session.layout.sync(&doc.store, &dirty);
         let mut bytes = 0u64;
         let mut error = None;
+        // The faces these changes show on, for a partial redraw (`None`: all of them).
+        let mut shown = None;
         if let (Some(gpu), Some(mesh)) = (ctx.gpu, open.gpu_mesh.as_mut()) {
             match session.encoded.as_mut() {
                 Some(encoded) if !plan.grown && encoded.format() == open.format => {
                     let spans = encoded.apply(&session.layout, &doc.store, &dirty, &plan);
                     let records = (plan.faces.as_slice(), session.layout.records());
                     match mesh.write_paint_upload(&gpu.ctx, &spans, encoded.bytes(), records) {
-                        Ok(written) => bytes += written,
+                        Ok(written) => {
+                            bytes += written;
+                            shown = Some(dirty.faces_shown(doc.store.topology(), &session.vertex_faces));
+                        }
                         Err(e) => error = Some(e.to_string()),
                     }
                 }
@@ -316,7 +323,7 @@ impl DocumentState {
         }
         session.stroke_upload_bytes += bytes;
         ctx.viewport.upload_bytes_this_frame += bytes;
-        ctx.viewport.scene_generation += 1;
+        ctx.viewport.scene_changed(shown);
         if let Some(error) = error {
             session.upload_failed = true;
             ctx.status.set(

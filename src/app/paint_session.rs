@@ -7,6 +7,7 @@ use std::time::Duration;
 
 use meshpaint_core::colors::store::{ColorStore, DirtyAccumulator};
 use meshpaint_core::io::document::Document;
+use meshpaint_core::mesh::topology::VertexFaces;
 use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::packing::paint_layout::{EncodedBuffer, PaintLayout};
 use meshpaint_core::paint::brush::{self, Painter};
@@ -67,6 +68,9 @@ pub struct PaintSession {
     pub compact_gpu_mesh: Option<GpuMesh>,
     /// Every element changed during the session (the union of the dirty sets of all dabs).
     pub repack_dirty: DirtyAccumulator,
+    /// The faces around each vertex: which faces a dab's changes show on (the 3D view
+    /// redraws only those).
+    pub vertex_faces: VertexFaces,
 }
 
 /// Which repack leaving paint mode ran.

@@ -256,6 +256,22 @@ pub struct ViewportState {
     pub upload_bytes_last_frame: u64,
     /// Bytes uploaded to the GPU so far this frame.
     pub upload_bytes_this_frame: u64,
+    /// What changed since scene generation `from` when only colours of known faces did
+    /// (paint uploads): the window shell then redraws only those faces, if the view last
+    /// drew generation `from` ([`ViewportState::scene_changed`]).
+    pub partial: Option<PartialChange>,
+}
+
+/// Colour changes of some faces, from scene generation `from` to `to` (the geometry, the
+/// camera and everything else as at `from`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PartialChange {
+    /// The generation the changes start from.
+    pub from: u64,
+    /// The generation after the last of them.
+    pub to: u64,
+    /// The faces whose colours changed (sorted and unique per change; may repeat across).
+    pub faces: Vec<u32>,
 }
 
 impl Default for ViewportState {
@@ -270,11 +286,29 @@ impl Default for ViewportState {
             scene_generation: 0,
             upload_bytes_last_frame: 0,
             upload_bytes_this_frame: 0,
+            partial: None,
         }
     }
 }
 
 impl ViewportState {
+    /// Counts a change of what the GPU mesh shows: `Some(faces)` when only those faces'
+    /// colours changed (they join the pending [`PartialChange`] if it ends at the current
+    /// generation), `None` for anything else (the next frame is drawn whole).
+    pub fn scene_changed(&mut self, faces: Option<Vec<u32>>) {
+        let from = self.scene_generation;
+        self.scene_generation += 1;
+        self.partial = match (self.partial.take(), faces) {
+            (Some(mut pending), Some(faces)) if pending.to == from => {
+                pending.faces.extend(faces);
+                pending.to = self.scene_generation;
+                Some(pending)
+            }
+            (_, Some(faces)) => Some(PartialChange { from, to: self.scene_generation, faces }),
+            (_, None) => None,
+        };
+    }
+
     /// The area's size in physical pixels (at least 1×1).
     pub fn size_px(&self) -> [u32; 2] {
         let w = (self.rect.width() * self.pixels_per_point).round().max(1.0) as u32;

@@ -24,10 +24,10 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::window::{Window, WindowId};
 
-use meshpaint_render::{DEPTH_FORMAT, DrawItem, GpuContext, OFFSCREEN_FORMAT, RenderTarget, Renderer};
+use meshpaint_render::{DEPTH_FORMAT, GpuContext, OFFSCREEN_FORMAT, RenderTarget, Renderer};
 
 use super::editor::Editor;
-use super::state::{Representation, Shown};
+use super::view_draw::ViewDrawer;
 use meshpaint_core::io::document::Source;
 use meshpaint_render::Gpu;
 
@@ -128,10 +128,6 @@ impl ViewTarget {
     }
 }
 
-/// What the 3D view's last drawing shows: render settings, what is shown and in which
-/// representation, view size, scene generation (drawn again only when it changes).
-type DrawnView = (meshpaint_render::RenderSettings, (Shown, Representation), [u32; 2], u64);
-
 /// Everything that exists while the window does.
 struct Running {
     window: Arc<Window>,
@@ -147,10 +143,8 @@ struct Running {
     view: ViewTarget,
     editor: Editor,
     last_logged_viewport: Option<([i32; 2], [u32; 2])>,
-    /// What the 3D view last drew (logged when it changes).
-    last_logged_pipeline: Option<&'static str>,
-    /// What the 3D view's target holds: it is redrawn only when this changes.
-    drawn_view: Option<DrawnView>,
+    /// What the 3D view's target holds, and its partial redraws.
+    drawer: ViewDrawer,
     /// UI passes run so far, and where to write that count after each one
     /// (`MESHPAINT_FRAME_COUNT_FILE`, for the idle test: at rest the count must not grow).
     frame_count: (u64, Option<std::path::PathBuf>),
@@ -239,8 +233,7 @@ impl Shell {
             view,
             editor,
             last_logged_viewport: None,
-            last_logged_pipeline: None,
-            drawn_view: None,
+            drawer: ViewDrawer::new(),
             frame_count: (0, std::env::var_os("MESHPAINT_FRAME_COUNT_FILE").map(std::path::PathBuf::from)),
             title: "meshpaint".to_owned(),
         })
@@ -366,30 +359,16 @@ impl Running {
 
         let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         if self.editor.panels.scene.continuous_redraw {
-            self.drawn_view = None;
+            self.drawer.invalidate();
         }
-        let settings = self.editor.render_settings();
-        let shown = (self.editor.panels.view.settings.shown, self.editor.shown_representation());
-        let view_key = (settings, shown, self.view.size, self.editor.viewport.scene_generation);
-        let item = self.editor.shown_item();
-        if let (Some(item), Some(gpu)) = (item.filter(|_| self.drawn_view != Some(view_key)), &self.gpu) {
-            self.drawn_view = Some(view_key);
-            let pipeline = match item {
-                DrawItem::MeshColors(_) => "mesh colors",
-                DrawItem::Baseline(_) => "the UV-textured source",
-                DrawItem::Mct(_) => "Mesh Color Textures",
-            };
-            if self.last_logged_pipeline != Some(pipeline) {
-                log::info!("3D view draws {pipeline}");
-                self.last_logged_pipeline = Some(pipeline);
-            }
+        if let Some(gpu) = &self.gpu {
             let target = RenderTarget {
                 color: &self.view.srgb_view,
                 depth: &self.view.depth_view,
                 width: self.view.size[0],
                 height: self.view.size[1],
             };
-            gpu.renderer.draw(ctx, &mut encoder, &target, item, &settings);
+            self.drawer.draw((ctx, gpu), &mut encoder, &target, self.view.size, &mut self.editor);
         }
 
         let screen =

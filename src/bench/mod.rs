@@ -4,6 +4,7 @@
 pub mod adaptive;
 pub mod brush_edge;
 pub mod extremes;
+pub mod latency;
 pub mod load;
 pub mod pack;
 pub mod paint;

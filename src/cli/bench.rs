@@ -70,6 +70,28 @@ pub(super) enum BenchCommand {
         #[arg(long, default_value_t = 720)]
         height: u32,
     },
+    /// Dab-to-screen latency as the editor paints: open, enter paint mode, strokes of one
+    /// pointer move per frame; per move the dab and the 3D view's frame finished on the GPU
+    /// (median, p90), with partial redraws and drawing every frame whole.
+    Latency {
+        /// A .glb / .gltf / OBJ / PLY / STL file.
+        file: PathBuf,
+        /// Uniform face resolution R.
+        #[arg(short, long, default_value_t = 8)]
+        resolution: u64,
+        /// Width of the 3D view.
+        #[arg(long, default_value_t = 1280)]
+        width: u32,
+        /// Height of the 3D view.
+        #[arg(long, default_value_t = 720)]
+        height: u32,
+        /// Pointer moves per stroke.
+        #[arg(long, default_value_t = 30)]
+        moves: usize,
+        /// Brush radius in pixels (default: the editor's brush).
+        #[arg(long)]
+        radius_px: Option<f64>,
+    },
     /// Frame time of the UV baseline and each mesh-colors filter mode (interleaved), GPU memory.
     Render {
         /// A .glb / .gltf file or a packed file.
@@ -285,6 +307,13 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
         }
         BenchCommand::Load { file, resolution, subdivide, width, height } => {
             load(file, resolution, subdivide, width, height)
+        }
+        BenchCommand::Latency { file, resolution, width, height, moves, radius_px } => {
+            let resolution = meshpaint_core::colors::layout::Resolution::new(resolution).context("--resolution")?;
+            let options =
+                meshpaint::bench::latency::LatencyOptions { resolution, size: [width, height], moves, radius_px };
+            println!("{}", meshpaint::bench::latency::bench_latency(&file, &options)?);
+            Ok(())
         }
         BenchCommand::Paint { file, resolution, dabs, subdivide, dab_samples, json, rows } => {
             paint(file, resolution, dabs, subdivide, dab_samples, json, rows)

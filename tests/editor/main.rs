@@ -7,3 +7,4 @@ mod app_ui;
 mod app_ui_convert;
 mod app_ui_tools;
 mod app_window;
+mod partial_redraw;

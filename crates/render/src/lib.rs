@@ -41,6 +41,7 @@ mod heat;
 mod layouts;
 mod mct;
 mod mesh_gpu;
+mod partial;
 mod readback;
 mod renderer;
 mod uniforms;
@@ -52,6 +53,8 @@ pub use heat::{HEAT_COLORS, heat_color};
 pub use layouts::BindLayouts;
 pub use mct::GpuMct;
 pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshGeometry, MeshUploadOptions, atlas_texture_format, default_atlas_width};
+pub use partial::{FaceSubset, Scissor};
+pub use readback::read_texture;
 pub use renderer::{
     DrawItem, FRAME_WGSL, FilterMode, MCT_WGSL, MESH_COLORS_WGSL, Overlays, RenderSettings, RenderTarget, Renderer,
     Shading, UV_BASELINE_WGSL,

@@ -81,3 +81,10 @@ impl GpuMesh {
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 }
+
+/// Every texel of `texture` (its first mip level; `bytes_per_texel` bytes each, rows without
+/// padding), read back: e.g. a view target to compare two drawings pixel for pixel. The
+/// texture needs `COPY_SRC` usage.
+pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, bytes_per_texel: u64) -> Result<Vec<u8>, RenderError> {
+    read_texels(ctx, texture, bytes_per_texel, u64::from(texture.width()) * u64::from(texture.height()))
+}

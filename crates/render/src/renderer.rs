@@ -193,6 +193,11 @@ pub struct Renderer {
     layouts: BindLayouts,
     /// One mesh-colors pipeline per `(filter_kind, level_mode)`, see [`mesh_pipeline_index`].
     mesh_pipelines: Vec<wgpu::RenderPipeline>,
+    /// The mesh-colors shader, and its pipelines for partial redraws (one per
+    /// `(filter_kind, level_mode)`, built on first use): depth test `LessEqual` against the
+    /// previous frame's depth, no depth write ([`crate::partial`]).
+    mesh_module: wgpu::ShaderModule,
+    partial_pipelines: [OnceLock<wgpu::RenderPipeline>; 4],
     baseline_pipeline: wgpu::RenderPipeline,
     /// The MCT shader and its pipelines, one per `LEVEL_MODE` and set of `FLAG_*` bits (see
     /// [`mct_pipeline_index`]), each built the first time it draws.
@@ -217,6 +222,9 @@ const MCT_LEVEL_ANISOTROPIC: u32 = 2;
 fn mct_pipeline_index(level_mode: u32, flags: u32) -> usize {
     level_mode.min(MCT_LEVEL_ANISOTROPIC) as usize * (MCT_FLAG_BITS as usize + 1) + (flags & MCT_FLAG_BITS) as usize
 }
+
+/// The depth test of a full frame: nearer wins, ties go to the face drawn first.
+const FULL_DEPTH: (wgpu::CompareFunction, bool) = (wgpu::CompareFunction::Less, true);
 
 /// The `(filter_kind, level_mode)` combinations the mesh-colors shader is specialised for,
 /// as its pipeline-overridable constants `FILTER_KIND` and `LEVEL_MODE` (keep in sync with
@@ -255,7 +263,7 @@ impl Renderer {
                 debug_assert_eq!(mesh_pipeline_index(filter_kind, level_mode), index);
                 let constants = [("FILTER_KIND", f64::from(filter_kind)), ("LEVEL_MODE", f64::from(level_mode))];
                 let label = format!("mesh colors (filter {filter_kind}, level mode {level_mode})");
-                Self::pipeline(ctx, &label, &mesh_module, &constants, layouts.mesh(), &[], color_format)
+                Self::pipeline(ctx, &label, &mesh_module, &constants, layouts.mesh(), &[], (color_format, FULL_DEPTH))
             })
             .collect();
         let baseline_module = Self::module(ctx, "uv baseline", UV_BASELINE_WGSL);
@@ -266,13 +274,15 @@ impl Renderer {
             &[],
             layouts.baseline(),
             &[Some(BaselineVertex::LAYOUT)],
-            color_format,
+            (color_format, FULL_DEPTH),
         );
         let mct_module = Self::module(ctx, "mesh color textures", MCT_WGSL);
         let renderer = Renderer {
             color_format,
             layouts,
             mesh_pipelines,
+            mesh_module,
+            partial_pipelines: std::array::from_fn(|_| OnceLock::new()),
             baseline_pipeline,
             mct_module,
             mct_pipelines: std::array::from_fn(|_| OnceLock::new()),
@@ -291,7 +301,21 @@ impl Renderer {
         self.mct_pipelines[mct_pipeline_index(level_mode, flags)].get_or_init(|| {
             let constants = [("LEVEL_MODE", f64::from(level_mode)), ("MCT_FLAGS", f64::from(flags))];
             let label = format!("mesh color textures (level mode {level_mode}, flags {flags})");
-            Self::pipeline(ctx, &label, &self.mct_module, &constants, self.layouts.mct(), &[], self.color_format)
+            let target = (self.color_format, FULL_DEPTH);
+            Self::pipeline(ctx, &label, &self.mct_module, &constants, self.layouts.mct(), &[], target)
+        })
+    }
+
+    /// The mesh-colors pipeline of a partial redraw for these uniforms' filter and level
+    /// mode (depth test `LessEqual`, no depth write), built on first use.
+    pub(crate) fn partial_pipeline(&self, ctx: &GpuContext, uniforms: &FrameUniforms) -> &wgpu::RenderPipeline {
+        let index = mesh_pipeline_index(uniforms.filter_kind, uniforms.level_mode);
+        self.partial_pipelines[index].get_or_init(|| {
+            let (filter_kind, level_mode) = MESH_PIPELINE_KEYS[index];
+            let constants = [("FILTER_KIND", f64::from(filter_kind)), ("LEVEL_MODE", f64::from(level_mode))];
+            let label = format!("mesh colors, partial redraw (filter {filter_kind}, level mode {level_mode})");
+            let target = (self.color_format, (wgpu::CompareFunction::LessEqual, false));
+            Self::pipeline(ctx, &label, &self.mesh_module, &constants, self.layouts.mesh(), &[], target)
         })
     }
 
@@ -309,7 +333,7 @@ impl Renderer {
         constants: &[(&str, f64)],
         bind_group_layout: &wgpu::BindGroupLayout,
         buffers: &[Option<wgpu::VertexBufferLayout<'_>>],
-        color_format: wgpu::TextureFormat,
+        (color_format, (depth_compare, depth_write)): (wgpu::TextureFormat, (wgpu::CompareFunction, bool)),
     ) -> wgpu::RenderPipeline {
         let device = &ctx.device;
         let compilation_options = wgpu::PipelineCompilationOptions { constants, ..Default::default() };
@@ -335,8 +359,8 @@ impl Renderer {
             },
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
+                depth_write_enabled: Some(depth_write),
+                depth_compare: Some(depth_compare),
                 stencil: wgpu::StencilState::default(),
                 bias: wgpu::DepthBiasState::default(),
             }),

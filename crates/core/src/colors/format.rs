@@ -11,6 +11,8 @@
 
 use half::f16;
 
+use super::srgb8::srgb_tables;
+
 /// A linear-light RGBA colour, straight (not premultiplied) alpha.
 pub type Rgba = [f32; 4];
 
@@ -227,14 +229,7 @@ impl ColorFormat {
         // Each arm splits `out` at its format's constant sample size, so every copy is a
         // fixed-size store, not a call.
         match self {
-            ColorFormat::Rgba8Srgb => {
-                let tables = srgb_tables();
-                for ((&color, out), slot) in colors.iter().zip(out.chunks_exact_mut(4)).zip(quantized.iter_mut()) {
-                    let bytes = tables.encode_rgba8(clamp_color(color));
-                    out.copy_from_slice(&bytes);
-                    *slot = tables.decode_rgba8(bytes);
-                }
-            }
+            ColorFormat::Rgba8Srgb => srgb_tables().encode_slice(colors, out, Some(quantized)),
             ColorFormat::Rgba16F => {
                 let n = colors.len().min(out.len() / 8).min(quantized.len());
                 encode_f16_runs(&colors[..n], &mut out[..n * 8], Some(&mut quantized[..n]));
@@ -252,12 +247,7 @@ impl ColorFormat {
     pub fn encode_slice(self, colors: &[Rgba], out: &mut [u8]) {
         // One loop per format, each at its constant sample size (fixed-size stores).
         match self {
-            ColorFormat::Rgba8Srgb => {
-                let tables = srgb_tables();
-                for (color, bytes) in colors.iter().zip(out.chunks_exact_mut(4)) {
-                    bytes.copy_from_slice(&tables.encode_rgba8(clamp_color(*color)));
-                }
-            }
+            ColorFormat::Rgba8Srgb => srgb_tables().encode_slice(colors, out, None),
             ColorFormat::Rgba16F => {
                 let n = colors.len().min(out.len() / 8);
                 encode_f16_runs(&colors[..n], &mut out[..n * 8], None);
@@ -483,113 +473,6 @@ fn srgb_table() -> &'static [f32] {
 pub fn srgb_to_linear(encoded: f32) -> f32 {
     let x = encoded.clamp(0.0, 1.0);
     if x <= 0.040_45 { x / 12.92 } else { ((x + 0.055) / 1.055).powf(2.4) }
-}
-
-fn unorm8(x: f32) -> u8 {
-    let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
-    // Round half away from zero without a libm call: `v − trunc(v)` is exact here.
-    let v = x * 255.0;
-    let t = v as u32;
-    (t + u32::from(v - t as f32 >= 0.5)) as u8
-}
-
-/// Tables for exact, fast RGBA8 sRGB conversion, built once in `f64`.
-struct SrgbTables {
-    /// Linear value of each 8-bit code.
-    decode: [f32; 256],
-    /// Each alpha code's value, `code / 255` (a lookup in place of a division).
-    alpha: [f32; 256],
-    /// `thresholds[b]` (`b < 255`): the smallest f32 whose exact encoding rounds to code
-    /// `b + 1` or above; a linear value encodes to the number of thresholds it reaches.
-    /// `thresholds[255]` is +∞.
-    thresholds: [f32; 256],
-    /// The code of the smallest f32 of each bucket of f32 bit patterns `bits >> 15` (one
-    /// exponent, the top 8 mantissa bits) from `first_bucket` up to 1.0. A bucket spans
-    /// < 0.4 % of its values and one sRGB code at least 0.89 %, so at most one threshold
-    /// falls inside a bucket: the code is the bucket's, plus one if the value reaches the
-    /// next threshold.
-    bucket: Vec<u8>,
-    /// The bucket holding `thresholds[0]`: every f32 below its start encodes to 0, so the
-    /// table (3.3 k entries) stays in the L1 cache.
-    first_bucket: u32,
-    /// The smallest f32 of `first_bucket`.
-    floor: f32,
-}
-
-/// Buckets of `bits >> BUCKET_SHIFT` below 1.0.
-const BUCKET_SHIFT: u32 = 15;
-
-fn srgb_tables() -> &'static SrgbTables {
-    static TABLES: std::sync::OnceLock<SrgbTables> = std::sync::OnceLock::new();
-    TABLES.get_or_init(|| {
-        let to_linear = |encoded: f64| {
-            if encoded <= 0.040_45 { encoded / 12.92 } else { ((encoded + 0.055) / 1.055).powf(2.4) }
-        };
-        // Each threshold is the smallest f32 at or above the exact (f64) boundary, so
-        // "reaches the threshold" is exactly "the f64 formula rounds up" for every f32.
-        let thresholds: [f32; 256] = std::array::from_fn(|b| {
-            if b == 255 {
-                return f32::INFINITY;
-            }
-            let exact = to_linear((b as f64 + 0.5) / 255.0);
-            let mut t = exact as f32;
-            while f64::from(t) < exact {
-                t = t.next_up();
-            }
-            while f64::from(t.next_down()) >= exact {
-                t = t.next_down();
-            }
-            t
-        });
-        let first_bucket = thresholds[0].to_bits() >> BUCKET_SHIFT;
-        let bucket = (first_bucket..1.0f32.to_bits() >> BUCKET_SHIFT)
-            .map(|k| {
-                let start = f32::from_bits(k << BUCKET_SHIFT);
-                thresholds.partition_point(|&t| t <= start) as u8
-            })
-            .collect();
-        let floor = f32::from_bits(first_bucket << BUCKET_SHIFT);
-        SrgbTables {
-            decode: std::array::from_fn(|b| to_linear(b as f64 / 255.0) as f32),
-            alpha: std::array::from_fn(|b| b as f32 / 255.0),
-            thresholds,
-            bucket,
-            first_bucket,
-            floor,
-        }
-    })
-}
-
-impl SrgbTables {
-    /// [`encode_srgb8`] with the tables at hand.
-    #[inline(always)]
-    fn encode(&self, linear: f32) -> u8 {
-        if linear.is_nan() || linear < self.floor {
-            return 0;
-        }
-        if linear >= 1.0 {
-            return 255;
-        }
-        let code = self.bucket[((linear.to_bits() >> BUCKET_SHIFT) - self.first_bucket) as usize];
-        code + u8::from(linear >= self.thresholds[usize::from(code)])
-    }
-
-    #[inline(always)]
-    fn encode_rgba8(&self, color: Rgba) -> [u8; 4] {
-        // Opaque alpha (the usual case) skips the rounding.
-        let alpha = if color[3] == 1.0 { 255 } else { unorm8(color[3]) };
-        [self.encode(color[0]), self.encode(color[1]), self.encode(color[2]), alpha]
-    }
-
-    #[inline(always)]
-    fn decode_rgba8(&self, bytes: [u8; 4]) -> Rgba {
-        [
-            self.decode[usize::from(bytes[0])],
-            self.decode[usize::from(bytes[1])],
-            self.decode[usize::from(bytes[2])],
-            self.alpha[usize::from(bytes[3])],
-        ]
-    }
 }
 
 /// Encodes one linear channel as an 8-bit sRGB code: the code whose exact encoded value

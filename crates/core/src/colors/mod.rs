@@ -8,6 +8,7 @@ pub mod layout;
 pub mod psnr;
 pub mod resample;
 mod slab;
+mod srgb8;
 pub mod stats;
 pub mod store;
 

@@ -27,7 +27,7 @@ use crate::colors::format::Rgba;
 use crate::colors::layout::{self, Resolution, SampleLocation};
 use crate::colors::resample::{Lattice, reduce_polyline, refine_polyline};
 use crate::colors::slab::Slab;
-use crate::mesh::topology::Topology;
+use crate::mesh::topology::{Topology, VertexFaces};
 
 /// Errors of store operations.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -126,6 +126,23 @@ impl DirtyElements {
     /// Whether nothing changed.
     pub fn is_empty(&self) -> bool {
         self.vertices.is_empty() && self.edges.is_empty() && self.faces.is_empty()
+    }
+
+    /// Every face whose rendering these changes reach, sorted and unique: faces whose
+    /// interiors or resolutions changed, the faces of every changed edge and around every
+    /// changed vertex (a face shows its own vertices', edges' and interior samples, nothing
+    /// else).
+    pub fn faces_shown(&self, topology: &Topology, vertex_faces: &VertexFaces) -> Vec<u32> {
+        let mut faces: Vec<u32> = self.faces.iter().chain(&self.resized_faces).copied().collect();
+        for &edge in self.edges.iter().chain(&self.resized_edges) {
+            faces.extend(topology.faces_of_edge(edge).iter().map(|&(face, _)| face));
+        }
+        for &vertex in &self.vertices {
+            faces.extend_from_slice(vertex_faces.faces(vertex));
+        }
+        faces.sort_unstable();
+        faces.dedup();
+        faces
     }
 }
 

@@ -229,3 +229,51 @@ impl Topology {
         Ok(())
     }
 }
+
+/// The faces around each vertex (compressed rows: `faces[offsets[v]..offsets[v + 1]]`, in
+/// face order), built once where the faces an edit shows on are needed (the editor's partial
+/// redraw after a dab).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct VertexFaces {
+    offsets: Vec<u32>,
+    faces: Vec<u32>,
+}
+
+impl VertexFaces {
+    /// The vertex → face incidence of `topology` (a face listed once per corner at `v`).
+    pub fn of(topology: &Topology) -> Self {
+        let vertices = topology.vertex_count as usize;
+        let mut offsets = vec![0u32; vertices + 1];
+        for corners in &topology.face_vertices {
+            for &v in corners {
+                offsets[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..vertices {
+            offsets[v + 1] += offsets[v];
+        }
+        let mut next = offsets.clone();
+        let mut faces = vec![0u32; topology.face_vertices.len() * 3];
+        for (face, corners) in topology.face_vertices.iter().enumerate() {
+            for &v in corners {
+                faces[next[v as usize] as usize] = face as u32;
+                next[v as usize] += 1;
+            }
+        }
+        VertexFaces { offsets, faces }
+    }
+
+    /// The faces with a corner at `vertex` (empty for an unknown vertex).
+    pub fn faces(&self, vertex: u32) -> &[u32] {
+        let v = vertex as usize;
+        match (self.offsets.get(v), self.offsets.get(v + 1)) {
+            (Some(&start), Some(&end)) => self.faces.get(start as usize..end as usize).unwrap_or(&[]),
+            _ => &[],
+        }
+    }
+
+    /// Bytes held.
+    pub fn heap_bytes(&self) -> u64 {
+        4 * (self.offsets.capacity() + self.faces.capacity()) as u64
+    }
+}

@@ -1,7 +1,7 @@
 //! The fast packer and the incremental repack against the straightforward serial packer
 //! (`packing::reference`), byte for byte: mixed resolutions, boundary and non-manifold
 //! edges, every format; random strokes and resolution changes. And the RGBA8 sRGB encoder
-//! against the exact (f64) transfer function on every f32 that matters.
+//! against the exact (f64) transfer function on every f32 in [0, 1].
 
 use crate::common;
 use crate::common::WriteThrough;
@@ -296,53 +296,78 @@ fn an_empty_edit_changes_nothing() {
     assert_eq!(*cache.packed(), before);
 }
 
-/// The exact code: the f64 transfer function, rounded to nearest; `None` when the value
-/// is within f64 noise of a rounding boundary (no f32 lands there in practice).
-fn exact_srgb8(linear: f32) -> Option<u8> {
+/// The exact code: the f64 transfer function, rounded to nearest. Panics when the value
+/// is within f64 noise of a rounding boundary (no f32 lands there: the check would be
+/// undecided).
+fn exact_srgb8(linear: f32) -> u8 {
     let x = f64::from(linear).clamp(0.0, 1.0);
     let encoded = if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
     let scaled = encoded * 255.0;
-    if (scaled - scaled.floor() - 0.5).abs() < 1e-9 {
-        return None;
-    }
-    Some((scaled + 0.5).floor() as u8)
+    assert!((scaled - scaled.floor() - 0.5).abs() > 1e-12, "{linear:e} is too near a boundary to decide");
+    (scaled + 0.5).floor() as u8
 }
 
+/// The RGBA8 encoder, through the slice encoder the packer runs (AVX2 where the CPU has
+/// it) and the scalar one, on every f32 in `[0, 1]` (1,065,353,217 values) in every
+/// channel. Alpha against the f32 product `x · 255` rounded half away from zero (the
+/// linear 8-bit unorm the encoder has always written). RGB against the f64 transfer function: both it and the
+/// encoder are monotonic, so checking that the encoder's code never falls, never rises by
+/// more than one between neighbouring f32s, starts at the exact code of 0, and equals the
+/// exact code on both sides of every rise, proves it equal to the exact code on every f32
+/// (between two rises both are constant). The decoded copy against the f64 decode.
 #[test]
-fn srgb8_lookup_equals_the_exact_formula_on_every_f32_that_matters() {
-    // Every 61st f32 bit pattern in [0, 1] (17 M values, all exponents and mantissas) …
+fn srgb8_encoder_equals_the_exact_formula_on_every_f32_in_0_1() {
+    use rayon::prelude::*;
     let one = 1.0f32.to_bits();
-    let mut checked = 0u64;
-    let mut check = |x: f32| {
-        if let Some(want) = exact_srgb8(x) {
-            assert_eq!(encode_srgb8(x), want, "{x:e} ({:#010x})", x.to_bits());
-            checked += 1;
-        }
-    };
-    for bits in (0..=one).step_by(61) {
-        check(f32::from_bits(bits));
-    }
-    // … and every f32 within 64 ulps of each of the 255 rounding boundaries, where a table
-    // could be off by one (the boundaries themselves from the f64 inverse function).
-    for b in 0..255u32 {
-        let encoded = (f64::from(b) + 0.5) / 255.0;
-        let boundary = if encoded <= 0.040_45 { encoded / 12.92 } else { ((encoded + 0.055) / 1.055).powf(2.4) };
-        let mut x = boundary as f32;
-        for _ in 0..64 {
-            x = x.next_down();
-        }
-        for _ in 0..128 {
-            check(x);
-            x = x.next_up();
-        }
-    }
-    assert!(checked > 17_000_000, "{checked}");
-    // Alpha: linear 8-bit unorm, rounded half away from zero, on the same stride.
-    for bits in (0..=one).step_by(61).chain([0.5f32 / 255.0, 1.5 / 255.0, 254.5 / 255.0].map(f32::to_bits)) {
-        let a = f32::from_bits(bits);
-        let want = (a * 255.0).round() as u8;
-        assert_eq!(meshpaint_core::colors::format::encode_rgba8_srgb([0.0, 0.0, 0.0, a])[3], want, "alpha {a:e}");
-    }
-    assert_eq!(encode_srgb8(1.0), 255);
+    let decode: Vec<f32> = (0..256)
+        .map(|b| {
+            let e = f64::from(b) / 255.0;
+            (if e <= 0.040_45 { e / 12.92 } else { ((e + 0.055) / 1.055).powf(2.4) }) as f32
+        })
+        .collect();
+    const CHUNK: u32 = 1 << 16;
+    let rises: u32 = (0..=one / CHUNK)
+        .into_par_iter()
+        .map(|chunk| {
+            // Each chunk starts one f32 early, so the rise between chunks is inside one.
+            let first = (chunk * CHUNK).saturating_sub(1);
+            let end = ((chunk + 1) * CHUNK).min(one + 1);
+            let values: Vec<f32> = (first..end).map(f32::from_bits).collect();
+            let colors: Vec<[f32; 4]> = values.iter().map(|&x| [x; 4]).collect();
+            let mut bytes = vec![0u8; 4 * colors.len()];
+            let mut decoded = vec![[0.0f32; 4]; colors.len()];
+            ColorFormat::Rgba8Srgb.encode_quantized_slice(&colors, &mut bytes, &mut decoded);
+            let mut rises = 0;
+            for (i, (&x, code)) in values.iter().zip(bytes.chunks_exact(4)).enumerate() {
+                let alpha = (x * 255.0).round() as u8;
+                assert_eq!(code[3], alpha, "alpha {x:e}");
+                assert_eq!(decoded[i][3].to_bits(), ((f64::from(alpha) / 255.0) as f32).to_bits(), "{x:e}");
+                assert!(code[0] == code[1] && code[1] == code[2], "{x:e}: {code:?}");
+                assert_eq!(encode_srgb8(x), code[0], "scalar {x:e}");
+                assert_eq!(decoded[i][0].to_bits(), decode[usize::from(code[0])].to_bits(), "{x:e}");
+                if i == 0 {
+                    continue;
+                }
+                let before = bytes[4 * (i - 1)];
+                assert!(
+                    code[0] == before || code[0] == before + 1,
+                    "{x:e} ({:#010x}): {before} → {}",
+                    x.to_bits(),
+                    code[0]
+                );
+                if code[0] != before {
+                    assert_eq!(exact_srgb8(values[i - 1]), before, "below the rise at {x:e}");
+                    assert_eq!(exact_srgb8(x), code[0], "at the rise at {x:e}");
+                    rises += 1;
+                }
+            }
+            rises
+        })
+        .sum();
+    assert_eq!(rises, 255, "every code from 0 to 255 reached in steps of one");
+    assert_eq!(exact_srgb8(0.0), 0);
     assert_eq!(encode_srgb8(0.0), 0);
+    assert_eq!(encode_srgb8(f32::NAN), 0);
+    assert_eq!(encode_srgb8(-1.0), 0);
+    assert_eq!(encode_srgb8(7.0), 255);
 }
