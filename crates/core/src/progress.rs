@@ -25,9 +25,12 @@ use thiserror::Error;
 #[error("cancelled")]
 pub struct Cancelled;
 
+/// What a [`Reporter`] hands each report to: `(fraction of the whole, stage)`.
+type Sink<'a> = Box<dyn Fn(f32, &str) + Send + Sync + 'a>;
+
 /// The sink of an operation's progress and its cancel flag (module docs).
 pub struct Reporter<'a> {
-    sink: Box<dyn Fn(f32, &str) + Send + Sync + 'a>,
+    sink: Sink<'a>,
     cancelled: AtomicBool,
     /// The caller's own cancel flag, if it keeps one (an editor job's).
     external: Option<&'a AtomicBool>,
