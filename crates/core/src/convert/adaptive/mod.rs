@@ -3,11 +3,24 @@
 //! # Rules ([`ResolutionRule`])
 //!
 //! - **Uniform** `R` on every face (the first round's behaviour).
-//! - **Texel density**: `R_f` = the smallest power of two ≥ the face's longest UV edge in
-//!   texels of the base-colour texture's level 0 (one sample per texel along that edge),
-//!   capped at `max`. Faces without a texture get `R = 1` (their colour is one constant).
-//! - **Error bound** `E`: `R_f` = the lowest power of two (up to `max`) whose
-//!   reconstruction stays within `E` of the texture on the face.
+//! - **Texel density**: about one sample per texel the face covers: of the two powers of
+//!   two around `√(2A)` (`A` the face's UV area in texels of the base-colour texture's
+//!   level 0; a face at `R` holds about `R²/2` samples), the one whose `R²/2` is nearer `A`,
+//!   at most `max`. Faces without a texture get `R = 1` (their colour is one constant).
+//! - **Error bound** `E`: `R_f` = the lowest power of two (up to the face's content cap)
+//!   whose reconstruction stays within `E` of the texture on the face.
+//! - **Budget** `N`: the resolutions with the least area-weighted squared error that hold at
+//!   most `N` samples (below).
+//!
+//! # The content cap
+//!
+//! No rule tries a face past its *content cap*: two samples a texel along its longest UV
+//! edge (`2·T`, `T` the smallest power of two ≥ that edge in texels), at least 8, at most
+//! `max`. Finer, a sample spacing is under half a texel of a bilinear texture and the error
+//! cannot fall by more than rounding. So `max` defaults to the layout's largest
+//! ([`Resolution::MAX`]): a logo on a large face gets the `R` its texels need (within a
+//! budget), a small face stops where its texels do, and every face's trials grow with the
+//! texels it covers rather than with `max²`.
 //!
 //! # The error of a face at `R` (the metric behind `--error E`)
 //!
@@ -15,9 +28,11 @@
 //! texture read trilinearly at the level matched to the sample spacing, in linear light,
 //! times the base-colour factor), and reconstructed with the linear filter (eq. 2.4) at
 //! the centroids of the `D²` sub-triangles of a denser lattice `D` — the *test points*,
-//! `D` = twice the smallest power of two ≥ the face's longest UV edge in texels, at least
-//! 8, at least `2R` and at most `2·max`, so every texel the face covers holds several
-//! points and so does every strip one sample spacing wide along an edge (where a UV seam's
+//! `D` = the smallest power of two ≥ the face's longest UV edge in texels, at least
+//! 8, at least `2R` and at most `2·max`, so every texel the face covers holds two or more
+//! points (twice that `D`, eight or more a texel, cost four times as much; the Duck's and
+//! the Fox's rows moved by under 0.1 dB, docs/ADAPTIVE.md) and so does every strip one sample spacing
+//! wide along an edge (where a UV seam's
 //! foreign colours fade out: with `D` from the texture alone, faces under a texel were
 //! tested on a lattice of 8 at every `R`, and at `R ≥ 32` the strip held no point). The truth
 //! at a test point is the texture's level 0 read bilinearly there (what a magnified UV
@@ -42,11 +57,14 @@
 //! error bound is verified on the store as fitted ([`bake_and_verify`]).
 //!
 //! A **budget** allocation for the least-squares bake measures what the fit shows instead:
-//! the whole mesh is baked and fitted at each uniform `R` whose sample count is at most
-//! [`CALIBRATION_FACTOR`] × the budget (counted before the store is allocated), and each
-//! face's error at that `R` is measured on that store (its neighbours at the same `R`, as the
-//! fit balances shared samples between them). Above the finest such `R`, a face's point-bake
-//! error is scaled by the gain its fit made there. (A face fitted alone, every sample free,
+//! the whole mesh is baked and fitted at the three finest uniform `R` whose sample count is
+//! at most [`CALIBRATION_FACTOR`] × the budget (counted before the store is allocated), and
+//! each face's error at that `R` is measured on that store (its neighbours at the same `R`,
+//! as the fit balances shared samples between them). At the other levels, a face's
+//! point-bake error is scaled by the gain its fit made at the nearest calibrated level.
+//! (Every level was calibrated before: on a 50k-triangle asset, one fit each was most of
+//! the time; the finest level alone missed the coarse levels' gains where small budgets put
+//! faces, and the Fox at a third of uniform R = 4's samples fell below it.) (A face fitted alone, every sample free,
 //! predicts far too little error at low `R`, where the global fit cannot give each face its
 //! own vertices: Fox's budget rows fell from 26.6–51.0 dB to 22.2–31.8 dB with it.)
 //!
