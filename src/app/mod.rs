@@ -12,7 +12,7 @@
 //! |---|---|---|
 //! | 7 | [`window`] | winit event loop, surface, egui-winit / egui-wgpu, offscreen 3D view, redraw scheduling |
 //! | 6 | [`view_draw`] | the 3D view drawn into its offscreen target: whole, or after paint uploads only the faces that changed (partial redraw) |
-//! | 5 | [`editor`], [`editor_settings`], [`editor_export`] | [`Editor`]: the document, camera, panels, 3D view state, status, jobs; one frame of UI ([`Editor::ui`]); every [`Action`] ([`Editor::perform`]) and [`command::Command`] ([`Editor::apply`]) carried out; finished jobs applied by [`jobs::JobKind`]; open and quit ask Save / Don't save / Cancel while changes are unsaved; the settings remembered between runs read from and written to the panels; File → Export… carried out |
+//! | 5 | [`editor`], [`editor_settings`], [`editor_export`], [`editor_jobs`] | [`Editor`]: the document, camera, panels, 3D view state, status, jobs; one frame of UI ([`Editor::ui`]); every [`Action`] ([`Editor::perform`]) and [`command::Command`] ([`Editor::apply`]) carried out; finished jobs applied by [`jobs::JobKind`] (a failed or cancelled one: [`editor_jobs`]); open and quit ask Save / Don't save / Cancel while changes are unsaved; the settings remembered between runs read from and written to the panels; File → Export… carried out |
 //! | 4 | [`paint`] | paint-mode commands on the document: strokes, live GPU upload, undo / redo, eyedropper, fill, resolution, Optimize, radius / strength gestures, brush cursor |
 //! | 3 | [`panels`], [`job_output`] | each panel a type that owns its state and draws itself, returning commands (menu, status line, file, export, import settings, autosave, view, paint, optimize, undo, scene, help, 3D view area); what jobs produce |
 //! | 2 | [`session`], [`input`], [`autosave`], [`file_dialog`] | the document being edited ([`session::DocumentState`]: open document, paint session, undo history); all input (shortcuts [`input::SHORTCUTS`], 3D-view navigation, the brush's pointer); autosave state; an egui file browser |
@@ -31,6 +31,7 @@ pub mod command;
 pub mod document;
 pub mod editor;
 pub mod editor_export;
+pub mod editor_jobs;
 pub mod editor_settings;
 pub mod export;
 pub mod file_dialog;
