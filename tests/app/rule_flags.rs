@@ -48,7 +48,8 @@ fn every_rule_flag_gives_the_library_rules_sample_count_in_every_command() {
     // A small textured model keeps this test fast; the rules' quality is tested in adaptive.rs.
     let file = model("BoxTextured/BoxTextured.glb");
     let file_arg = file.to_str().unwrap();
-    let max = Resolution::new(64).unwrap();
+    // The commands' default largest R: the layout's (each face stops at its content cap).
+    let max = Resolution::MAX;
     let dir = TempDir::new("rule-flags");
     let uniform = library_counts(&file, ResolutionRule::Uniform(Resolution::new(8).unwrap()));
     let cases: [(&[&str], ResolutionRule); 3] = [
