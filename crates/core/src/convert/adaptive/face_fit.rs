@@ -75,13 +75,19 @@ pub(super) struct FaceFit<'a> {
     points: std::borrow::Cow<'a, [TestPoint]>,
 }
 
-/// The test lattice of a face of `material` from the texture alone: twice its longest UV
-/// edge in texels (a power of two: at least two points a texel the face covers), at least
-/// 8, at most `2·max`.
+/// The test lattice of a face of `material` from the texture alone: its longest UV edge in
+/// texels (a power of two: at least two points a texel the face covers), at least 8, at
+/// most `2·max` and at most [`MAX_TEST_LATTICE`].
 pub(super) fn dense_lattice(material: &FaceMaterial, max: Resolution) -> u32 {
     let texels = power_of_two_at_least(material.longest_uv_edge_texels, Resolution::MAX).get();
-    texels.clamp(8, 2 * max.get())
+    texels.clamp(8, 2 * max.get()).min(MAX_TEST_LATTICE)
 }
+
+/// The test lattice at most (65,536 points a face): a face of thousands of texels a side
+/// (a logo on a truck's side) is tested on a sample of its texels, not on every one, so
+/// its trials at each level cost what a 256-texel face's do (the seam strips still get
+/// their own points at every `R`).
+pub(super) const MAX_TEST_LATTICE: u32 = 256;
 
 impl<'a> FaceFit<'a> {
     /// The test points of the `dense` lattice, to give a later fit of the same face.
