@@ -655,7 +655,7 @@ struct GltfLayout {
 
 /// The glTF JSON describing the binary chunk laid out as `layout` says.
 fn gltf_root(layout: GltfLayout) -> json::Root {
-    use json::accessor::{ComponentType, GenericComponentType, Type};
+    use json::accessor::{ComponentType, Type};
     use json::buffer::Target;
 
     let mut root = json::Root {
@@ -686,21 +686,6 @@ fn gltf_root(layout: GltfLayout) -> json::Root {
     let colors_view = view(&mut root, layout.colors_offset, layout.indices_offset, Target::ArrayBuffer);
     let indices_view = view(&mut root, layout.indices_offset, layout.buffer_length, Target::ElementArrayBuffer);
 
-    let accessor =
-        |view, count: usize, component: ComponentType, ty: Type, bounds: Option<([f32; 3], [f32; 3])>| json::Accessor {
-            buffer_view: Some(view),
-            byte_offset: None,
-            count: USize64::from(count),
-            component_type: Valid(GenericComponentType(component)),
-            extensions: None,
-            extras: Default::default(),
-            type_: Valid(ty),
-            min: bounds.map(|(min, _)| json::Value::from(min.to_vec())),
-            max: bounds.map(|(_, max)| json::Value::from(max.to_vec())),
-            name: None,
-            normalized: false,
-            sparse: None,
-        };
     let positions = root.push(accessor(
         positions_view,
         layout.vertices,
@@ -789,4 +774,30 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
         action: error.action,
         source: error.source,
     })
+}
+
+/// A glTF accessor of `count` elements of `ty` / `component` in buffer view `view`, with
+/// `bounds` as its min and max (positions need them); the one builder every glTF writer
+/// of this folder uses.
+pub(crate) fn accessor(
+    view: json::Index<json::buffer::View>,
+    count: usize,
+    component: json::accessor::ComponentType,
+    ty: json::accessor::Type,
+    bounds: Option<([f32; 3], [f32; 3])>,
+) -> json::Accessor {
+    json::Accessor {
+        buffer_view: Some(view),
+        byte_offset: None,
+        count: USize64::from(count),
+        component_type: Valid(json::accessor::GenericComponentType(component)),
+        extensions: None,
+        extras: Default::default(),
+        type_: Valid(ty),
+        min: bounds.map(|(min, _)| json::Value::from(min.to_vec())),
+        max: bounds.map(|(_, max)| json::Value::from(max.to_vec())),
+        name: None,
+        normalized: false,
+        sparse: None,
+    }
 }

@@ -85,20 +85,7 @@ impl Writer {
         use json::buffer::Target;
         let target = if ty == json::accessor::Type::Scalar { Target::ElementArrayBuffer } else { Target::ArrayBuffer };
         let view = self.view(bytes, Some(target));
-        self.root.push(json::Accessor {
-            buffer_view: Some(view),
-            byte_offset: None,
-            count: USize64::from(count),
-            component_type: Valid(json::accessor::GenericComponentType(component)),
-            extensions: None,
-            extras: Default::default(),
-            type_: Valid(ty),
-            min: bounds.map(|(min, _)| json::Value::from(min.to_vec())),
-            max: bounds.map(|(_, max)| json::Value::from(max.to_vec())),
-            name: None,
-            normalized: false,
-            sparse: None,
-        })
+        self.root.push(super::export_gltf::accessor(view, count, component, ty, bounds))
     }
 
     fn texture(&mut self, texture: &Texture) -> Result<json::Index<json::Texture>, ExportError> {

@@ -158,7 +158,7 @@ fn root(
     indices: usize,
     (min, max): ([f32; 3], [f32; 3]),
 ) -> json::Root {
-    use json::accessor::{ComponentType, GenericComponentType, Type};
+    use json::accessor::{ComponentType, Type};
     use json::buffer::Target;
 
     let mut root = json::Root {
@@ -197,20 +197,7 @@ fn root(
         .collect();
     let mut accessor =
         |view, count: usize, component: ComponentType, ty: Type, bounds: Option<([f32; 3], [f32; 3])>| {
-            root.push(json::Accessor {
-                buffer_view: Some(view),
-                byte_offset: None,
-                count: USize64::from(count),
-                component_type: Valid(GenericComponentType(component)),
-                extensions: None,
-                extras: Default::default(),
-                type_: Valid(ty),
-                min: bounds.map(|(min, _)| json::Value::from(min.to_vec())),
-                max: bounds.map(|(_, max)| json::Value::from(max.to_vec())),
-                name: None,
-                normalized: false,
-                sparse: None,
-            })
+            root.push(super::export_gltf::accessor(view, count, component, ty, bounds))
         };
     let positions = accessor(view_ids[0], vertices, ComponentType::F32, Type::Vec3, Some((min, max)));
     let normals = accessor(view_ids[1], vertices, ComponentType::F32, Type::Vec3, None);
