@@ -685,7 +685,6 @@ fn gltf_root(layout: GltfLayout) -> json::Root {
     let normals_view = view(&mut root, layout.normals_offset, layout.colors_offset, Target::ArrayBuffer);
     let colors_view = view(&mut root, layout.colors_offset, layout.indices_offset, Target::ArrayBuffer);
     let indices_view = view(&mut root, layout.indices_offset, layout.buffer_length, Target::ElementArrayBuffer);
-
     let positions = root.push(accessor(
         positions_view,
         layout.vertices,
@@ -776,9 +775,7 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
     })
 }
 
-/// A glTF accessor of `count` elements of `ty` / `component` in buffer view `view`, with
-/// `bounds` as its min and max (positions need them); the one builder every glTF writer
-/// of this folder uses.
+/// The accessor of `count` `ty`s in `view` (min / max: `bounds`), for every glTF writer here.
 pub(crate) fn accessor(
     view: json::Index<json::buffer::View>,
     count: usize,
