@@ -10,6 +10,7 @@ mod follow_brush;
 mod fuzz;
 mod hard_edge;
 mod import;
+mod layers;
 mod layout;
 mod least_squares;
 mod mct;
