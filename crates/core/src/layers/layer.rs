@@ -187,5 +187,5 @@ pub(super) fn check_name(name: &str) -> Result<(), LayerError> {
 
 /// `opacity` made valid: clamped to `[0, 1]`, NaN becomes 0.
 pub(super) fn valid_opacity(opacity: f32) -> f32 {
-    opacity.max(0.0).min(1.0)
+    if opacity.is_nan() { 0.0 } else { opacity.clamp(0.0, 1.0) }
 }

@@ -2,7 +2,8 @@
 //! visibility, opacity, blend mode ([`blend`]), content and an optional paintable mask
 //! ([`layer`]); the composite that renders, packs and exports, computed sample by sample and
 //! kept up to date through dirty elements ([`compose`], [`stack`]); layer operations and
-//! their undo in one history with the paint steps ([`ops`], `history`).
+//! their undo in one history with the paint steps ([`ops`], `history`); the stack in the
+//! packed file's layers section ([`file`]).
 //!
 //! Layers are *material layers spanning channels* (as Substance's fill and paint layers):
 //! one mask, visibility and place in the stack for everything a material changes. Every
@@ -12,6 +13,7 @@
 
 pub mod blend;
 pub mod compose;
+pub mod file;
 mod history;
 pub mod layer;
 pub mod ops;

@@ -107,7 +107,7 @@ fn random_stack(seed: u64, base: &ColorStore) -> LayerStack {
         if n % 2 == 1 {
             stack.add_mask(index, 1.0, None).unwrap();
             paint(&mut stack, PaintTarget::Mask, || {
-                let m = if rng.next() % 4 == 0 { 0.0 } else { rng.unit() };
+                let m = if rng.next().is_multiple_of(4) { 0.0 } else { rng.unit() };
                 [m, m, m, 1.0]
             });
         }
@@ -161,7 +161,7 @@ fn one_normal_layer_composites_bit_exactly() {
     base.write_all(|_| {
         let mut c = rng.color();
         c[0] *= 100.0;
-        if rng.next() % 3 == 0 {
+        if rng.next().is_multiple_of(3) {
             c[3] = 0.0;
         }
         c

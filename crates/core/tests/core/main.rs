@@ -11,6 +11,7 @@ mod fuzz;
 mod hard_edge;
 mod import;
 mod layers;
+mod layers_file;
 mod layout;
 mod least_squares;
 mod mct;
