@@ -47,8 +47,18 @@ impl LayerStack {
         Ok(())
     }
 
-    /// Applies `op` and returns the operation that reverses it.
+    /// Applies `op` and returns the operation that reverses it. The active layer stays the
+    /// same layer when it is still in the stack (else the one now at its place, or the top one).
     fn apply(&mut self, op: Op) -> Result<Op, LayerError> {
+        let active_id = self.layers.get(self.active).map(|layer| layer.id);
+        let inverse = self.apply_op(op)?;
+        let fallback = self.active.min(self.layers.len().saturating_sub(1));
+        self.active = self.layers.iter().position(|layer| Some(layer.id) == active_id).unwrap_or(fallback);
+        Ok(inverse)
+    }
+
+    /// [`LayerStack::apply`] without the active layer's bookkeeping.
+    fn apply_op(&mut self, op: Op) -> Result<Op, LayerError> {
         if op.changes_composite() {
             self.all_dirty = true;
         }
@@ -59,10 +69,6 @@ impl LayerStack {
                     return Err(LayerError::NoSuchLayer { index, count });
                 }
                 self.layers.insert(index, *layer);
-                if self.active >= index && count > 0 {
-                    self.active += 1;
-                }
-                self.active = self.active.min(self.layers.len() - 1);
                 Op::Remove { index }
             }
             Op::Remove { index } => {
@@ -71,9 +77,6 @@ impl LayerStack {
                     return Err(LayerError::LastLayer);
                 }
                 let removed = self.layers.remove(index);
-                if self.active > index || self.active == self.layers.len() {
-                    self.active = self.active.saturating_sub(1);
-                }
                 Op::Insert { index, layer: Box::new(removed) }
             }
             Op::Move { from, to } => {
@@ -81,9 +84,6 @@ impl LayerStack {
                 self.check_index(to)?;
                 let moved = self.layers.remove(from);
                 self.layers.insert(to, moved);
-                if self.active == from {
-                    self.active = to;
-                }
                 Op::Move { from: to, to: from }
             }
             Op::Opacity { index, opacity } => {

@@ -289,6 +289,27 @@ fn undo_and_redo_of_layer_operations_and_paint_are_bit_exact() {
 }
 
 #[test]
+fn the_active_layer_stays_the_same_layer_across_operations() {
+    let mut stack = LayerStack::from_store(&mixed_store());
+    for name in ["a", "b", "c"] {
+        stack.add_layer(name, None).unwrap();
+    }
+    let name = |s: &LayerStack| s.layers()[s.active()].name().to_owned();
+    stack.set_active(2).unwrap();
+    assert_eq!(name(&stack), "b");
+    stack.move_layer(3, 0).unwrap();
+    assert_eq!(name(&stack), "b", "a reorder around it");
+    stack.delete_layer(0).unwrap();
+    assert_eq!(name(&stack), "b", "a delete below it");
+    stack.delete_layer(stack.active()).unwrap();
+    assert_eq!(name(&stack), "a", "deleting it (the top layer): the one below");
+    stack.undo().unwrap();
+    stack.undo().unwrap();
+    stack.undo().unwrap();
+    assert_eq!(stack.layers().len(), 4);
+}
+
+#[test]
 fn layer_operations_refuse_what_they_cannot_do() {
     let mut stack = LayerStack::from_store(&mixed_store());
     assert!(stack.delete_layer(0).is_err(), "the last layer stays");
