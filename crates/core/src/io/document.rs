@@ -239,6 +239,25 @@ impl ConversionReport {
     }
 }
 
+/// Bakes the texture into `store` (fitted by `fit`, verified for an error bound) and measures
+/// the result against the texture, recording both in `phases`.
+fn bake_and_measure(
+    store: &mut ColorStore,
+    welded: &crate::mesh::weld::WeldedMesh,
+    scene: &Scene,
+    (rule, fit): (ResolutionRule, BakeFit),
+    phases: &mut OpenPhases,
+    progress: crate::progress::Progress<'_>,
+) -> Result<(), crate::progress::Cancelled> {
+    let baking = Instant::now();
+    crate::convert::adaptive::bake_and_verify_with(store, welded, scene, rule, fit, progress.part(0.0, 0.9))?;
+    phases.bake = baking.elapsed();
+    let measuring = Instant::now();
+    phases.texture_psnr_db = crate::convert::adaptive::texture_psnr(store, welded, scene, progress.part(0.9, 1.0))?;
+    phases.measure = measuring.elapsed();
+    Ok(())
+}
+
 /// A smooth, deterministic colour field over the bounding box that shows the shape and the
 /// resolution of a mesh: three sine waves of different frequency per channel
 /// ([`position_colored`]; a view option, untextured meshes open in a neutral colour).
@@ -610,15 +629,7 @@ impl Document {
         let mut store = ColorStore::with_resolutions(topology, resolutions, uniform.unwrap_or([1.0; 4]))
             .map_err(|source| DocumentError::Store { path: name.to_owned(), source })?;
         if has_base_color {
-            let baking = Instant::now();
-            crate::convert::adaptive::bake_and_verify_with(&mut store, &welded, &scene, rule, fit, bake.part(0.0, 0.9))
-                .map_err(cancelled)?;
-            phases.bake = baking.elapsed();
-            let measuring = Instant::now();
-            phases.texture_psnr_db =
-                crate::convert::adaptive::texture_psnr(&store, &welded, &scene, bake.part(0.9, 1.0))
-                    .map_err(cancelled)?;
-            phases.measure = measuring.elapsed();
+            bake_and_measure(&mut store, &welded, &scene, (rule, fit), phases, bake).map_err(cancelled)?;
         } else if neutral && uniform.is_none() {
             fill_neutral(&mut store, &welded.triangle_materials, &scene);
         }
