@@ -21,6 +21,7 @@ mod packer;
 mod paint_layout;
 mod picking;
 mod progress;
+mod ptex;
 mod repack;
 mod seams;
 mod store;
