@@ -23,6 +23,7 @@ mod formats;
 mod gpu_render;
 mod mct_file;
 mod production_assets;
+mod ptex_cli;
 mod rule_flags;
 mod trade;
 mod validator;

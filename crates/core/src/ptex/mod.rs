@@ -25,6 +25,7 @@
 //! | [`layout`] | blocks (pairs), the face record, sorting by resolution, the `nRes` / `nRow` tables and the atlas width |
 //! | [`mod@build`] | texels from the packed mesh (reference sampler) and the borders copied from the neighbours |
 //! | [`sample`] | the CPU evaluation of hardware bilinear and of the paper's trilinear (two levels, per-pixel level of detail) |
+//! | [`file`] | the packed Ptex file (`docs/PTEX_FORMAT.md`): mesh, records, tables and texture in one checked, checksummed file |
 //!
 //! What is exact (tests in `crates/core/tests/core/ptex.rs`): every interior texel is the
 //! reference at its centre; a border texel across an edge between blocks of the same
@@ -34,6 +35,7 @@
 //! piecewise-linear filter: both measured, not hidden.
 
 pub mod build;
+pub mod file;
 pub mod layout;
 pub mod sample;
 

@@ -174,6 +174,19 @@ fn a_short_mct_campaign_finds_no_crash_and_reaches_the_content_checks() {
     assert!(kinds >= 20, "only {kinds} kinds of refusal\n{}", report.text());
 }
 
+#[test]
+fn a_short_ptex_campaign_finds_no_crash_and_reaches_the_content_checks() {
+    let report = run(&campaign(Target::Ptex, 20_261_207, 4000, "ptex"));
+    assert!(report.crashes.is_empty(), "{}", report.text());
+    let total: u64 = report.outcomes.values().sum();
+    assert_eq!(total, 4000, "{}", report.text());
+    let checksum = count(&report.outcomes, "refused: ChecksumMismatch");
+    let accepted = count(&report.outcomes, "accepted");
+    assert!(checksum * 10 < total, "{checksum} of {total} mutants stop at the checksum\n{}", report.text());
+    assert!(accepted * 50 > total, "only {accepted} of {total} mutants are accepted\n{}", report.text());
+    assert!(count(&report.outcomes, "refused: Content") > 0, "the content checks are reached\n{}", report.text());
+}
+
 /// Regression fixtures: inputs the fuzzer once crashed on (tests/fixtures/fuzz/), each
 /// run through its target's full oracle, with the outcome it must have now.
 #[test]

@@ -22,6 +22,7 @@ mod paint_layout;
 mod picking;
 mod progress;
 mod ptex;
+mod ptex_file;
 mod repack;
 mod seams;
 mod store;

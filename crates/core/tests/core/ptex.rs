@@ -183,6 +183,10 @@ fn tables_are_the_counts_and_blocks_tile_the_texture_without_overlap() {
     assert!(waste < 0.25, "unused {waste}");
 }
 
+/// A block side: its start and end vertex, the face owning it and its border texel of index
+/// `i` at resolution `n`.
+type Side = (u32, u32, u32, fn(i64, i64) -> [i64; 2]);
+
 /// For every border texel, the texel of the neighbour's block (at the same level of detail)
 /// whose centre is this one mirrored across the shared edge, found by searching the whole
 /// neighbour block: bytes equal where both blocks have the same resolution.
@@ -205,7 +209,7 @@ fn borders_are_the_neighbours_texels_across_the_edge() {
         for (bi, block) in layout.blocks.iter().enumerate() {
             let [t1, p, t2, q] = block.corners;
             // (start, end, owner, border texel of index i at resolution n).
-            let sides: [(u32, u32, u32, fn(i64, i64) -> [i64; 2]); 4] = [
+            let sides: [Side; 4] = [
                 (t1, p, block.faces[0], |i, _| [i, -1]),
                 (p, t2, block.faces[1], |i, n| [n, i]),
                 (q, t2, block.faces[1], |i, n| [i, n]),
