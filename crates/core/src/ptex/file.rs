@@ -391,7 +391,10 @@ pub fn from_bytes(bytes: &[u8]) -> Result<PtexFile, PtexFileError> {
     let format = ColorFormat::from_code(header.format_code)
         .ok_or_else(|| PtexFileError::Header(format!("unknown colour format {}", header.format_code)))?;
     let [vertices, faces, blocks] = header.counts.map(u64::from);
-    let texels = u64::from(header.width) * u64::from(header.height) * format.bytes_per_sample() as u64;
+    // Sides are not checked yet (the content checks come later): saturate, never overflow.
+    let texels = u64::from(header.width)
+        .saturating_mul(u64::from(header.height))
+        .saturating_mul(format.bytes_per_sample() as u64);
     let expected = [vertices * 16, faces * 12, faces * 4, TABLES_SIZE, texels];
     for ((section, name), want) in header.sections.iter().zip(SECTION_NAMES).zip(expected) {
         if section.length != want {

@@ -191,12 +191,20 @@ fn a_short_ptex_campaign_finds_no_crash_and_reaches_the_content_checks() {
 /// run through its target's full oracle, with the outcome it must have now.
 #[test]
 fn former_fuzz_crashes_are_handled() {
-    let expected = [(
-        // Finite positions and transforms whose product overflows f32: welded world
-        // positions were infinite and the packed writer refused the imported document.
-        "gltf-world-position-overflows-to-infinity.glb",
-        "imported, refused: NonFiniteWorldPosition",
-    )];
+    let expected = [
+        (
+            // Finite positions and transforms whose product overflows f32: welded world
+            // positions were infinite and the packed writer refused the imported document.
+            "gltf-world-position-overflows-to-infinity.glb",
+            "imported, refused: NonFiniteWorldPosition",
+        ),
+        (
+            // A packed Ptex header of sides near 2^32: the texel byte count overflowed u64
+            // before the sides were checked.
+            "ptex-texture-size-overflows.ptx",
+            "refused: Header",
+        ),
+    ];
     let dir = common::workspace_path("tests/fixtures/fuzz");
     let mut files: Vec<String> =
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
@@ -209,6 +217,7 @@ fn former_fuzz_crashes_are_handled() {
         let found = match name.rsplit('.').next() {
             Some("mpk") => harness::packed::run(&bytes),
             Some("mct") => harness::mct_file::run(&bytes),
+            Some("ptx") => harness::ptex_file::run(&bytes),
             Some("glb") => harness::gltf::run(&bytes, true, 2),
             _ => harness::gltf::run(&bytes, false, 2),
         };
