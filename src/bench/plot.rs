@@ -265,8 +265,8 @@ pub fn plot_tradeoff(
         );
     }
     root.draw(&Text::new(
-        "colour: filter · circle: mesh colors, square: MCT · filled rgba8, hollow rgba16f, hollow with a dot rgba32f · \
-         labelled: the Pareto front of both",
+        "colour: filter · circle: mesh colors, square: MCT, triangle: packed Ptex · filled rgba8, hollow rgba16f, \
+         hollow with a dot rgba32f · labelled: the Pareto front of all",
         (90, 872),
         (FONT, 17).into_font(),
     ))
