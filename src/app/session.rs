@@ -234,6 +234,10 @@ pub fn opened_text(document: &OpenDocument, elapsed: Duration) -> String {
         thousands(document.samples),
         elapsed.as_secs_f64()
     );
+    // The conversion's rule and PSNR against the texture, and the faces the budget held.
+    if let Some(conversion) = document.document.conversion.as_ref().filter(|c| c.texture_psnr_db.is_some()) {
+        text.push_str(&format!("; {}", conversion.summary()));
+    }
     let notes = &document.document.warnings;
     match notes.as_slice() {
         [] => {}

@@ -135,6 +135,8 @@ pub(super) enum BenchCommand {
         /// row beside each R ≥ 4, texel density and error bounds 0.05…0.0025.
         #[arg(long, value_delimiter = ',')]
         rules: Vec<String>,
+        #[command(flatten)]
+        close_up: CloseUpArgs,
     },
     /// What every choice costs and buys: representation (mesh colors, Mesh Color Texture) ×
     /// filter × resolution (uniform R 1…32 and --error bounds) × colour format, per view at
@@ -303,8 +305,16 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             Ok(())
         }
         BenchCommand::Trade(args) => trade(&args),
-        BenchCommand::Adaptive { file, max_resolution, size, views, supersample, bake, rules } => {
-            adaptive(file, max_resolution, size, views, supersample, bake, rules)
+        BenchCommand::Adaptive { file, max_resolution, size, views, supersample, bake, rules, close_up } => {
+            let options = meshpaint::bench::adaptive::AdaptiveOptions {
+                budget_max: None,
+                size,
+                views,
+                supersample,
+                fits: bake.iter().map(|&b| b.into()).collect(),
+                close_up: close_up.get()?,
+            };
+            adaptive(file, max_resolution, options, rules)
         }
         BenchCommand::Pack { file, resolution, format, runs, subdivide, stroke_samples } => {
             pack(file, resolution, format, runs, subdivide, stroke_samples)
@@ -363,10 +373,8 @@ fn unwrap(file: &std::path::Path, size: u32, subdivide: u32) -> Result<()> {
 fn trade(args: &TradeArgs) -> Result<()> {
     let options = args.options()?;
     let file = &args.file;
-    let rows = meshpaint::bench::trade::bench_trade(file, &options)?;
-    for row in &rows {
-        println!("{row}");
-    }
+    // One line per row as soon as its view is measured.
+    let rows = meshpaint::bench::trade::bench_trade_streaming(file, &options, &mut |row| println!("{row}"))?;
     if !args.no_extremes {
         let gpu = meshpaint_render::Gpu::new_headless()?;
         for mut row in meshpaint::bench::extremes::extremes_rows(&gpu)? {
@@ -388,10 +396,7 @@ fn trade(args: &TradeArgs) -> Result<()> {
 fn adaptive(
     file: PathBuf,
     max_resolution: u64,
-    size: u32,
-    views: u32,
-    supersample: u32,
-    bake: Vec<BakeArg>,
+    mut options: meshpaint::bench::adaptive::AdaptiveOptions,
     rules: Vec<String>,
 ) -> Result<()> {
     let max = meshpaint_core::colors::layout::Resolution::new(max_resolution).context("--max-resolution")?;
@@ -400,14 +405,8 @@ fn adaptive(
         .map(|rule| meshpaint::bench::adaptive::parse_rule(rule, max).map_err(|err| anyhow::anyhow!("--rules {err}")))
         .collect::<Result<Vec<_>>>()?;
     let scene = meshpaint_core::mesh::import::import_gltf(&file)?;
-    let fits: Vec<BakeFit> = bake.iter().map(|&b| b.into()).collect();
-    let options = meshpaint::bench::adaptive::AdaptiveOptions {
-        budget_max: chosen.is_empty().then_some(max),
-        size,
-        views,
-        supersample,
-        fits: fits.clone(),
-    };
+    options.budget_max = chosen.is_empty().then_some(max);
+    let fits = options.fits.clone();
     // One line per row as soon as it is measured: a large asset takes minutes per row.
     let mut print_row = |row: &meshpaint::bench::adaptive::AdaptiveRow| {
         let mut value = row.to_json();
@@ -426,6 +425,42 @@ fn adaptive(
         println!("{summary}");
     }
     Ok(())
+}
+
+// `--look-at X,Y,Z --distance D [--yaw --pitch]` of `bench adaptive`: one close-up view.
+#[derive(Debug, Clone, clap::Args)]
+pub(super) struct CloseUpArgs {
+    /// Measure one close-up view looking at this point (world X,Y,Z; e.g. a region's `center`
+    /// printed by `meshpaint synth`) instead of --views cameras around the model.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true, requires = "distance")]
+    look_at: Option<Vec<f64>>,
+    /// Eye distance from --look-at.
+    #[arg(long)]
+    distance: Option<f64>,
+    /// Yaw of the close-up, degrees (0: the eye on +Z looking along −Z).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    yaw: f64,
+    /// Pitch of the close-up, degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pitch: f64,
+}
+
+impl CloseUpArgs {
+    fn get(&self) -> Result<Option<meshpaint::bench::adaptive::CloseUp>> {
+        let Some(target) = &self.look_at else { return Ok(None) };
+        let distance = self.distance.unwrap_or(0.0);
+        anyhow::ensure!(distance.is_finite() && distance > 0.0, "--distance must be a positive number");
+        anyhow::ensure!(
+            target.len() == 3 && target.iter().all(|v| v.is_finite()),
+            "--look-at takes three finite numbers X,Y,Z"
+        );
+        Ok(Some(meshpaint::bench::adaptive::CloseUp {
+            target: [target[0], target[1], target[2]],
+            distance,
+            yaw_degrees: self.yaw,
+            pitch_degrees: self.pitch,
+        }))
+    }
 }
 
 /// `bench pack`: the full repack, the incremental repack after a stroke and the relayout after a resolution stroke, per format.

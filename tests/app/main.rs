@@ -21,6 +21,7 @@ mod export_uvs;
 mod extremes;
 mod formats;
 mod gpu_render;
+mod logo_closeup;
 mod mct_file;
 mod production_assets;
 mod ptex_cli;

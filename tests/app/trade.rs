@@ -233,7 +233,15 @@ fn bench_trade_mct_linear_is_close_to_mesh_colors_linear() {
         dabs: 1,
         ..Default::default()
     };
-    let rows = meshpaint::bench::trade::bench_trade(&common::model("BoxTextured/BoxTextured.glb"), &options).unwrap();
+    let mut streamed = Vec::new();
+    let rows = meshpaint::bench::trade::bench_trade_streaming(
+        &common::model("BoxTextured/BoxTextured.glb"),
+        &options,
+        &mut |row| streamed.push(row.clone()),
+    )
+    .unwrap();
+    // Every row reached the caller as it was measured (the CLI prints it then), in order.
+    assert_eq!(streamed, rows);
     let config = |representation: &str, filter: &str, view: &str| {
         rows.iter()
             .find(|r| {

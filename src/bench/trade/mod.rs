@@ -92,7 +92,7 @@ pub use crate::bench::plot::pareto_front;
 pub use bvh::brute_force;
 pub use metrics::{ImageError, compare};
 pub use points::{plot_points, write_plots};
-pub use run::bench_trade;
+pub use run::{bench_trade, bench_trade_streaming};
 pub use seams::{SeamEdges, SeamJump, mct_seam_jumps, ptex_seam_jumps, seam_jumps, seam_jumps_over};
 
 use meshpaint_core::colors::format::ColorFormat;

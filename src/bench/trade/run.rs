@@ -25,6 +25,16 @@ use meshpaint_render::Gpu;
 /// references, interleaved frame times and errors ([`Study::view_rows`]), then seams and BVH
 /// presets.
 pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json::Value>, BenchRenderError> {
+    bench_trade_streaming(path, options, &mut |_| {})
+}
+
+/// [`bench_trade`], giving each group of rows to `on_row` as soon as it is measured (the CLI
+/// prints them then: a large asset takes minutes per view).
+pub fn bench_trade_streaming(
+    path: &Path,
+    options: &TradeOptions,
+    on_row: &mut dyn FnMut(&serde_json::Value),
+) -> Result<Vec<serde_json::Value>, BenchRenderError> {
     let gpu = Gpu::new_headless()?;
     let budget = Budget::from_environment().with_gpu(gpu.budget_limits());
     let scene = import_gltf(path).ok();
@@ -67,17 +77,23 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
         "convert_seconds_total": started.elapsed().as_secs_f64(),
     })];
     rows.extend(skipped_rows(&choices, &file, options));
+    rows.iter().for_each(&mut *on_row);
+    let mut emit = |rows: &mut Vec<serde_json::Value>, new: Vec<serde_json::Value>| {
+        new.iter().for_each(&mut *on_row);
+        rows.extend(new);
+    };
     let study = Study { gpu: &gpu, choices: &choices, baseline: &timing_baseline, textured, file: &file, options };
     for view in views(bounds, options.views) {
-        rows.extend(study.view_rows(&view, face_count)?);
+        emit(&mut rows, study.view_rows(&view, face_count)?);
     }
     for choice in &choices {
-        rows.extend(seam_rows(choice, &file)?);
+        emit(&mut rows, seam_rows(choice, &file)?);
     }
-    for mut row in bvh_rows(&first.document, bounds) {
-        merge(&mut row, &serde_json::json!({"bench": "trade", "kind": "bvh", "file": file}));
-        rows.push(row);
+    let mut bvh = bvh_rows(&first.document, bounds);
+    for row in &mut bvh {
+        merge(row, &serde_json::json!({"bench": "trade", "kind": "bvh", "file": file}));
     }
+    emit(&mut rows, bvh);
     Ok(rows)
 }
 

@@ -162,8 +162,14 @@ pub struct OpenPhases {
     /// rounds included).
     pub bake: Duration,
     /// Allocating and colouring the store (budget check, resolutions, bake or fill, vertex
-    /// colours): the phases above and the rest.
+    /// colours, the measure below): the phases above and the rest.
     pub store: Duration,
+    /// Measuring the converted store against the texture ([`Self::texture_psnr_db`]).
+    pub measure: Duration,
+    /// The converted colours' PSNR against the base-colour texture over the textured surface
+    /// ([`crate::convert::adaptive::texture_psnr`]); `None` without a texture (or for a
+    /// packed file), `+∞` when lossless.
+    pub texture_psnr_db: Option<f64>,
 }
 
 /// An open mesh with its editable colours.
@@ -183,6 +189,43 @@ pub struct Document {
     /// keep no texture). The editor turns "resolution follows the brush" on for untextured
     /// documents.
     pub textured: bool,
+    /// What the conversion that made it showed (a glTF mesh; `None` for a packed file).
+    pub conversion: Option<ConversionReport>,
+}
+
+/// What a conversion from a mesh shows when it ends: the rule and how well the colours
+/// follow the texture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConversionReport {
+    /// The rule, as [`ResolutionRule::describe`] says it.
+    pub rule: String,
+    /// The colours' PSNR against the base-colour texture over the textured surface
+    /// ([`crate::convert::adaptive::texture_psnr`], before vertex colours multiply in);
+    /// `None` without a texture, `+∞` when lossless.
+    pub texture_psnr_db: Option<f64>,
+    /// Faces a sample budget held below what their texels could use (zero for other rules).
+    pub faces_held_by_budget: u64,
+}
+
+impl ConversionReport {
+    /// One line for a status bar or log: the rule, the PSNR, the faces the budget held.
+    pub fn summary(&self) -> String {
+        let mut line = self.rule.clone();
+        match self.texture_psnr_db {
+            Some(db) if db.is_finite() => line += &format!(", {db:.1} dB against the texture"),
+            Some(_) => line += ", lossless against the texture",
+            None => {}
+        }
+        if self.faces_held_by_budget > 0 {
+            line += &format!(
+                ", {} face{} held below {} texels by the budget",
+                self.faces_held_by_budget,
+                if self.faces_held_by_budget == 1 { "" } else { "s" },
+                if self.faces_held_by_budget == 1 { "its" } else { "their" }
+            );
+        }
+        line
+    }
 }
 
 /// A smooth, deterministic colour field over the bounding box that shows the shape and the
@@ -551,9 +594,14 @@ impl Document {
             .map_err(|source| DocumentError::Store { path: name.to_owned(), source })?;
         if has_base_color {
             let baking = Instant::now();
-            crate::convert::adaptive::bake_and_verify_with(&mut store, &welded, &scene, rule, fit, bake)
+            crate::convert::adaptive::bake_and_verify_with(&mut store, &welded, &scene, rule, fit, bake.part(0.0, 0.9))
                 .map_err(cancelled)?;
             phases.bake = baking.elapsed();
+            let measuring = Instant::now();
+            phases.texture_psnr_db =
+                crate::convert::adaptive::texture_psnr(&store, &welded, &scene, bake.part(0.9, 1.0))
+                    .map_err(cancelled)?;
+            phases.measure = measuring.elapsed();
         } else if neutral && uniform.is_none() {
             fill_neutral(&mut store, &welded.triangle_materials, &scene);
         }
@@ -567,8 +615,14 @@ impl Document {
             .any(|m| m.and_then(|m| scene.materials.get(m as usize)).is_some_and(|m| m.base_color_texture.is_some()));
         phases.store = started.elapsed();
         progress.report(1.0, "converted");
+        let conversion = ConversionReport {
+            rule: rule.describe(),
+            texture_psnr_db: phases.texture_psnr_db,
+            faces_held_by_budget: phases.rule.faces_held_by_budget,
+        };
         Ok(Document {
             textured,
+            conversion: Some(conversion),
             positions: welded.positions_world,
             store,
             degenerate_triangles_dropped: welded.degenerate_triangles_dropped,
@@ -591,6 +645,7 @@ impl Document {
             source: SourceKind::Packed(packed.format),
             warnings: Vec::new(),
             textured: false,
+            conversion: None,
         })
     }
 

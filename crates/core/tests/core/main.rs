@@ -5,6 +5,7 @@ mod common;
 
 mod adaptive_extremes;
 mod bake;
+mod conversion_psnr;
 mod examples;
 mod follow_brush;
 mod fuzz;
