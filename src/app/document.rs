@@ -359,7 +359,11 @@ pub fn write_packed(document: &Document, format: ColorFormat, path: &Path, job: 
     let packed = document.pack(format).with_context(|| format!("packing for {}", path.display()))?;
     let repack = started.elapsed();
     job.progress(0.6, "writing");
-    meshpaint_core::packing::file::write_file(path, &packed)?;
+    // The editor's tools paint the store, not yet the layers: when they did, the layers no
+    // longer make the store and saving them would lose the paint, so the save is flattened.
+    let flattened = !document.layers_in_sync();
+    let layers = if flattened { None } else { document.layers_section(format) };
+    meshpaint_core::packing::file::write_file_with_layers(path, &packed, layers.as_ref())?;
     let bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     job.progress(1.0, "done");
     Ok(Written {
@@ -367,7 +371,13 @@ pub fn write_packed(document: &Document, format: ColorFormat, path: &Path, job: 
         bytes,
         repack: Some(repack),
         format: Some(format),
-        summary: format!("{} samples ({}), {}", thousands(packed.sample_count()), format.name(), human_bytes(bytes)),
+        summary: format!(
+            "{} samples ({}), {}{}",
+            thousands(packed.sample_count()),
+            format.name(),
+            human_bytes(bytes),
+            if flattened { "; layers flattened (the store was painted outside them)" } else { "" }
+        ),
     })
 }
 

@@ -98,6 +98,14 @@ pub enum DocumentError {
         /// The cause.
         source: PackError,
     },
+    /// The saved layers do not fit the document or the budget.
+    #[error("{path}: {source}")]
+    Layers {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: crate::layers::LayerError,
+    },
     /// The caller cancelled the conversion ([`crate::progress::Reporter::cancel`]).
     #[error("{path}: cancelled")]
     Cancelled {
@@ -189,6 +197,9 @@ pub struct Document {
     /// keep no texture). The editor turns "resolution follows the brush" on for untextured
     /// documents.
     pub textured: bool,
+    /// The layers (docs/LAYERS.md) when the document has them: `store` is then their
+    /// composite. `None`: the store is the document's only colour (as before layers).
+    pub layers: Option<crate::layers::LayerStack>,
     /// What the conversion that made it showed (a glTF mesh; `None` for a packed file).
     pub conversion: Option<ConversionReport>,
 }
@@ -445,11 +456,17 @@ impl Document {
         progress.report(0.0, "reading and importing");
         let head = read_head(path)?;
         if packed_file::looks_like_packed(&head) {
-            let packed = packed_file::read_file(path)?;
-            return Self::from_packed_within(&packed, budget).map_err(|source| match source {
+            let (packed, layers) = packed_file::read_file_with_layers(path)?;
+            let mut document = Self::from_packed_within(&packed, budget).map_err(|source| match source {
                 PackError::Budget(source) => DocumentError::Budget { path: path.to_owned(), source },
                 source => DocumentError::Pack { path: path.to_owned(), source },
-            });
+            })?;
+            if let Some(section) = layers {
+                document
+                    .attach_layers(&section, budget)
+                    .map_err(|source| DocumentError::Layers { path: path.to_owned(), source })?;
+            }
+            return Ok(document);
         }
         let (scene, kind) = import_scene_after(path, &head, budget)?;
         let mut document = Self::from_scene_phased(
@@ -628,6 +645,7 @@ impl Document {
             degenerate_triangles_dropped: welded.degenerate_triangles_dropped,
             source: SourceKind::Gltf,
             warnings: scene.warnings,
+            layers: None,
         })
     }
 
@@ -646,7 +664,46 @@ impl Document {
             warnings: Vec::new(),
             textured: false,
             conversion: None,
+            layers: None,
         })
+    }
+
+    /// Gives the document the layers of a saved layers section (its store becomes their
+    /// composite, recomputed from the layers: they are the source).
+    pub fn attach_layers(
+        &mut self,
+        section: &packed_file::LayersSection,
+        budget: &Budget,
+    ) -> Result<(), crate::layers::LayerError> {
+        let mut stack = crate::layers::file::from_section(section, &self.store, self.display_format(), budget)?;
+        stack.sync(&mut self.store);
+        self.store.take_dirty();
+        self.layers = Some(stack);
+        Ok(())
+    }
+
+    /// Whether the store is exactly its layers' composite (true without layers). False when
+    /// the store was changed without going through the layers (e.g. painted by a tool that
+    /// does not know them yet): saving the layers would then lose that change.
+    pub fn layers_in_sync(&self) -> bool {
+        let Some(stack) = &self.layers else {
+            return true;
+        };
+        let mut composite = self.store.clone();
+        stack.composite_into(&mut composite) == 0
+    }
+
+    /// The layers section a save in `format` writes (`None` without layers: a version-1 file).
+    pub fn layers_section(&self, format: ColorFormat) -> Option<packed_file::LayersSection> {
+        self.layers.as_ref().map(|stack| crate::layers::file::to_section(stack, format))
+    }
+
+    /// Packs the document and writes it to `path` as a packed file in `format`, with its
+    /// layers when it has them (atomically, [`packed_file::write_file_with_layers`]).
+    pub fn write_packed(&self, path: &Path, format: ColorFormat) -> Result<PackedMesh, DocumentError> {
+        let packed = self.pack(format).map_err(|source| DocumentError::Pack { path: path.to_owned(), source })?;
+        packed_file::write_file_with_layers(path, &packed, self.layers_section(format).as_ref())?;
+        Ok(packed)
     }
 
     /// Packs the document into linear buffers in `format`.

@@ -1,6 +1,6 @@
 //! The fuzz harness (examples/fuzz) in the test suite: its supervisor must report every kind
 //! of crash with the input saved, and short campaigns (a fixed seed, a few thousand inputs)
-//! against the packed-file reader, the glTF importer and the MCT-file reader must find nothing — while their
+//! against the packed-file reader (layers section included), the glTF importer and the MCT-file reader must find nothing — while their
 //! inputs reach far into the reader (the mutators fix the checksum and the layout, so most
 //! mutants are refused by content checks, not by the checksum, and some are accepted).
 //!
@@ -129,6 +129,10 @@ fn a_short_packed_campaign_finds_no_crash_and_reaches_the_content_checks() {
     assert!(checksum * 10 < total, "{checksum} of {total} mutants stop at the checksum\n{}", report.text());
     assert!(accepted * 50 > total, "only {accepted} of {total} mutants are accepted\n{}", report.text());
     assert!(kinds >= 15, "only {kinds} kinds of refusal\n{}", report.text());
+    // The layered seeds (version 2) reach the layers section: some accepted, some refused.
+    let layered = count(&report.outcomes, "accepted with layers");
+    let bad_layers = count(&report.outcomes, "refused: BadLayers");
+    assert!(layered > 0 && bad_layers > 0, "layers section not reached\n{}", report.text());
 }
 
 #[test]

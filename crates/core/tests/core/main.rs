@@ -11,6 +11,8 @@ mod follow_brush;
 mod fuzz;
 mod hard_edge;
 mod import;
+mod layers;
+mod layers_file;
 mod layout;
 mod least_squares;
 mod mct;
