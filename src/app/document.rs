@@ -23,7 +23,7 @@ use meshpaint_core::packing::linear::PackedMesh;
 use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::paint::picking::MeshBvh;
 use meshpaint_core::progress::Reporter;
-use meshpaint_render::{BaselineMesh, DrawItem, Gpu, GpuMct, GpuMesh, MeshGeometry};
+use meshpaint_render::{BaselineMesh, DrawItem, Gpu, GpuMct, GpuMesh, GpuPtex, MeshGeometry};
 
 use super::jobs::JobContext;
 use super::state::{Representation, Shown};
@@ -81,6 +81,39 @@ pub struct AlternateViews {
     /// The Mesh Color Texture of the packed mesh, with the mesh generation it was built for
     /// ([`OpenDocument::mesh_generation`]).
     pub mct: Option<(u64, Result<BuiltMct, String>)>,
+    /// The packed Ptex of the packed mesh, with the mesh generation it was built for.
+    pub ptex: Option<(u64, Result<BuiltPtex, String>)>,
+}
+
+/// A packed Ptex on the GPU and what building it cost.
+#[derive(Debug)]
+pub struct BuiltPtex {
+    /// The texture, records and tables, drawn with the document's GPU mesh geometry.
+    pub ptex: GpuPtex,
+    /// Store-independent build time (packed mesh → texture), without the upload.
+    pub build: Duration,
+    /// Texture, records and tables over the packed mesh's face records and colours.
+    pub bytes_over_mesh_colors: f64,
+}
+
+/// Builds the packed Ptex of `packed` (as [`build_mct`]) within `budget` and uploads it.
+pub fn build_ptex(
+    packed: &PackedMesh,
+    geometry: &MeshGeometry,
+    budget: &Budget,
+    gpu: &Gpu,
+    job: &JobContext,
+) -> Result<BuiltPtex, String> {
+    job.progress(0.1, "packing the per-face blocks");
+    let started = Instant::now();
+    let max_dimension = gpu.ctx.limits().max_texture_dimension_2d;
+    let texture = meshpaint_core::ptex::build(packed, max_dimension, budget.memory_bytes)
+        .map_err(|error| format!("building the packed Ptex: {error}"))?;
+    let build = started.elapsed();
+    job.progress(0.8, "uploading the texture");
+    let ptex = gpu.upload_ptex(geometry, &texture).map_err(|error| format!("uploading the packed Ptex: {error}"))?;
+    let mesh_colors = (packed.face_record_bytes() + packed.color_bytes()).max(1);
+    Ok(BuiltPtex { ptex, build, bytes_over_mesh_colors: texture.gpu_bytes() as f64 / mesh_colors as f64 })
 }
 
 /// A Mesh Color Texture on the GPU and what building it cost.
@@ -125,6 +158,8 @@ pub enum AlternateView {
     PositionColors(Box<Result<GpuMesh, String>>),
     /// [`AlternateViews::mct`], built for this mesh generation.
     Mct(u64, Box<Result<BuiltMct, String>>),
+    /// [`AlternateViews::ptex`], built for this mesh generation.
+    Ptex(u64, Box<Result<BuiltPtex, String>>),
 }
 
 /// Builds the view `shown` of `document`, opened from `source`, on `gpu` (`None` for
@@ -214,6 +249,21 @@ impl OpenDocument {
         }
     }
 
+    /// Whether the packed Ptex of the current GPU mesh still has to be built.
+    pub fn ptex_missing(&self) -> bool {
+        self.alternates.ptex.as_ref().is_none_or(|(generation, _)| *generation != self.mesh_generation)
+    }
+
+    /// The packed Ptex of the current GPU mesh, if it is built; `Err` says why it cannot be.
+    pub fn current_ptex(&self) -> Option<Result<&BuiltPtex, &str>> {
+        match &self.alternates.ptex {
+            Some((generation, built)) if *generation == self.mesh_generation => {
+                Some(built.as_ref().map_err(String::as_str))
+            }
+            _ => None,
+        }
+    }
+
     /// The packed mesh and GPU geometry a Mesh Color Texture is built from (`None` without
     /// a GPU mesh or while paint mode holds the packing).
     pub fn mct_source(&self) -> Option<(PackedMesh, MeshGeometry)> {
@@ -226,8 +276,9 @@ impl OpenDocument {
     /// is built, else the mesh colors (`None` without a GPU).
     pub fn shown_item(&self, shown: Shown, representation: Representation) -> Option<DrawItem<'_>> {
         let alternate = match shown {
-            Shown::MeshColors => match (representation, self.current_mct()) {
-                (Representation::MeshColorTexture, Some(Ok(built))) => Some(DrawItem::Mct(&built.mct)),
+            Shown::MeshColors => match (representation, self.current_mct(), self.current_ptex()) {
+                (Representation::MeshColorTexture, Some(Ok(built)), _) => Some(DrawItem::Mct(&built.mct)),
+                (Representation::PackedPtex, _, Some(Ok(built))) => Some(DrawItem::Ptex(&built.ptex)),
                 _ => None,
             },
             Shown::SourceTexture => match &self.alternates.source_texture {

@@ -149,6 +149,28 @@ impl DocumentState {
                 open.alternates.mct = Some((generation, *built));
                 failed
             }
+            AlternateView::Ptex(generation, built) => {
+                if generation != open.mesh_generation {
+                    log::info!("a packed Ptex finished for colours that changed since; ignored");
+                    return;
+                }
+                let failed = match built.as_ref() {
+                    Ok(built) => {
+                        let [w, h] = built.ptex.size;
+                        let text = format!(
+                            "Built the packed Ptex: {w} × {h} texture, {} ({:.2}× the mesh colors) in {:.0} ms",
+                            human_bytes(built.ptex.gpu_bytes()),
+                            built.bytes_over_mesh_colors,
+                            built.build.as_secs_f64() * 1000.0
+                        );
+                        status.set(Severity::Info, text);
+                        None
+                    }
+                    Err(message) => Some(message.clone()),
+                };
+                open.alternates.ptex = Some((generation, *built));
+                failed
+            }
         };
         if let Some(message) = failed {
             status.set(Severity::Warning, format!("Cannot show it: {message}"));
@@ -179,6 +201,7 @@ impl DocumentState {
         // The colours on the GPU changed: a Mesh Color Texture of the old ones is stale.
         open.mesh_generation += 1;
         open.alternates.mct = None;
+        open.alternates.ptex = None;
         open.samples_with_mips = repacked.samples_with_mips;
         open.packed_bytes = repacked.packed_bytes;
         open.samples = open.document.store.sample_count();

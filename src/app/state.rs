@@ -102,17 +102,23 @@ pub enum Representation {
     /// the shared vertex and edge colours duplicated, filtered by the GPU's bilinear sampler
     /// (crates/core/src/mct; built from the packed mesh when shown, again after each repack).
     MeshColorTexture,
+    /// Packed Ptex (Kim, Hillesland, Hensley 2011): per-pair square blocks with their MIP
+    /// chains and one-texel borders from the neighbours in one texture, filtered by the
+    /// GPU's bilinear sampler (crates/core/src/ptex; built as Mesh Color Textures are).
+    PackedPtex,
 }
 
 impl Representation {
     /// Every choice, in the order the view panel lists them.
-    pub const ALL: [Representation; 2] = [Representation::MeshColors, Representation::MeshColorTexture];
+    pub const ALL: [Representation; 3] =
+        [Representation::MeshColors, Representation::MeshColorTexture, Representation::PackedPtex];
 
     /// The name the view panel shows.
     pub fn name(self) -> &'static str {
         match self {
             Representation::MeshColors => "Mesh colors (software filter)",
             Representation::MeshColorTexture => "Mesh Color Textures (hardware filter)",
+            Representation::PackedPtex => "Packed Ptex (hardware filter)",
         }
     }
 }

@@ -1,8 +1,8 @@
 //! `meshpaint bench render`: frame time of the UV-texture baseline, of every mesh-colors
-//! filter mode and of the Mesh Color Textures built from the same buffers (the
+//! filter mode and of the Mesh Color Textures and packed Ptex built from the same buffers (the
 //! representation axis: every row names its representation) on the same mesh, view and
 //! image size, interleaved in one run, as ratios to the baseline; plus the GPU memory each
-//! path holds and the MCT's build time.
+//! path holds and the MCT's and packed Ptex's build times.
 //!
 //! A frame is one render pass into an offscreen target, submitted and waited for
 //! (`poll(wait)`), so on lavapipe it measures the rasteriser's whole work. Modes are
@@ -31,9 +31,9 @@ use meshpaint_render::{
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeTiming {
     /// `baseline-uv`, `nearest`, `linear`, `mip-1`, `trilinear`, `mct-linear`, `mct-mip-1`,
-    /// `mct-trilinear`, `mct-anisotropic`.
+    /// `mct-trilinear`, `ptex-linear`, `ptex-mip-1`, `ptex-trilinear`, `mct-anisotropic`.
     pub name: String,
-    /// `uv-texture`, `mesh-colors` or `mct`.
+    /// `uv-texture`, `mesh-colors`, `mct` or `ptex`.
     pub representation: &'static str,
     /// Median frame time, seconds.
     pub median_seconds: f64,
@@ -68,6 +68,8 @@ pub struct RenderBench {
     pub modes: Vec<ModeTiming>,
     /// Seconds to build the Mesh Color Texture from the packed buffers.
     pub mct_build_seconds: f64,
+    /// Seconds to build the packed Ptex from the packed buffers.
+    pub ptex_build_seconds: f64,
 }
 
 impl RenderBench {
@@ -101,6 +103,7 @@ impl RenderBench {
             "triangles": self.triangles,
             "baseline": self.baseline,
             "mct_build_ms": self.mct_build_seconds * 1e3,
+            "ptex_build_ms": self.ptex_build_seconds * 1e3,
             "modes": modes,
         })
     }
@@ -204,12 +207,17 @@ pub fn bench_render(
     let texture = meshpaint_core::mct::build(&packed, max_dimension, u64::MAX)?;
     let mct_build_seconds = build_start.elapsed().as_secs_f64();
     let mct = gpu.upload_mct(&mesh.geometry(), &texture)?;
+    let build_start = Instant::now();
+    let packed_ptex = meshpaint_core::ptex::build(&packed, max_dimension, u64::MAX)?;
+    let ptex_build_seconds = build_start.elapsed().as_secs_f64();
+    let ptex = gpu.upload_ptex(&mesh.geometry(), &packed_ptex)?;
 
     let camera: OrbitCamera = default_camera(mesh.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
     let timer = FrameTimer::new(&gpu, width, height);
 
     let geometry_bytes = mesh.gpu_bytes() - mesh.atlas_bytes() - mesh.face_record_bytes();
-    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 9] = [
+    let ptex_bytes = geometry_bytes + ptex.gpu_bytes();
+    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 12] = [
         ("baseline-uv", "uv-texture", DrawItem::Baseline(&baseline), FilterMode::Linear, baseline.gpu_bytes()),
         ("nearest", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Nearest, mesh.gpu_bytes()),
         ("linear", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Linear, mesh.gpu_bytes()),
@@ -218,6 +226,9 @@ pub fn bench_render(
         ("mct-linear", "mct", DrawItem::Mct(&mct), FilterMode::Linear, geometry_bytes + mct.gpu_bytes()),
         ("mct-mip-1", "mct", DrawItem::Mct(&mct), FilterMode::MipLevel(1), geometry_bytes + mct.gpu_bytes()),
         ("mct-trilinear", "mct", DrawItem::Mct(&mct), FilterMode::Trilinear, geometry_bytes + mct.gpu_bytes()),
+        ("ptex-linear", "ptex", DrawItem::Ptex(&ptex), FilterMode::Linear, ptex_bytes),
+        ("ptex-mip-1", "ptex", DrawItem::Ptex(&ptex), FilterMode::MipLevel(1), ptex_bytes),
+        ("ptex-trilinear", "ptex", DrawItem::Ptex(&ptex), FilterMode::Trilinear, ptex_bytes),
         // Trilinear where the adapter has no anisotropic filtering (`anisotropic` in the report).
         // Last and timed after the interleaved rounds (`INTERLEAVED`): on lavapipe it is ~100×
         // the others and would leave the frame after it with cold caches.
@@ -229,7 +240,7 @@ pub fn bench_render(
     for &(_, _, item, filter, _) in &paths {
         timer.frame(item, filter, camera);
     }
-    const INTERLEAVED: usize = 8;
+    const INTERLEAVED: usize = 11;
     for modes in [0..INTERLEAVED, INTERLEAVED..paths.len()] {
         for _ in 0..frames.max(1) {
             for k in modes.clone() {
@@ -266,6 +277,7 @@ pub fn bench_render(
         baseline: baseline_name,
         modes,
         mct_build_seconds,
+        ptex_build_seconds,
     })
 }
 
@@ -333,6 +345,9 @@ pub enum BenchRenderError {
     /// The Mesh Color Texture cannot be built.
     #[error(transparent)]
     Mct(#[from] meshpaint_core::mct::MctError),
+    /// The packed Ptex cannot be built.
+    #[error(transparent)]
+    Ptex(#[from] meshpaint_core::ptex::PtexError),
     /// The measurement needs a reference the file does not have.
     #[error("{0}")]
     NoReference(String),

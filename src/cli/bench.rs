@@ -257,6 +257,9 @@ pub(super) struct TradeArgs {
     /// Leave out the Mesh Color Texture rows (mesh colors only).
     #[arg(long)]
     pub(super) no_mct: bool,
+    /// Leave out the packed Ptex rows.
+    #[arg(long)]
+    pub(super) no_ptex: bool,
 }
 
 impl TradeArgs {
@@ -273,6 +276,7 @@ impl TradeArgs {
             uniform: (0..=max_uniform.log2()).filter_map(|l| Resolution::from_log2(l).ok()).collect(),
             formats: if self.formats.is_empty() { ColorFormat::ALL.to_vec() } else { self.formats.clone() },
             mct: !self.no_mct,
+            ptex: !self.no_ptex,
             frames: self.frames,
             error_bounds: self.errors.clone(),
             ..Default::default()

@@ -12,7 +12,7 @@ use meshpaint_core::packing::lod::VertexLod;
 use meshpaint_core::progress::Reporter;
 use meshpaint_render::{DrawItem, FilterMode, Gpu, MeshGeometry, Overlays, RenderSettings, Shading};
 
-use super::args::{CameraArgs, LOG_TARGET, Representation, ResolutionArg, is_mct_file};
+use super::args::{CameraArgs, LOG_TARGET, Representation, ResolutionArg, is_mct_file, is_ptex_file};
 
 /// Arguments of `meshpaint render`.
 #[derive(Debug, clap::Args)]
@@ -56,9 +56,10 @@ pub(super) struct RenderArgs {
     /// shape and its samples; the document is unchanged).
     #[arg(long, conflicts_with = "baseline_uv")]
     position_colors: bool,
-    /// mesh-colors (software filter in the shader) or mct (Mesh Color Textures: the same
-    /// colours in a 2D atlas filtered by the GPU's sampler; docs/MCT.md). Nearest filters
-    /// draw bilinear with mct.
+    /// mesh-colors (software filter in the shader), mct (Mesh Color Textures: the same
+    /// colours in a 2D atlas filtered by the GPU's sampler; docs/MCT.md) or ptex (packed
+    /// Ptex: per-pair square blocks with borders, hardware bilinear; docs/PTEX.md). Nearest
+    /// filters draw bilinear with mct and ptex; anisotropic draws trilinear with ptex.
     #[arg(long, value_enum, default_value_t = Representation::MeshColors, conflicts_with = "baseline_uv")]
     representation: Representation,
 }
@@ -102,6 +103,27 @@ fn filter_mode(filter: RenderFilter, level: Option<u32>) -> Result<FilterMode> {
     })
 }
 
+/// A packed Ptex file (docs/PTEX_FORMAT.md) drawn as the texture it holds: the image and
+/// its face count.
+fn render_ptex_file(
+    args: &RenderArgs,
+    gpu: &Gpu,
+    settings: &dyn Fn(meshpaint_core::camera::BoundingSphere) -> RenderSettings,
+) -> Result<(image::RgbaImage, u32, u64)> {
+    anyhow::ensure!(
+        !args.baseline_uv && !args.position_colors,
+        "{}: a packed Ptex file holds its texture only (no --baseline-uv, no --position-colors)",
+        args.file.display()
+    );
+    let file = meshpaint_core::ptex::file::read_ptex(&args.file)?;
+    let lod = VertexLod::with_density(&file.positions, &file.indices, file.ptex.vertex_density.clone());
+    let (geometry, bounds) = MeshGeometry::upload(&gpu.ctx, &file.positions, &file.indices, &lod)
+        .with_context(|| format!("{}: uploading its mesh", args.file.display()))?;
+    let ptex = gpu.upload_ptex(&geometry, &file.ptex).with_context(|| format!("{}", args.file.display()))?;
+    let image = gpu.render_image(DrawItem::Ptex(&ptex), &settings(bounds), args.width, args.height)?;
+    Ok((image, geometry.face_count, 0))
+}
+
 pub(super) fn run(args: RenderArgs) -> Result<()> {
     let filter = filter_mode(args.filter, args.level)?;
     args.camera.check()?;
@@ -133,6 +155,8 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
         let mct = gpu.upload_mct(&geometry, &file.mct).with_context(|| format!("{}", args.file.display()))?;
         let image = gpu.render_image(DrawItem::Mct(&mct), &settings(bounds), args.width, args.height)?;
         (image, geometry.face_count, 0)
+    } else if is_ptex_file(&args.file)? {
+        render_ptex_file(&args, &gpu, &settings)?
     } else if args.baseline_uv {
         let (scene, _) = meshpaint_core::io::document::import_scene_within(&args.file, &budget)?;
         let mesh = gpu.upload_baseline(&scene)?.with_context(|| {
@@ -174,6 +198,14 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
                     .with_context(|| format!("{}: building the Mesh Color Texture", args.file.display()))?;
                 let mct = gpu.upload_mct(&mesh.geometry(), &texture)?;
                 gpu.render_image(DrawItem::Mct(&mct), &settings(mesh.bounds), args.width, args.height)?
+            }
+            Representation::Ptex => {
+                let packed = shown.pack(document.display_format())?;
+                let max_dimension = gpu.ctx.limits().max_texture_dimension_2d;
+                let texture = meshpaint_core::ptex::build(&packed, max_dimension, budget.memory_bytes)
+                    .with_context(|| format!("{}: building the packed Ptex", args.file.display()))?;
+                let ptex = gpu.upload_ptex(&mesh.geometry(), &texture)?;
+                gpu.render_image(DrawItem::Ptex(&ptex), &settings(mesh.bounds), args.width, args.height)?
             }
         };
         (image, mesh.face_count, mesh.atlas.samples)

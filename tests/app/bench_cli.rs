@@ -141,6 +141,10 @@ fn bench_render_reports_every_mode_against_the_baseline() {
     // The anisotropic MCT row is there whether or not the adapter filters anisotropically.
     assert!(report["anisotropic"].is_boolean(), "{report}");
     assert!(modes.iter().any(|m| m["mode"] == "mct-anisotropic" && m["representation"] == "mct"), "{report}");
+    for mode in ["ptex-linear", "ptex-mip-1", "ptex-trilinear"] {
+        assert!(modes.iter().any(|m| m["mode"] == mode && m["representation"] == "ptex"), "{mode}: {report}");
+    }
+    assert!(report["ptex_build_ms"].as_f64().unwrap() > 0.0, "{report}");
 }
 
 #[test]

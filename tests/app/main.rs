@@ -24,6 +24,7 @@ mod gpu_render;
 mod logo_closeup;
 mod mct_file;
 mod production_assets;
+mod ptex_cli;
 mod rule_flags;
 mod trade;
 mod validator;

@@ -47,10 +47,26 @@ fn bench_trade_on_box_textured_prints_complete_rows_and_writes_plots() {
     let representation = |r: &str| configs.iter().copied().filter(|row| row["representation"] == r).collect::<Vec<_>>();
     // (R = 1, 2, 4 and two bounds) × 3 formats × 5 filters × 4 views.
     assert_eq!(representation("mesh-colors").len(), 5 * 3 * 5 * views);
-    // The same packs as MCT × 4 filters (no nearest), less any format whose MCT was skipped.
+    // The same packs as MCT and as packed Ptex × 4 filters each (no nearest), less any format
+    // whose MCT or Ptex was skipped.
     let skipped = kind("skipped");
-    assert_eq!(representation("mct").len() + skipped.len() * 4 * views, 5 * 3 * 4 * views, "{skipped:?}");
-    assert_eq!(representation("mesh-colors").len() + representation("mct").len(), configs.len());
+    for r in ["mct", "ptex"] {
+        let skipped_here = skipped.iter().filter(|row| row["representation"] == r).count();
+        assert_eq!(representation(r).len() + skipped_here * 4 * views, 5 * 3 * 4 * views, "{r}: {skipped:?}");
+    }
+    let all = ["mesh-colors", "mct", "ptex"].map(|r| representation(r).len());
+    assert_eq!(all.iter().sum::<usize>(), configs.len());
+    for row in representation("ptex") {
+        assert!(["linear", "mip-1", "mip-2", "trilinear"].contains(&row["filter"].as_str().unwrap()), "{row}");
+        for key in ["gpu_bytes", "ptex_bytes", "ptex_bytes_over_mesh_colors", "ptex_build_seconds", "frame_ratio"] {
+            let value = number(row, key);
+            assert!(value.is_finite() && value > 0.0, "{key} = {value} in {row}");
+        }
+        assert!(number(row, "gpu_bytes") > number(row, "ptex_bytes"), "geometry counted too: {row}");
+        assert!(number(row, "ptex_border_over_interior") > 0.0, "{row}");
+    }
+    let ptex_seams = kind("seam").into_iter().filter(|row| row["representation"] == "ptex").count();
+    assert!(ptex_seams > 0, "packed Ptex seam rows");
     assert!(kind("baseline").iter().all(|row| row["representation"] == "uv-texture"));
     for row in representation("mct") {
         assert!(["linear", "mip-1", "mip-2", "trilinear"].contains(&row["filter"].as_str().unwrap()), "{row}");

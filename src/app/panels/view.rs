@@ -191,13 +191,18 @@ impl ViewPanel {
                 .response
                 .labelled_by(label.id)
                 .on_hover_text(
-                    "T — how the GPU draws the painted colours: mesh colors filtered in the shader (exact), or \
-                     Mesh Color Textures, one 2D atlas the GPU's own sampler filters",
+                    "T — how the GPU draws the painted colours: mesh colors filtered in the shader (exact), \
+                     Mesh Color Textures (one 2D atlas the GPU's own sampler filters) or packed Ptex \
+                     (per-pair blocks with borders, the GPU's sampler too)",
                 );
         });
         let Some(open) = ctx.document else {
             return;
         };
+        if view.representation == Representation::PackedPtex && view.shown == Shown::MeshColors {
+            ptex_status(ui, open, ctx.level0_only);
+            return;
+        }
         if view.representation != Representation::MeshColorTexture || view.shown != Shown::MeshColors {
             return;
         }
@@ -234,6 +239,33 @@ impl ViewPanel {
         let measure = || measure_mct_psnr(ctx, open, built, &key);
         let line = ("Mesh Color Texture vs mesh colors", "rendering both");
         psnr_line(ui, &mut self.mct_psnr, key, measure, line);
+    }
+}
+
+/// The packed Ptex's state under the representation choice: building, why it cannot be
+/// shown, or its size and cost.
+fn ptex_status(ui: &mut egui::Ui, open: &OpenDocument, level0_only: bool) {
+    if level0_only {
+        ui.label(egui::RichText::new("Paint mode draws mesh colors; the texture follows when it ends").weak());
+        return;
+    }
+    match open.current_ptex() {
+        None => {
+            ui.label(egui::RichText::new("Building the packed Ptex…").weak());
+        }
+        Some(Err(message)) => {
+            ui.colored_label(ui.visuals().warn_fg_color, format!("Showing the mesh colors: {message}"));
+        }
+        Some(Ok(built)) => {
+            let [w, h] = built.ptex.size;
+            let text = format!(
+                "Texture {w} × {h}: {} ({:.2}× the mesh colors' buffers), built in {:.0} ms",
+                human_bytes(built.ptex.gpu_bytes()),
+                built.bytes_over_mesh_colors,
+                built.build.as_secs_f64() * 1000.0
+            );
+            ui.label(egui::RichText::new(text).weak());
+        }
     }
 }
 

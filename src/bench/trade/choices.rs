@@ -17,7 +17,8 @@ use meshpaint_core::io::document::Document;
 use meshpaint_core::mct::MeshColorTexture;
 use meshpaint_core::mesh::scene::Scene;
 use meshpaint_core::packing::linear::PackedMesh;
-use meshpaint_render::{Gpu, GpuMct, GpuMesh};
+use meshpaint_core::ptex::PackedPtex;
+use meshpaint_render::{Gpu, GpuMct, GpuMesh, GpuPtex};
 
 /// One resolution choice: a document, its JSON label, and the meshes packed from it.
 pub(super) struct Choice {
@@ -42,6 +43,16 @@ pub(super) struct Packed {
     pub(super) pack_seconds: f64,
     /// The MCT built from `packed`, or why it could not be built or uploaded.
     pub(super) mct: Result<MctPack, String>,
+    /// The packed Ptex built from `packed`, or why it could not be built or uploaded.
+    pub(super) ptex: Result<PtexPack, String>,
+}
+
+/// A packed Ptex of one pack, on the CPU (for the seam evaluation) and the GPU.
+pub(super) struct PtexPack {
+    pub(super) texture: PackedPtex,
+    pub(super) gpu: GpuPtex,
+    /// Best of three builds from the packed buffers.
+    pub(super) build_seconds: f64,
 }
 
 /// A Mesh Color Texture of one pack, on the CPU (for the seam evaluation) and the GPU.
@@ -121,7 +132,8 @@ pub(super) fn prepare(
             let packed = packed?;
             let mesh = gpu.upload(&packed)?;
             let mct = if options.mct { build_mct(gpu, &packed, &mesh) } else { Err("not asked (--no-mct)".into()) };
-            choice.packs.push(Packed { format, packed, mesh, pack_seconds: timing.best_seconds, mct });
+            let ptex = if options.ptex { build_ptex(gpu, &packed, &mesh) } else { Err("not asked (--no-ptex)".into()) };
+            choice.packs.push(Packed { format, packed, mesh, pack_seconds: timing.best_seconds, mct, ptex });
         }
         if !textured {
             choice.reference = Some(gpu.upload(&choice.document.pack(ColorFormat::Rgba32F)?)?);
@@ -143,6 +155,16 @@ fn build_mct(gpu: &Gpu, packed: &PackedMesh, mesh: &GpuMesh) -> Result<MctPack, 
     let texture = texture.map_err(|e| e.to_string())?;
     let gpu_mct = gpu.upload_mct(&mesh.geometry(), &texture).map_err(|e| e.to_string())?;
     Ok(MctPack { texture, gpu: gpu_mct, build_seconds: timing.best_seconds })
+}
+
+/// The packed Ptex of `packed` (best of three builds, sides up to the device's largest
+/// texture) uploaded with `mesh`'s geometry, or why not.
+fn build_ptex(gpu: &Gpu, packed: &PackedMesh, mesh: &GpuMesh) -> Result<PtexPack, String> {
+    let max_dimension = gpu.ctx.limits().max_texture_dimension_2d;
+    let (timing, texture) = Timing::measure(3, || meshpaint_core::ptex::build(packed, max_dimension, u64::MAX));
+    let texture = texture.map_err(|e| e.to_string())?;
+    let gpu_ptex = gpu.upload_ptex(&mesh.geometry(), &texture).map_err(|e| e.to_string())?;
+    Ok(PtexPack { texture, gpu: gpu_ptex, build_seconds: timing.best_seconds })
 }
 
 /// The `resolution` of a document: its R when uniform, else `"R a..b"`.

@@ -93,7 +93,7 @@ pub use bvh::brute_force;
 pub use metrics::{ImageError, compare};
 pub use points::{plot_points, write_plots};
 pub use run::{bench_trade, bench_trade_streaming};
-pub use seams::{SeamEdges, SeamJump, mct_seam_jumps, seam_jumps, seam_jumps_over};
+pub use seams::{SeamEdges, SeamJump, mct_seam_jumps, ptex_seam_jumps, seam_jumps, seam_jumps_over};
 
 use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::colors::layout::Resolution;
@@ -116,6 +116,8 @@ pub struct TradeOptions {
     pub formats: Vec<ColorFormat>,
     /// Whether Mesh Color Texture rows are measured beside mesh colors.
     pub mct: bool,
+    /// Whether packed Ptex rows are measured beside mesh colors.
+    pub ptex: bool,
     /// Interleaved timing rounds per view (the median frame is reported).
     pub frames: usize,
     /// Dabs per throughput measurement.
@@ -132,6 +134,7 @@ impl Default for TradeOptions {
             max_resolution: Resolution::from_log2(6).unwrap_or(Resolution::MAX),
             formats: ColorFormat::ALL.to_vec(),
             mct: true,
+            ptex: true,
             frames: 5,
             dabs: 10,
         }

@@ -4,7 +4,7 @@
 
 use image::RgbaImage;
 
-use super::choices::{Choice, MctPack, Packed};
+use super::choices::{Choice, Packed};
 use super::metrics::{compare, error_json, median, merge};
 use super::{DISTANCES, FILTERS, MCT_FILTERS, TradeOptions};
 use crate::bench::BenchRenderError;
@@ -45,13 +45,32 @@ fn unlit(camera: OrbitCamera, filter: FilterMode) -> RenderSettings {
     settings
 }
 
+/// A representation of the study's rows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Rep {
+    MeshColors,
+    Mct,
+    Ptex,
+}
+
+impl Rep {
+    fn name(self) -> &'static str {
+        match self {
+            Rep::MeshColors => "mesh-colors",
+            Rep::Mct => "mct",
+            Rep::Ptex => "ptex",
+        }
+    }
+}
+
 /// One configuration drawn in a view: a choice, one of its packs, the representation and
-/// an index into [`FILTERS`] (mesh colors) or [`MCT_FILTERS`] (MCT).
+/// an index into [`FILTERS`] (mesh colors) or [`MCT_FILTERS`] (MCT and packed Ptex: both
+/// hardware bilinear, a fixed level or two levels).
 #[derive(Debug, Clone, Copy)]
 struct Item {
     choice: usize,
     pack: usize,
-    mct: bool,
+    rep: Rep,
     filter: usize,
 }
 
@@ -73,9 +92,11 @@ impl Study<'_> {
         let mut items = Vec::new();
         for (choice, c) in self.choices.iter().enumerate() {
             for (pack, p) in c.packs.iter().enumerate() {
-                items.extend((0..FILTERS.len()).map(|filter| Item { choice, pack, mct: false, filter }));
-                if p.mct.is_ok() {
-                    items.extend((0..MCT_FILTERS.len()).map(|filter| Item { choice, pack, mct: true, filter }));
+                items.extend((0..FILTERS.len()).map(|filter| Item { choice, pack, rep: Rep::MeshColors, filter }));
+                for (rep, ok) in [(Rep::Mct, p.mct.is_ok()), (Rep::Ptex, p.ptex.is_ok())] {
+                    if ok {
+                        items.extend((0..MCT_FILTERS.len()).map(|filter| Item { choice, pack, rep, filter }));
+                    }
                 }
             }
         }
@@ -86,20 +107,17 @@ impl Study<'_> {
         &self.choices[item.choice].packs[item.pack]
     }
 
-    /// The item's MCT, when it is an MCT item.
-    fn mct(&self, item: Item) -> Option<&MctPack> {
-        if item.mct { self.packed(item).mct.as_ref().ok() } else { None }
-    }
-
     fn draw_item(&self, item: Item) -> DrawItem<'_> {
-        match self.mct(item) {
-            Some(mct) => DrawItem::Mct(&mct.gpu),
-            None => DrawItem::MeshColors(&self.packed(item).mesh),
+        let packed = self.packed(item);
+        match (item.rep, &packed.mct, &packed.ptex) {
+            (Rep::Mct, Ok(mct), _) => DrawItem::Mct(&mct.gpu),
+            (Rep::Ptex, _, Ok(ptex)) => DrawItem::Ptex(&ptex.gpu),
+            _ => DrawItem::MeshColors(&packed.mesh),
         }
     }
 
     fn filter(item: Item) -> (&'static str, FilterMode) {
-        if item.mct { MCT_FILTERS[item.filter] } else { FILTERS[item.filter] }
+        if item.rep == Rep::MeshColors { FILTERS[item.filter] } else { MCT_FILTERS[item.filter] }
     }
 
     /// Median frame times in ms of the baseline and of every item, interleaved: each round
@@ -198,7 +216,7 @@ impl Study<'_> {
         let resolutions = choice.document.store.face_resolutions();
         let mut row = serde_json::json!({
             "bench": "trade", "kind": "config", "file": self.file,
-            "representation": if item.mct { "mct" } else { "mesh-colors" },
+            "representation": item.rep.name(),
             "filter": Self::filter(item).0, "resolution": choice.label, "error_bound": choice.error_bound,
             "resolution_min": resolutions.iter().map(|r| r.get()).min(),
             "resolution_max": resolutions.iter().map(|r| r.get()).max(),
@@ -210,8 +228,9 @@ impl Study<'_> {
             "pack_seconds": packed.pack_seconds,
             "convert_seconds": choice.convert_seconds,
         });
-        let more = match self.mct(item) {
-            Some(mct) => serde_json::json!({
+        let more = match (item.rep, &packed.mct, &packed.ptex) {
+            (Rep::Ptex, _, Ok(ptex)) => ptex_json(packed, ptex),
+            (Rep::Mct, Ok(mct), _) => serde_json::json!({
                 "gpu_bytes": packed.geometry_bytes() + mct.gpu.gpu_bytes(),
                 "color_gpu_bytes": mct.gpu.gpu_bytes(),
                 "mct_bytes": mct.texture.gpu_bytes(),
@@ -222,7 +241,7 @@ impl Study<'_> {
                 "mct_clamped_ring_texels": mct.texture.stats.clamped_ring_texels,
                 "mct_max_ring_clamp": mct.texture.stats.max_ring_clamp,
             }),
-            None => serde_json::json!({
+            _ => serde_json::json!({
                 "gpu_bytes": packed.mesh.gpu_bytes(),
                 "color_gpu_bytes": packed.mesh.atlas_bytes() + packed.mesh.face_record_bytes(),
                 "dab_samples_per_second": choice.dab.get("samples_per_second_median"),
@@ -233,6 +252,33 @@ impl Study<'_> {
         merge(&mut row, &more);
         row
     }
+}
+
+/// The packed Ptex columns of a `config` row: bytes (GPU, and over the packed mesh colors),
+/// where its texels go (the blocks' own, borders, unused: the paper's ~8 % packing and ~10 %
+/// border anchors are `ptex_unused_over_interior` and `ptex_border_over_interior`) and the
+/// build time.
+fn ptex_json(packed: &Packed, ptex: &super::choices::PtexPack) -> serde_json::Value {
+    let t = &ptex.texture;
+    let interior = t.stats.interior_texels.max(1) as f64;
+    serde_json::json!({
+        "gpu_bytes": packed.geometry_bytes() + ptex.gpu.gpu_bytes(),
+        "color_gpu_bytes": ptex.gpu.gpu_bytes(),
+        "ptex_bytes": t.gpu_bytes(),
+        "ptex_bytes_over_mesh_colors": t.gpu_bytes() as f64 / packed.mesh_colors_bytes().max(1) as f64,
+        "ptex_build_seconds": ptex.build_seconds,
+        "ptex_texture": [t.layout.width, t.layout.height],
+        "ptex_blocks": t.layout.blocks.len(),
+        "ptex_lone_blocks": t.layout.blocks.iter().filter(|b| !b.paired).count(),
+        "ptex_levels": t.layout.levels,
+        "ptex_interior_texels": t.stats.interior_texels,
+        "ptex_border_texels": t.stats.border_texels(),
+        "ptex_unused_texels": t.unused_texels(),
+        "ptex_border_over_interior": t.stats.border_texels() as f64 / interior,
+        "ptex_unused_over_interior": t.unused_texels() as f64 / interior,
+        "ptex_resampled_border_texels": t.stats.resampled_border_texels,
+        "ptex_unfolded_border_texels": t.stats.unfolded_border_texels,
+    })
 }
 
 /// The pixels compared: all 16 subsamples of the reference covered, and the test covers the pixel.

@@ -24,6 +24,8 @@ mod packer;
 mod paint_layout;
 mod picking;
 mod progress;
+mod ptex;
+mod ptex_file;
 mod repack;
 mod seams;
 mod store;

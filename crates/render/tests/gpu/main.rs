@@ -8,5 +8,6 @@ mod baseline_materials;
 mod gpu_atlas_addressing;
 mod gpu_mct;
 mod gpu_paint_upload;
+mod gpu_ptex;
 mod gpu_vs_cpu;
 mod shaders;
