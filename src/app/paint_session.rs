@@ -91,7 +91,7 @@ impl PaintSession {
             }
             shown.map(|mesh| CompactMesh::Shown(mesh.atlas_writer()))
         } else {
-            self.compact_gpu_mesh.take().map(CompactMesh::Owned)
+            self.compact_gpu_mesh.take().map(|mesh| CompactMesh::Owned(Box::new(mesh)))
         };
         (cache, self.repack_dirty, compact)
     }
@@ -101,7 +101,7 @@ impl PaintSession {
 #[derive(Debug)]
 pub enum CompactMesh {
     /// Kept aside during paint mode; the view shows it again when the repack is done.
-    Owned(GpuMesh),
+    Owned(Box<GpuMesh>),
     /// The mesh the view shows (paint mode painted it in place): written through its atlas.
     Shown(AtlasWriter),
 }
@@ -118,7 +118,7 @@ impl CompactMesh {
     /// The mesh for the view to show afterwards (`None`: keep the one shown).
     pub fn into_mesh(self) -> Option<GpuMesh> {
         match self {
-            CompactMesh::Owned(mesh) => Some(mesh),
+            CompactMesh::Owned(mesh) => Some(*mesh),
             CompactMesh::Shown(_) => None,
         }
     }

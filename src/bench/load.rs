@@ -7,9 +7,11 @@
 //! the total: it stands in for a larger file), weld, topology, store (allocate and colour),
 //! then pack + upload next to the BVH build (both branches timed; the total counts the
 //! wall time of the pair), and one rendered frame: `total_seconds`, the document on screen.
-//! Then what Tab does in the editor ([`meshpaint_render::Gpu::upload_paint_layout`], the same
-//! call): enter paint mode (paint layout, its upload, the base snapshot of the store) and
-//! the first frame of it: `total_to_paint_seconds`, the first frame a brush can touch. The
+//! Then what Tab does in the editor ([`meshpaint_render::Gpu::enter_paint`], the same call):
+//! enter paint mode (the paint layout laid over the packing the view shows, beside the base
+//! snapshot of the store and the vertex → face table; `--eager-paint`: the layout built,
+//! encoded and uploaded, the way before) and the first frame of it: `total_to_paint_seconds`,
+//! the first frame a brush can touch. `buffers` gives the bytes of every buffer held then. The
 //! peak memory is read twice: with the document on screen (`peak_resident_on_screen_bytes`)
 //! and at the end, in paint mode (`peak_resident_bytes`). The GPU itself is created before the
 //! clock starts (the editor has it before any file opens).
