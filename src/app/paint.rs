@@ -79,26 +79,40 @@ impl DocumentState {
         // Changes from before (none expected) are in the new layout anyway; the compact
         // packing is reused on leaving only if it is still the store's.
         let unpacked_changes = !document.store.take_dirty().is_empty();
-        let layout = PaintLayout::new(&document.store);
-        let (mut compact_gpu_mesh, mut encoded) = (None, None);
-        if let Some(gpu) = ctx.gpu {
-            match gpu.upload_paint_layout(&layout, &document.store, &document.positions, open.format) {
-                Ok(upload) => {
-                    ctx.viewport.upload_bytes_this_frame += upload.bytes;
-                    compact_gpu_mesh = open.gpu_mesh.replace(upload.mesh);
+        let mut pack_cache = if unpacked_changes { None } else { open.pack_cache.take() };
+        let (mut layout, mut compact_gpu_mesh, mut encoded, mut lent_colors) = (None, None, None, false);
+        // Painted in place when the view shows the packing (no wait); else uploaded anew. The
+        // base snapshot (copy-on-write) and the session's tables are made meanwhile.
+        let compact = if open.gpu_mesh.is_some() { pack_cache.as_mut() } else { None };
+        let (store, positions, format) = (&document.store, &document.positions, open.format);
+        let (entered, (base, vertex_faces, repack_dirty)) = rayon::join(
+            || ctx.gpu.map(|gpu| gpu.enter_paint(store, positions, format, compact)),
+            || (store.clone(), VertexFaces::of(store.topology()), DirtyAccumulator::new(store.topology())),
+        );
+        if let Some(entered) = entered {
+            match entered {
+                Ok(start) => {
+                    ctx.viewport.upload_bytes_this_frame += start.bytes;
+                    match start.mesh {
+                        Some(mesh) => compact_gpu_mesh = open.gpu_mesh.replace(mesh),
+                        None => lent_colors = true,
+                    }
                     // Paint mode draws mesh colors; the Mesh Color Texture is rebuilt after it.
                     open.mesh_generation += 1;
                     open.alternates.mct = None;
                     open.alternates.ptex = None;
-                    encoded = Some(upload.encoded);
+                    encoded = Some(start.encoded);
+                    layout = Some(start.layout);
                 }
                 Err(error) => {
+                    open.pack_cache = pack_cache;
                     let text = format!("Cannot enter paint mode: uploading the paint layout failed: {error}");
                     ctx.status.set(Severity::Error, text);
                     return;
                 }
             }
         }
+        let layout = layout.unwrap_or_else(|| PaintLayout::new(&document.store));
         let painter = {
             let mut painter = Painter::new(&document.positions);
             painter.set_settings(*ctx.brush);
@@ -108,7 +122,8 @@ impl DocumentState {
         self.paint = Some(PaintSession {
             layout,
             encoded,
-            base: document.store.clone(),
+            lent_colors,
+            base,
             painter,
             gesture: None,
             last_pointer: None,
@@ -116,10 +131,10 @@ impl DocumentState {
             stroke_upload_bytes: 0,
             stroke_samples_changed: 0,
             upload_failed: false,
-            pack_cache: if unpacked_changes { None } else { open.pack_cache.take() },
+            pack_cache,
             compact_gpu_mesh,
-            repack_dirty: DirtyAccumulator::new(document.store.topology()),
-            vertex_faces: VertexFaces::of(document.store.topology()),
+            repack_dirty,
+            vertex_faces,
         });
         self.gpu_paint_layout = true;
         ctx.viewport.scene_generation += 1;
@@ -140,7 +155,7 @@ impl DocumentState {
             return;
         };
         let (cache, mut dirty, compact_gpu_mesh) = match session {
-            Some(mut session) => (session.pack_cache.take(), session.repack_dirty, session.compact_gpu_mesh.take()),
+            Some(session) => session.into_repack_inputs(open.gpu_mesh.as_ref()),
             None => (None, DirtyAccumulator::default(), None),
         };
         let document = Arc::clone(&open.document);
@@ -175,7 +190,7 @@ impl DocumentState {
                         let bytes = &packed.colors[first as usize * size..(first + count) as usize * size];
                         mesh.write_samples(&gpu.ctx, first, bytes).map_err(upload_error)?;
                     }
-                    Some(mesh)
+                    mesh.into_mesh()
                 }
                 (Some(gpu), _, _) => Some(gpu.upload(packed).map_err(upload_error)?),
                 (None, _, _) => None,
@@ -300,8 +315,14 @@ impl DocumentState {
         // The faces these changes show on, for a partial redraw (`None`: all of them).
         let mut shown = None;
         if let (Some(gpu), Some(mesh)) = (ctx.gpu, open.gpu_mesh.as_mut()) {
+            if plan.grown
+                && let Some(encoded) = session.encoded.as_mut()
+                && let Err(e) = gpu.grow_paint_buffer(mesh, encoded, &session.layout)
+            {
+                error = Some(e.to_string());
+            }
             match session.encoded.as_mut() {
-                Some(encoded) if !plan.grown && encoded.format() == open.format => {
+                Some(encoded) if error.is_none() && encoded.format() == open.format => {
                     let spans = encoded.apply(&session.layout, &doc.store, &dirty, &plan);
                     let records = (plan.faces.as_slice(), session.layout.records());
                     match mesh.write_paint_upload(&gpu.ctx, &spans, encoded.bytes(), records) {
@@ -317,6 +338,9 @@ impl DocumentState {
                         *mesh = upload.mesh;
                         bytes += upload.bytes;
                         session.encoded = Some(upload.encoded);
+                        // The packing's bytes are gone with the mesh: leaving packs in full.
+                        session.lent_colors = false;
+                        error = None;
                     }
                     Err(e) => error = Some(e.to_string()),
                 },

@@ -11,7 +11,7 @@ use meshpaint_core::mesh::topology::VertexFaces;
 use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::packing::paint_layout::{EncodedBuffer, PaintLayout};
 use meshpaint_core::paint::brush::{self, Painter};
-use meshpaint_render::GpuMesh;
+use meshpaint_render::{AtlasWriter, GpuContext, GpuMesh, RenderError};
 
 /// Points of pointer travel for strength 0 → 1 in the Shift+F gesture.
 pub const STRENGTH_GESTURE_POINTS: f32 = 200.0;
@@ -45,6 +45,9 @@ pub struct PaintSession {
     /// The encoded paint buffer as the GPU holds it (uploads send merged spans from it);
     /// `None` without a GPU.
     pub encoded: Option<EncodedBuffer>,
+    /// `encoded` holds the bytes of [`PaintSession::pack_cache`], lent to paint the mesh the
+    /// view showed in place ([`meshpaint_render::Gpu::enter_paint`]); they go back on leaving.
+    pub lent_colors: bool,
     /// The colours when paint mode was entered (Erase to base).
     pub base: ColorStore,
     /// The brush engine.
@@ -71,6 +74,54 @@ pub struct PaintSession {
     /// The faces around each vertex: which faces a dab's changes show on (the 3D view
     /// redraws only those).
     pub vertex_faces: VertexFaces,
+}
+
+impl PaintSession {
+    /// What the repack on leaving starts from: the packing (its lent bytes given back), every
+    /// change of the session, and the compact GPU buffers to patch in place: those kept
+    /// aside, or the ones `shown` (the view's mesh) when the session painted them in place.
+    pub fn into_repack_inputs(
+        mut self,
+        shown: Option<&GpuMesh>,
+    ) -> (Option<PackCache>, DirtyAccumulator, Option<CompactMesh>) {
+        let mut cache = self.pack_cache.take();
+        let compact = if self.lent_colors {
+            if let (Some(cache), Some(encoded)) = (cache.as_mut(), self.encoded.take()) {
+                cache.return_colors(encoded.into_bytes());
+            }
+            shown.map(|mesh| CompactMesh::Shown(mesh.atlas_writer()))
+        } else {
+            self.compact_gpu_mesh.take().map(|mesh| CompactMesh::Owned(Box::new(mesh)))
+        };
+        (cache, self.repack_dirty, compact)
+    }
+}
+
+/// The compact buffers on the GPU a repack patches in place.
+#[derive(Debug)]
+pub enum CompactMesh {
+    /// Kept aside during paint mode; the view shows it again when the repack is done.
+    Owned(Box<GpuMesh>),
+    /// The mesh the view shows (paint mode painted it in place): written through its atlas.
+    Shown(AtlasWriter),
+}
+
+impl CompactMesh {
+    /// Overwrites samples `first..` with `encoded`.
+    pub fn write_samples(&self, ctx: &GpuContext, first: u64, encoded: &[u8]) -> Result<(), RenderError> {
+        match self {
+            CompactMesh::Owned(mesh) => mesh.write_samples(ctx, first, encoded),
+            CompactMesh::Shown(atlas) => atlas.write_samples(ctx, first, encoded),
+        }
+    }
+
+    /// The mesh for the view to show afterwards (`None`: keep the one shown).
+    pub fn into_mesh(self) -> Option<GpuMesh> {
+        match self {
+            CompactMesh::Owned(mesh) => Some(*mesh),
+            CompactMesh::Shown(_) => None,
+        }
+    }
 }
 
 /// Which repack leaving paint mode ran.
@@ -100,7 +151,8 @@ impl Repack {
 pub struct Repacked {
     /// The document that was packed (applied only if it is still the open one).
     pub document: Arc<Document>,
-    /// The compact buffers on the GPU (`None` without a GPU).
+    /// The compact buffers on the GPU (`None` without a GPU, or when the view's mesh was
+    /// patched in place).
     pub gpu_mesh: Option<GpuMesh>,
     /// Samples with MIP chains.
     pub samples_with_mips: u64,

@@ -69,6 +69,10 @@ pub(super) enum BenchCommand {
         /// Height of the first frame.
         #[arg(long, default_value_t = 720)]
         height: u32,
+        /// Enter paint mode the way before: build and upload the paint layout (timed step by
+        /// step) instead of painting the packing the view shows in place.
+        #[arg(long)]
+        eager_paint: bool,
     },
     /// Dab-to-screen latency as the editor paints: open, enter paint mode, strokes of one
     /// pointer move per frame; per move the dab and the 3D view's frame finished on the GPU
@@ -319,8 +323,8 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
         BenchCommand::Pack { file, resolution, format, runs, subdivide, stroke_samples } => {
             pack(file, resolution, format, runs, subdivide, stroke_samples)
         }
-        BenchCommand::Load { file, resolution, subdivide, width, height } => {
-            load(file, resolution, subdivide, width, height)
+        BenchCommand::Load { file, resolution, subdivide, width, height, eager_paint } => {
+            load(file, resolution, subdivide, (width, height), eager_paint)
         }
         BenchCommand::Latency { file, resolution, width, height, moves, radius_px } => {
             let resolution = meshpaint_core::colors::layout::Resolution::new(resolution).context("--resolution")?;
@@ -499,9 +503,9 @@ fn pack(
 }
 
 /// `bench load`: from a file to the document on screen and on to paint mode, phase by phase.
-fn load(file: PathBuf, resolution: u64, subdivide: u32, width: u32, height: u32) -> Result<()> {
+fn load(file: PathBuf, resolution: u64, subdivide: u32, size: (u32, u32), eager_paint: bool) -> Result<()> {
     let r = meshpaint_core::colors::layout::Resolution::new(resolution).context("--resolution")?;
-    let report = meshpaint::bench::bench_load(&file, r, subdivide, &budget(None), width, height)?;
+    let report = meshpaint::bench::bench_load(&file, r, subdivide, &budget(None), size, eager_paint)?;
     println!("{report}");
     Ok(())
 }

@@ -21,6 +21,7 @@ use meshpaint_core::colors::layout::{self, Resolution};
 use meshpaint_core::colors::store::ColorStore;
 use meshpaint_core::mesh::topology::Topology;
 use meshpaint_core::packing::linear::PackedMesh;
+use meshpaint_core::packing::lod::LOD_BIAS;
 use meshpaint_core::packing::packer::pack;
 use meshpaint_core::packing::sampler::{Filter, sample, sample_trilinear};
 use meshpaint_core::paint::picking::{BvhPreset, MeshBvh};
@@ -431,7 +432,8 @@ fn continuous_lod_with(scene: &Scene, inputs: &[(f64, DVec3)], face: u32, bary: 
         let to_eye = eye - point(v);
         let cosine = normal.dot(to_eye).abs() / to_eye.length();
         depth += f64::from(bary[k]) * (point(v) - eye).dot(forward);
-        mu += f64::from(bary[k]) * (kappa * density / cosine.max(1.0 / 16.0)).log2().clamp(-64.0, 64.0);
+        let term = (kappa * density / cosine.max(1.0 / 16.0)).log2() + f64::from(LOD_BIAS);
+        mu += f64::from(bary[k]) * term.clamp(-64.0, 64.0);
     }
     let last = resolutions.iter().map(|r| r.log2()).max().unwrap_or(0);
     (depth.log2() + mu).clamp(0.0, f64::from(last)) as f32
@@ -443,7 +445,8 @@ fn continuous_lod_with(scene: &Scene, inputs: &[(f64, DVec3)], face: u32, bary: 
 #[test]
 fn trilinear_matches_the_continuous_level_of_detail() {
     let mut failures = Vec::new();
-    for resolution in [256u64, 4096] {
+    // Fine enough that the level of detail, with its bias, blends levels ≥ 1.
+    for resolution in [1024u64, 4096] {
         let scene = big_triangle(resolution, 77 + resolution);
         // The blend must matter: most pixels between two levels, not at one.
         let lods: Vec<f32> = (0..SIZE * SIZE)
@@ -535,7 +538,8 @@ fn trilinear_on_the_duck_in_perspective_matches_the_continuous_level_of_detail()
 #[test]
 fn trilinear_is_seamless_across_mixed_resolution_edges() {
     let mut failures = Vec::new();
-    for (ra, rb, seed) in [(1024u64, 64u64, 5u64), (4096, 2, 6), (1, 2048, 7), (512, 512, 8)] {
+    // Resolutions fine enough that the edge's level of detail, with its bias, is past 1.
+    for (ra, rb, seed) in [(4096u64, 256u64, 5u64), (4096, 2, 6), (1, 2048, 7), (2048, 2048, 8)] {
         let scene = square_scene(
             &[[18.0, 31.0], [229.0, 44.0], [37.0, 223.0], [241.0, 238.0]],
             vec![[0, 1, 2], [2, 1, 3]],

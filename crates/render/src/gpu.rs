@@ -16,6 +16,7 @@ use meshpaint_core::mct::MeshColorTexture;
 use meshpaint_core::mesh::scene::Scene;
 use meshpaint_core::mesh::weld::weld_scene;
 use meshpaint_core::packing::linear::PackedMesh;
+use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::packing::paint_layout::{EncodedBuffer, PaintLayout};
 use meshpaint_core::ptex::PackedPtex;
 
@@ -26,6 +27,21 @@ pub struct PaintUpload {
     pub mesh: GpuMesh,
     /// The CPU copy of the encoded buffer that a dab's uploads copy their spans from.
     pub encoded: EncodedBuffer,
+    /// Bytes uploaded: colours and face records.
+    pub bytes: u64,
+}
+
+/// What entering paint mode put in place ([`Gpu::enter_paint`]).
+#[derive(Debug)]
+pub struct PaintStart {
+    /// Where every element's level-0 samples are in the GPU's colour buffer.
+    pub layout: PaintLayout,
+    /// The CPU copy of that buffer, which a dab's uploads copy their spans from.
+    pub encoded: EncodedBuffer,
+    /// A new GPU mesh holding the paint layout, or `None`: the mesh the view shows (the
+    /// compact packing's) is painted in place, and `encoded` holds the bytes lent by the
+    /// packing ([`PackCache::lend_colors`]), to be given back on leaving.
+    pub mesh: Option<GpuMesh>,
     /// Bytes uploaded: colours and face records.
     pub bytes: u64,
 }
@@ -81,6 +97,44 @@ impl Gpu {
         let mesh = self.upload(&packed)?;
         let bytes = packed.color_bytes() + packed.face_record_bytes();
         Ok(PaintUpload { mesh, encoded: EncodedBuffer::from_packed_owned(packed), bytes })
+    }
+
+    /// Enters paint mode on `store`. With `compact`, the packing of `store` that the view's
+    /// GPU mesh holds ([`Gpu::upload`] of [`PackCache::packed`]), in `format`, nothing is
+    /// uploaded or encoded: the paint layout is laid over that packing
+    /// ([`PaintLayout::over_packed`]) and its bytes are lent to the encoded copy. Otherwise
+    /// (no packing, another format, a packing of other resolutions) the paint layout is built
+    /// and uploaded ([`Gpu::upload_paint_layout`]).
+    pub fn enter_paint(
+        &self,
+        store: &ColorStore,
+        positions: &[[f32; 3]],
+        format: ColorFormat,
+        compact: Option<&mut PackCache>,
+    ) -> Result<PaintStart, RenderError> {
+        if let Some(cache) = compact.filter(|cache| cache.packed().format == format)
+            && let Some(layout) = PaintLayout::over_packed(store, cache.packed())
+        {
+            let encoded = EncodedBuffer::from_bytes(format, cache.lend_colors());
+            return Ok(PaintStart { layout, encoded, mesh: None, bytes: 0 });
+        }
+        let layout = PaintLayout::new(store);
+        let upload = self.upload_paint_layout(&layout, store, positions, format)?;
+        Ok(PaintStart { layout, encoded: upload.encoded, mesh: Some(upload.mesh), bytes: upload.bytes })
+    }
+
+    /// Grows the paint buffer, on the GPU (`mesh`) and its CPU copy (`encoded`), to the
+    /// capacity of `layout` after a plan that `grown`: the old samples stay where they are
+    /// (copied on the GPU), so only the plan's ranges need uploading afterwards.
+    pub fn grow_paint_buffer(
+        &self,
+        mesh: &mut GpuMesh,
+        encoded: &mut EncodedBuffer,
+        layout: &PaintLayout,
+    ) -> Result<(), RenderError> {
+        mesh.grow_atlas(&self.ctx, self.renderer.layouts(), layout.capacity())?;
+        encoded.grow(layout.capacity());
+        Ok(())
     }
 
     /// Uploads the UV-texture baseline of `scene`: its welded mesh, every face with its own

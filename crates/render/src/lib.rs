@@ -49,11 +49,13 @@ mod uniforms;
 
 pub use baseline::{BaselineMesh, BaselineSource, BaselineVertex, mip_chain_linear};
 pub use context::{GpuContext, backends_from_env};
-pub use gpu::{Gpu, PaintUpload};
+pub use gpu::{Gpu, PaintStart, PaintUpload};
 pub use heat::{HEAT_COLORS, heat_color};
 pub use layouts::BindLayouts;
 pub use mct::GpuMct;
-pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshGeometry, MeshUploadOptions, atlas_texture_format, default_atlas_width};
+pub use mesh_gpu::{
+    AtlasLayout, AtlasWriter, GpuMesh, MeshGeometry, MeshUploadOptions, atlas_texture_format, default_atlas_width,
+};
 pub use partial::{FaceSubset, Scissor};
 pub use ptex::{GpuPtex, GpuPtexSlice, gpu_tables};
 pub use readback::read_texture;

@@ -38,7 +38,10 @@ pub(super) const DATA_TEXEL_BYTES: u64 = 16;
 
 /// Writes `data` (whole texels of `bytes_per_texel`) into `texture`, whose rows are `width`
 /// texels, starting at texel index `first` (texel `(first % width, first / width)`): partial
-/// rows at the ends, bands of full rows in between.
+/// rows at the ends, bands of full rows in between. Each write is staged in a buffer of its
+/// own that lives until the GPU has run its copy, so a write of many bands is submitted and
+/// waited for band by band: at most one band ([`UPLOAD_BAND_BYTES`]) is staged at a time
+/// instead of the whole atlas beside its texture (on lavapipe both are host memory).
 fn write_texel_rows(
     ctx: &GpuContext,
     texture: &wgpu::Texture,
@@ -51,7 +54,14 @@ fn write_texel_rows(
     let width = u64::from(width);
     let band_rows = (UPLOAD_BAND_BYTES / (width * bytes_per_texel)).max(1);
     let mut done = 0u64;
+    let mut staged = 0u64;
     while done < count {
+        if staged >= UPLOAD_BAND_BYTES {
+            ctx.queue.submit([]);
+            // A failed wait leaves the staging to the next submission: only memory is at stake.
+            let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+            staged = 0;
+        }
         let (x, y) = ((first + done) % width, (first + done) / width);
         let remaining = count - done;
         // A partial row (unaligned start or the tail), else a band of full rows.
@@ -78,6 +88,7 @@ fn write_texel_rows(
             wgpu::Extent3d { width: texels_per_row as u32, height: rows as u32, depth_or_array_layers: 1 },
         );
         done += texels_per_row * rows;
+        staged += texels_per_row * rows * bytes_per_texel;
     }
 }
 
@@ -331,37 +342,15 @@ impl GpuMesh {
             bytemuck::cast_slice::<FaceRecord, u8>(&packed.face_records),
         )?;
 
-        let atlas_texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("colour atlas"),
-            size: wgpu::Extent3d { width: atlas.width, height: atlas.height, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: atlas_texture_format(packed.format),
-            // COPY_SRC: tests read the GPU copy back (super::readback).
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let view = |texture: &wgpu::Texture| texture.create_view(&wgpu::TextureViewDescriptor::default());
-        let atlas_view = view(&atlas_texture);
+        let atlas_texture = new_atlas_texture(ctx, &atlas, packed.format);
         let uniforms = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("mesh colors uniforms"),
             size: std::mem::size_of::<super::FrameUniforms>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("mesh colors bind group"),
-            layout: layouts.mesh(),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view(&positions)) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&view(&indices)) },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&view(&face_records)) },
-                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&atlas_view) },
-                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&view(&normals)) },
-            ],
-        });
+        let bind_group =
+            mesh_bind_group(ctx, layouts, &uniforms, [&positions, &indices, &face_records, &atlas_texture, &normals]);
         let mesh = GpuMesh {
             origin,
             bounds,
@@ -382,21 +371,50 @@ impl GpuMesh {
         Ok(mesh)
     }
 
+    /// Grows the colour atlas to hold `samples` (rows of the same width): the old texels are
+    /// copied on the GPU, the new ones are zero (the encoding of a zero colour), so a paint
+    /// layout that outgrew its buffer re-encodes and uploads nothing but its changes. Nothing
+    /// happens when the atlas holds `samples` already.
+    pub fn grow_atlas(&mut self, ctx: &GpuContext, layouts: &BindLayouts, samples: u64) -> Result<(), RenderError> {
+        if samples <= self.atlas.samples {
+            return Ok(());
+        }
+        let atlas = AtlasLayout::new(samples, self.atlas.width, ctx.limits().max_texture_dimension_2d)?;
+        let texture = ctx.checked(|| {
+            let texture = new_atlas_texture(ctx, &atlas, self.format);
+            let mut encoder =
+                ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("grow the atlas") });
+            encoder.copy_texture_to_texture(
+                self.atlas_texture.as_image_copy(),
+                texture.as_image_copy(),
+                wgpu::Extent3d { width: self.atlas.width, height: self.atlas.height, depth_or_array_layers: 1 },
+            );
+            ctx.queue.submit([encoder.finish()]);
+            Ok(texture)
+        })?;
+        self.bind_group = mesh_bind_group(
+            ctx,
+            layouts,
+            &self.uniforms,
+            [&self.positions, &self.indices, &self.face_records, &texture, &self.normals],
+        );
+        self.atlas_texture = texture;
+        self.atlas = atlas;
+        Ok(())
+    }
+
     /// Overwrites samples `first..first + n` of the colour atlas with `encoded` (`n` samples
     /// in the mesh's format), e.g. the dirty range of a paint stroke.
     pub fn write_samples(&self, ctx: &GpuContext, first: u64, encoded: &[u8]) -> Result<(), RenderError> {
-        let bytes_per_sample = self.format.bytes_per_sample() as u64;
-        let count = encoded.len() as u64 / bytes_per_sample;
-        if !(encoded.len() as u64).is_multiple_of(bytes_per_sample) || first.saturating_add(count) > self.atlas.samples
-        {
-            return Err(RenderError::InvalidMesh(format!(
-                "writing {} bytes at sample {first} overruns the {} samples of the colour atlas",
-                encoded.len(),
-                self.atlas.samples
-            )));
-        }
-        write_texel_rows(ctx, &self.atlas_texture, self.atlas.width, bytes_per_sample, first, encoded);
-        Ok(())
+        write_atlas_samples(ctx, (&self.atlas_texture, &self.atlas, self.format), first, encoded)
+    }
+
+    /// A handle to the colour atlas that another thread can write samples through
+    /// ([`AtlasWriter::write_samples`]) while this mesh is drawn: leaving paint mode patches
+    /// the mesh the view shows from its repack job. It writes into this atlas, not into one
+    /// that [`GpuMesh::grow_atlas`] makes later.
+    pub fn atlas_writer(&self) -> AtlasWriter {
+        AtlasWriter { texture: self.atlas_texture.clone(), atlas: self.atlas, format: self.format }
     }
 
     /// Writes one paint-mode upload (the editor's path after a dab): the sample spans
@@ -495,6 +513,81 @@ impl GpuMesh {
             + data_texture_bytes(&self.face_records)
             + atlas
     }
+}
+
+/// A mesh's colour atlas, writable from any thread ([`GpuMesh::atlas_writer`]).
+#[derive(Debug, Clone)]
+pub struct AtlasWriter {
+    texture: wgpu::Texture,
+    atlas: AtlasLayout,
+    format: ColorFormat,
+}
+
+impl AtlasWriter {
+    /// Overwrites samples `first..first + n` with `encoded` ([`GpuMesh::write_samples`]).
+    pub fn write_samples(&self, ctx: &GpuContext, first: u64, encoded: &[u8]) -> Result<(), RenderError> {
+        write_atlas_samples(ctx, (&self.texture, &self.atlas, self.format), first, encoded)
+    }
+}
+
+/// Writes `encoded` (whole samples of `format`) into the atlas `texture` laid out as `atlas`
+/// from sample `first` on; refuses writes past its samples.
+fn write_atlas_samples(
+    ctx: &GpuContext,
+    (texture, atlas, format): (&wgpu::Texture, &AtlasLayout, ColorFormat),
+    first: u64,
+    encoded: &[u8],
+) -> Result<(), RenderError> {
+    let bytes_per_sample = format.bytes_per_sample() as u64;
+    let count = encoded.len() as u64 / bytes_per_sample;
+    if !(encoded.len() as u64).is_multiple_of(bytes_per_sample) || first.saturating_add(count) > atlas.samples {
+        return Err(RenderError::InvalidMesh(format!(
+            "writing {} bytes at sample {first} overruns the {} samples of the colour atlas",
+            encoded.len(),
+            atlas.samples
+        )));
+    }
+    write_texel_rows(ctx, texture, atlas.width, bytes_per_sample, first, encoded);
+    Ok(())
+}
+
+/// A colour atlas of `atlas`'s size for samples of `format` (new textures are zero).
+fn new_atlas_texture(ctx: &GpuContext, atlas: &AtlasLayout, format: ColorFormat) -> wgpu::Texture {
+    ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("colour atlas"),
+        size: wgpu::Extent3d { width: atlas.width, height: atlas.height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: atlas_texture_format(format),
+        // COPY_SRC: tests read the GPU copy back (super::readback), and a grown atlas copies
+        // the old one.
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// The mesh-colors bind group: the uniforms, then positions, indices, face records, atlas
+/// and normals (bindings 1–5).
+fn mesh_bind_group(
+    ctx: &GpuContext,
+    layouts: &BindLayouts,
+    uniforms: &wgpu::Buffer,
+    [positions, indices, face_records, atlas, normals]: [&wgpu::Texture; 5],
+) -> wgpu::BindGroup {
+    let view = |texture: &wgpu::Texture| texture.create_view(&wgpu::TextureViewDescriptor::default());
+    ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("mesh colors bind group"),
+        layout: layouts.mesh(),
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view(positions)) },
+            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&view(indices)) },
+            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&view(face_records)) },
+            wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&view(atlas)) },
+            wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&view(normals)) },
+        ],
+    })
 }
 
 /// Vertex and face counts of `packed`, or why it cannot be drawn: counts beyond `u32`, face

@@ -434,6 +434,8 @@ impl Renderer {
         let eye = (settings.camera.eye() - item.origin()).as_vec3();
         let pixel_angle =
             (2.0 * (settings.camera.fov_y_degrees.to_radians() * 0.5).tan() / f64::from(height.max(1))) as f32;
+        // κ · 2^LOD_BIAS: the level of detail's bias (crates/core/src/packing/lod.rs).
+        let pixel_angle = pixel_angle * meshpaint_core::packing::lod::LOD_BIAS.exp2();
         let (filter_kind, level_mode, level) = settings.filter.uniform_fields();
         let mut flags = 0;
         match settings.shading {

@@ -17,6 +17,11 @@ use rayon::prelude::*;
 
 use crate::colors::format::Rgba;
 
+/// Bytes of `v`'s allocation.
+pub(crate) fn vec_bytes<T>(v: &Vec<T>) -> usize {
+    v.capacity() * std::mem::size_of::<T>()
+}
+
 /// Samples per chunk (16 MiB of `f32` RGBA); a longer element gets a chunk of its own.
 const CHUNK: usize = 1 << 20;
 
@@ -61,6 +66,22 @@ impl Slab {
         let chunks: Vec<Arc<Vec<Rgba>>> =
             chunk_lens.par_iter().map(|&n| Arc::new(crate::memory::filled(n, color))).collect();
         Slab { dead: vec![0; chunks.len()], chunks, slots, live }
+    }
+
+    /// Heap bytes `(chunks, index)`: the chunks' allocations (counted whole, shared or not),
+    /// then the slots and dead counts.
+    pub(crate) fn heap_bytes(&self) -> (u64, u64) {
+        let chunks: usize = self.chunks.iter().map(|c| c.capacity() * std::mem::size_of::<Rgba>()).sum();
+        (chunks as u64, (vec_bytes(&self.dead) + vec_bytes(&self.slots)) as u64)
+    }
+
+    /// Bytes of the chunks this slab shares with `other` (the same allocation, not yet copied
+    /// on a write).
+    pub(crate) fn shared_bytes(&self, other: &Slab) -> u64 {
+        let shared = |chunk: &Arc<Vec<Rgba>>| other.chunks.iter().any(|o| Arc::ptr_eq(o, chunk));
+        let bytes: usize =
+            self.chunks.iter().filter(|c| shared(c)).map(|c| c.capacity() * std::mem::size_of::<Rgba>()).sum();
+        bytes as u64
     }
 
     /// Samples held by all elements.

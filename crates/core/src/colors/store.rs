@@ -305,6 +305,34 @@ impl ColorStore {
         }
     }
 
+    /// Heap bytes of the store: `(samples, the rest)`: the slabs' chunks, then the
+    /// resolutions, vertex colours, slots and dirty sets (the shared topology not counted).
+    pub fn heap_bytes(&self) -> (u64, u64) {
+        use crate::colors::slab::vec_bytes;
+        let dirty =
+            [&self.dirty_vertices, &self.dirty_edges, &self.dirty_faces, &self.resized_faces, &self.resized_edges]
+                .iter()
+                .map(|set| vec_bytes(&set.flags) + vec_bytes(&set.list))
+                .sum::<usize>();
+        let (edge_chunks, edge_index) = self.edge_samples.heap_bytes();
+        let (interior_chunks, interior_index) = self.interior_samples.heap_bytes();
+        let rest = vec_bytes(&self.face_resolution)
+            + vec_bytes(&self.edge_resolution)
+            + vec_bytes(&self.vertex_colors)
+            + vec_bytes(&self.vertex_owner_face)
+            + dirty;
+        (edge_chunks + interior_chunks, rest as u64 + edge_index + interior_index)
+    }
+
+    /// Heap bytes of this store not shared with `other` (a snapshot's own cost: its sample
+    /// chunks are shared until either writes into them).
+    pub fn unshared_bytes(&self, other: &ColorStore) -> u64 {
+        let (samples, rest) = self.heap_bytes();
+        let shared = self.edge_samples.shared_bytes(&other.edge_samples)
+            + self.interior_samples.shared_bytes(&other.interior_samples);
+        samples - shared + rest
+    }
+
     /// The mesh connectivity.
     pub fn topology(&self) -> &Topology {
         &self.topology

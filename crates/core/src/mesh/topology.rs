@@ -133,6 +133,17 @@ impl Topology {
         self.face_vertices.len() as u32
     }
 
+    /// Heap bytes of the connectivity's arrays.
+    pub fn heap_bytes(&self) -> u64 {
+        (std::mem::size_of_val(self.face_vertices.as_slice())
+            + std::mem::size_of_val(self.face_edges.as_slice())
+            + std::mem::size_of_val(self.face_edge_reversed_bits.as_slice())
+            + std::mem::size_of_val(self.edge_vertices.as_slice())
+            + std::mem::size_of_val(self.edge_face_offsets.as_slice())
+            + std::mem::size_of_val(self.edge_faces.as_slice())
+            + std::mem::size_of_val(self.vertex_valence.as_slice())) as u64
+    }
+
     /// Number of unique edges.
     pub fn edge_count(&self) -> u32 {
         self.edge_vertices.len() as u32

@@ -23,7 +23,8 @@
 //! ```
 //!
 //! - `κ` is the world size of one pixel at unit depth, `2 tan(fov_y / 2) / height`, so
-//!   `depth · κ` is the pixel's footprint on a surface facing the camera;
+//!   `depth · κ` is the pixel's footprint on a surface facing the camera, times
+//!   `2^LOD_BIAS` ([`LOD_BIAS`]: the measured bias towards finer levels);
 //! - `v̂ᵢ` the unit vector from `pᵢ` towards the eye and `nᵢ` the vertex normal (area-weighted
 //!   face normals, rounded to `f16` as the GPU stores them): `1 / |n · v̂|` stretches the
 //!   footprint on surfaces seen at a grazing angle (the major axis of the pixel's ellipse,
@@ -53,6 +54,17 @@ use crate::mesh::normals::{face_cross, unit_or_zero};
 /// The smallest `|n · v̂|` the footprint stretch uses: at most 4 levels coarser at grazing
 /// angles. Keep in sync with `LOD_MIN_COSINE` in shaders/mesh_colors.wgsl.
 pub const MIN_COSINE: f32 = 1.0 / 16.0;
+
+/// Levels added to the level of detail (negative: finer): `κ` is scaled by `2^LOD_BIAS`, so
+/// every `μᵢ` and therefore the level at every point moves by the same amount and stays
+/// continuous across edges of any `R` pair. Chosen by measuring trilinear against the
+/// supersampled reference at near, mid and far distances, biases 0, −0.5, −1, −1.5 and −2
+/// (docs/BENCHMARKS.md, issue-46 section): without a bias trilinear lost 4–6 dB to linear at
+/// mid distance; at −2 it is within 0.5 dB of linear or better there on the Duck and the Fox
+/// and ahead of linear far away. The footprint this rule estimates (the larger axis, the
+/// densest face at a vertex, a lattice of squares) is wider than the box the reference
+/// averages over, most of all on long thin faces.
+pub const LOD_BIAS: f32 = -2.0;
 
 /// `μᵢ` is clamped to `±LOD_TERM_LIMIT`, so no `±∞` or NaN enters the interpolation.
 /// Keep in sync with `LOD_TERM_LIMIT` in shaders/mesh_colors.wgsl.

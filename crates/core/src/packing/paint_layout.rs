@@ -20,11 +20,18 @@
 //! proportional to the samples and records that changed. When the buffer's capacity is
 //! exhausted, `sync` says so and the caller re-uploads everything (`grown`); capacity
 //! doubles each time, so that is rare.
+//!
+//! Entering paint mode need not build this layout from scratch: [`PaintLayout::over_packed`]
+//! lays it over the compact packing the view already shows (each element's block is level 0
+//! of its MIP chain, vertex `v` at `v · vertex_levels`), so the GPU keeps its buffers and the
+//! encoded copy is the packing's own bytes. Only elements whose sample count changes move, to
+//! blocks past the packing's end; the chains' levels ≥ 1 go stale, which paint mode never reads
+//! (it samples level 0 only) and leaving paint mode recomputes for every edited element.
 
 use crate::colors::format::{ColorFormat, Rgba};
 use crate::colors::layout::Resolution;
 use crate::colors::store::{ColorStore, DirtyElements};
-use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word};
+use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, pack_word, unpack_word};
 
 /// A block of the colour buffer: `base .. base + capacity`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -66,6 +73,11 @@ pub struct PaintLayout {
     /// Samples the GPU buffer holds.
     capacity: u64,
     records: Vec<FaceRecord>,
+    /// Vertex `v`'s sample is at `v · vertex_stride` (1 in a layout of its own, the vertex
+    /// levels of the compact packing it was laid over).
+    vertex_stride: u32,
+    /// The end of the packing this layout was laid over (0 for a layout of its own).
+    packed_end: u64,
 }
 
 fn block_capacity(samples: u32) -> u32 {
@@ -84,6 +96,8 @@ impl PaintLayout {
             end: u64::from(topology.vertex_count),
             capacity: 0,
             records: Vec::new(),
+            vertex_stride: 1,
+            packed_end: 0,
         };
         for edge in 0..topology.edge_count() {
             let block = layout.allocate(store.edge_samples(edge).len() as u32);
@@ -96,6 +110,61 @@ impl PaintLayout {
         layout.capacity = (layout.end + layout.end / 2).clamp(1, MAX_SAMPLES);
         layout.records = (0..topology.face_count()).map(|face| layout.record(store, face)).collect();
         layout
+    }
+
+    /// The layout over `packed`, the compact packing of `store` the GPU already holds
+    /// ([`crate::packing::packer::PackCache`]): every element's block is level 0 of its chain
+    /// there, vertex `v` at `v · vertex_levels`, the face records are the packing's own (a
+    /// chain's level 0 starts at its base), and the capacity is the packing's samples, so no
+    /// byte moves on entering paint mode. `None` when `packed` is not a packing of `store`'s
+    /// topology and resolutions (then lay out anew: [`PaintLayout::new`]).
+    pub fn over_packed(store: &ColorStore, packed: &PackedMesh) -> Option<Self> {
+        let topology = store.topology();
+        let faces = topology.face_count() as usize;
+        if packed.face_records.len() != faces
+            || packed.indices.len() != faces
+            || packed.vertex_levels == 0
+            || u64::from(topology.vertex_count) * u64::from(packed.vertex_levels) > packed.sample_count()
+        {
+            return None;
+        }
+        let total = packed.sample_count();
+        let fits = |base: u32, len: usize| u64::from(base) + len as u64 <= total;
+        let mut edge_blocks = vec![Block::default(); topology.edge_count() as usize];
+        let mut interior_blocks = vec![Block::default(); faces];
+        for (face, record) in packed.face_records.iter().enumerate() {
+            let r = store.face_resolution(face as u32)?;
+            let (base, log2) = unpack_word(record.interior);
+            let len = store.interior_samples(face as u32).len();
+            if log2 != r.log2() || !fits(base, len) {
+                return None;
+            }
+            interior_blocks[face] = Block { base: if len == 0 { 0 } else { base }, capacity: len as u32 };
+            for (k, &word) in record.edges.iter().enumerate() {
+                let edge = topology.face_edges[face][k];
+                let (base, log2) = unpack_word(word);
+                let len = store.edge_samples(edge).len();
+                if log2 != store.edge_resolution(edge)?.log2() || !fits(base, len) {
+                    return None;
+                }
+                edge_blocks[edge as usize] = Block { base: if len == 0 { 0 } else { base }, capacity: len as u32 };
+            }
+        }
+        Some(PaintLayout {
+            edge_blocks,
+            interior_blocks,
+            free: vec![Vec::new(); 32],
+            end: total,
+            capacity: total,
+            records: packed.face_records.clone(),
+            vertex_stride: packed.vertex_levels,
+            packed_end: total,
+        })
+    }
+
+    /// Where vertex `v`'s sample is.
+    fn vertex_slot(&self, v: u32) -> u32 {
+        v.saturating_mul(self.vertex_stride)
     }
 
     fn allocate(&mut self, samples: u32) -> Block {
@@ -112,8 +181,11 @@ impl PaintLayout {
         Block { base, capacity }
     }
 
+    /// Frees `block` for reuse by its size class. The blocks of the packing a layout was laid
+    /// over ([`PaintLayout::over_packed`]) are never reused: they hold chains, not blocks.
     fn release(&mut self, block: Block) {
-        if block.capacity > 0
+        if block.capacity.is_power_of_two()
+            && u64::from(block.base) >= self.packed_end
             && let Some(list) = self.free.get_mut(block.capacity.trailing_zeros() as usize)
         {
             list.push(block.base);
@@ -128,6 +200,15 @@ impl PaintLayout {
             pack_word(self.edge_blocks[edge as usize].base, r_edge.log2())
         });
         FaceRecord { interior: pack_word(self.interior_blocks[face as usize].base, r.log2()), edges }
+    }
+
+    /// Heap bytes of the layout (blocks, free lists, face records).
+    pub fn heap_bytes(&self) -> u64 {
+        let free: usize = self.free.iter().map(|list| std::mem::size_of_val(list.as_slice())).sum();
+        (std::mem::size_of_val(self.edge_blocks.as_slice())
+            + std::mem::size_of_val(self.interior_blocks.as_slice())
+            + std::mem::size_of_val(self.records.as_slice())
+            + free) as u64
     }
 
     /// Samples the GPU buffer must hold (allocated blocks plus slack).
@@ -187,7 +268,7 @@ impl PaintLayout {
             plan.grown = true;
         }
         let mut ranges: Vec<(u32, u32)> = Vec::new();
-        ranges.extend(dirty.vertices.iter().map(|&v| (v, 1)));
+        ranges.extend(dirty.vertices.iter().map(|&v| (self.vertex_slot(v), 1)));
         for &edge in &dirty.edges {
             let len = store.edge_samples(edge).len() as u32;
             if len > 0 {
@@ -215,13 +296,7 @@ impl PaintLayout {
     pub fn colors(&self, store: &ColorStore, first: u32, count: u32) -> Vec<Rgba> {
         let mut out = vec![[0.0; 4]; count as usize];
         let end = u64::from(first) + u64::from(count);
-        // Vertices first: they occupy 0..V.
         let topology = store.topology();
-        for v in first..(end.min(u64::from(topology.vertex_count)) as u32) {
-            if let Some(color) = store.vertex_color(v) {
-                out[(v - first) as usize] = color;
-            }
-        }
         let mut put = |base: u32, samples: &[Rgba]| {
             for (k, &color) in samples.iter().enumerate() {
                 let index = u64::from(base) + k as u64;
@@ -230,6 +305,11 @@ impl PaintLayout {
                 }
             }
         };
+        for v in 0..topology.vertex_count {
+            if let Some(color) = store.vertex_color(v) {
+                put(self.vertex_slot(v), &[color]);
+            }
+        }
         for (edge, block) in self.edge_blocks.iter().enumerate() {
             if block.capacity > 0 && u64::from(block.base) < end && block.base + block.capacity > first {
                 put(block.base, store.edge_samples(edge as u32));
@@ -282,7 +362,7 @@ impl PaintLayout {
         };
         for &v in &dirty.vertices {
             if let Some(color) = store.vertex_color(v) {
-                put(v, &[color]);
+                put(self.vertex_slot(v), &[color]);
             }
         }
         for &edge in &dirty.edges {
@@ -310,20 +390,28 @@ impl PaintLayout {
         // Every run: the vertices (blocks of `RUN` at their own index), then each edge's and
         // each interior's block, with the samples that go there.
         const RUN: u32 = 4096;
-        let vertex_runs = (0..topology.vertex_count.div_ceil(RUN)).map(|k| {
-            let first = k * RUN;
-            (Block { base: first, capacity: RUN.min(topology.vertex_count - first) }, Element::Vertices(first))
-        });
+        let stride = self.vertex_stride;
+        let vertex_runs: Vec<(Block, Element)> = if stride == 1 {
+            (0..topology.vertex_count.div_ceil(RUN))
+                .map(|k| {
+                    let first = k * RUN;
+                    (Block { base: first, capacity: RUN.min(topology.vertex_count - first) }, Element::Vertices(first))
+                })
+                .collect()
+        } else {
+            (0..topology.vertex_count).map(|v| (Block { base: v * stride, capacity: 1 }, Element::Vertex(v))).collect()
+        };
         let edge_runs = self.edge_blocks.iter().enumerate().map(|(e, &b)| (b, Element::Edge(e as u32)));
         let face_runs = self.interior_blocks.iter().enumerate().map(|(f, &b)| (b, Element::Interior(f as u32)));
         let runs: Vec<(Block, Element)> =
-            vertex_runs.chain(edge_runs).chain(face_runs).filter(|(b, _)| b.capacity > 0).collect();
+            vertex_runs.into_iter().chain(edge_runs).chain(face_runs).filter(|(b, _)| b.capacity > 0).collect();
         let samples = |element: Element| -> &[Rgba] {
             match element {
                 Element::Vertices(first) => {
                     let first = first as usize;
                     vertices.get(first..(first + RUN as usize).min(vertices.len())).unwrap_or(&[])
                 }
+                Element::Vertex(v) => vertices.get(v as usize..v as usize + 1).unwrap_or(&[]),
                 Element::Edge(e) => store.edge_samples(e),
                 Element::Interior(f) => store.interior_samples(f),
             }
@@ -332,7 +420,7 @@ impl PaintLayout {
         PackedMesh {
             positions: positions.to_vec(),
             indices: store.topology().face_vertices.clone(),
-            vertex_levels: 1,
+            vertex_levels: self.vertex_stride,
             face_records: self.records.clone(),
             format,
             colors: bytes,
@@ -343,8 +431,10 @@ impl PaintLayout {
 /// Whose samples a run of [`PaintLayout::packed`] holds.
 #[derive(Debug, Clone, Copy)]
 enum Element {
-    /// Vertices from this id on (a run of them).
+    /// Vertices from this id on (a run of them, at their own index).
     Vertices(u32),
+    /// One vertex (at `v · vertex_stride`).
+    Vertex(u32),
     Edge(u32),
     Interior(u32),
 }
@@ -413,6 +503,28 @@ impl EncodedBuffer {
     /// [`EncodedBuffer::from_packed`] keeping `packed`'s bytes (no copy).
     pub fn from_packed_owned(packed: PackedMesh) -> Self {
         EncodedBuffer { format: packed.format, bytes: packed.colors }
+    }
+
+    /// The buffer `bytes` in `format` (the bytes the GPU holds: the compact packing's, under
+    /// a layout [`PaintLayout::over_packed`] it).
+    pub fn from_bytes(format: ColorFormat, bytes: Vec<u8>) -> Self {
+        EncodedBuffer { format, bytes }
+    }
+
+    /// The bytes, given back (e.g. to the packing they were lent from).
+    pub fn into_bytes(self) -> Vec<u8> {
+        self.bytes
+    }
+
+    /// Grows the buffer to `samples` (the new slots zero, the encoding of a zero colour), as
+    /// the GPU buffer grows when a plan has `grown`; never shrinks. Returns whether it grew.
+    pub fn grow(&mut self, samples: u64) -> bool {
+        let len = usize::try_from(samples).unwrap_or(usize::MAX).saturating_mul(self.format.bytes_per_sample());
+        if len <= self.bytes.len() {
+            return false;
+        }
+        self.bytes.resize(len, 0);
+        true
     }
 
     /// The encoded samples, `bytes_per_sample` each.

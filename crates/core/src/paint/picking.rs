@@ -207,6 +207,20 @@ struct ExactHit {
 }
 
 impl MeshBvh {
+    /// Heap bytes: the tree's nodes and primitive indices, the face ids, corners and the
+    /// `f64` vertex copy.
+    pub fn heap_bytes(&self) -> u64 {
+        fn bytes<T>(v: &[T]) -> u64 {
+            std::mem::size_of_val(v) as u64
+        }
+        let tree = match &self.tree {
+            Some(Tree::Bvh2(bvh)) => bytes(&bvh.nodes) + bytes(&bvh.primitive_indices),
+            Some(Tree::CwBvh(bvh)) => bytes(&bvh.nodes) + bytes(&bvh.primitive_indices),
+            None => 0,
+        };
+        tree + bytes(&self.faces) + bytes(&self.triangles) + bytes(&self.vertices)
+    }
+
     /// Builds the BVH of `triangles` (corner ids into `positions`) with `preset`.
     pub fn build(positions: &[[f32; 3]], triangles: &[[u32; 3]], preset: BvhPreset) -> MeshBvh {
         Self::build_kind(positions, triangles, preset, BvhKind::Bvh2)

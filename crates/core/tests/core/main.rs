@@ -21,6 +21,7 @@ mod occlusion;
 mod optimize;
 mod packed_file;
 mod packer;
+mod paint_in_place;
 mod paint_layout;
 mod picking;
 mod progress;

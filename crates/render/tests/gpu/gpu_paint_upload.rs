@@ -18,6 +18,7 @@ use meshpaint_core::colors::layout::Resolution;
 use meshpaint_core::colors::store::{ColorStore, SampleRef};
 use meshpaint_core::mesh::topology::Topology;
 use meshpaint_core::packing::linear::PackedMesh;
+use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::packing::paint_layout::{EncodedBuffer, PaintLayout};
 use meshpaint_core::packing::sampler::packed_sample_index;
 use meshpaint_render::{GpuMesh, MeshUploadOptions};
@@ -30,7 +31,7 @@ fn mismatches(gpu: &Gpu, mesh: &GpuMesh, store: &ColorStore, format: ColorFormat
     let on_gpu = PackedMesh {
         positions: Vec::new(),
         indices: store.topology().face_vertices.clone(),
-        vertex_levels: 1,
+        vertex_levels: mesh.vertex_levels,
         face_records,
         format,
         colors,
@@ -141,6 +142,67 @@ fn partial_uploads_after_random_edits_and_resolution_changes_match_the_store() {
         mesh.write_samples(&gpu.ctx, vertex_sample, &garbage).unwrap();
         let wrong = mismatches(&gpu, &mesh, &store, format);
         assert!(!wrong.is_empty(), "{format:?}: a corrupted GPU sample went unnoticed");
+    }
+}
+
+/// Paint mode on the packing the view shows (what Tab does when the view has it): the
+/// paint layout laid over the compact packing on the GPU, its bytes lent to the CPU copy,
+/// partial uploads after random edits, and raised resolutions growing the atlas on the GPU
+/// (`GpuMesh::grow_atlas`: the old texels copied, nothing re-encoded). Every lattice point
+/// read back as the shaders address it holds the store's colour; a narrow atlas (61 texels)
+/// makes the copy and the uploads wrap rows at odd offsets.
+#[test]
+fn painting_the_packing_in_place_with_atlas_growth_matches_the_store() {
+    let gpu = Gpu::create();
+    let (positions, triangles) = icosphere(1);
+    let topology = Topology::build(positions.len() as u32, &triangles).unwrap();
+    let mut rng = SplitMix64(0x5EED_0046);
+    for format in ColorFormat::ALL {
+        let mut store = ColorStore::uniform(topology.clone(), Resolution::new(4).unwrap(), [0.5, 0.5, 0.5, 1.0]);
+        let mut sites = Vec::new();
+        store.for_each_site(|site| sites.push(site.sample));
+        for &sample in &sites {
+            store.write_sample(sample, rng.color());
+        }
+        store.take_dirty();
+        let mut cache = PackCache::build(&store, &positions, format).unwrap();
+        let mut mesh = GpuMesh::upload(
+            &gpu.ctx,
+            gpu.renderer.layouts(),
+            cache.packed(),
+            &MeshUploadOptions { atlas_width: Some(61) },
+        )
+        .unwrap();
+        assert!(mesh.vertex_levels > 1, "the packing has MIP chains");
+        let mut layout = PaintLayout::over_packed(&store, cache.packed()).unwrap();
+        let mut encoded = EncodedBuffer::from_bytes(format, cache.lend_colors());
+        let mut grown = 0;
+        for round in 0..12 {
+            if round % 3 == 1 {
+                let face = rng.below(u64::from(topology.face_count())) as u32;
+                store.write_resolution(face, Resolution::from_log2(3 + rng.below(2) as u32).unwrap()).unwrap();
+            }
+            let mut sites: Vec<SampleRef> = Vec::new();
+            store.for_each_site(|site| sites.push(site.sample));
+            for _ in 0..1 + rng.below(40) {
+                let sample = sites[rng.below(sites.len() as u64) as usize];
+                store.write_sample(sample, rng.color());
+            }
+            let dirty = store.take_dirty();
+            let plan = layout.sync(&store, &dirty);
+            if plan.grown {
+                grown += 1;
+                let samples = mesh.atlas.samples;
+                mesh.grow_atlas(&gpu.ctx, gpu.renderer.layouts(), layout.capacity()).unwrap();
+                assert!(mesh.atlas.samples > samples);
+                encoded.grow(layout.capacity());
+            }
+            let spans = encoded.apply(&layout, &store, &dirty, &plan);
+            mesh.write_paint_upload(&gpu.ctx, &spans, encoded.bytes(), (&plan.faces, layout.records())).unwrap();
+            let wrong = mismatches(&gpu, &mesh, &store, format);
+            assert!(wrong.is_empty(), "{format:?} round {round}: the GPU copy differs:\n{}", wrong.join("\n"));
+        }
+        assert!(grown > 0, "{format:?}: no raised resolution grew the atlas");
     }
 }
 

@@ -509,6 +509,19 @@ pub struct PackCache {
     packed: PackedMesh,
 }
 
+/// Heap bytes of a [`PackCache`] by buffer ([`PackCache::heap_bytes`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct PackBytes {
+    /// The encoded colour buffer (what the GPU holds).
+    pub colors: u64,
+    /// Face records and the packed copies of positions and indices.
+    pub records_and_geometry: u64,
+    /// The `f32` MIP levels kept for incremental repacks (vertex chains, levels ≥ 1).
+    pub levels: u64,
+    /// Layout and prefix tables, the vertex → edge incidence.
+    pub tables: u64,
+}
+
 /// What a full pack lays out before it writes: the canonical layout, the edge and interior
 /// prefixes, the vertex → edge incidence and, for a relayout, the chains already in place.
 struct Plan {
@@ -642,6 +655,49 @@ impl PackCache {
     /// The packed mesh.
     pub fn packed(&self) -> &PackedMesh {
         &self.packed
+    }
+
+    /// Lends the packed colour bytes out: paint mode edits level 0 in them in place
+    /// ([`crate::packing::paint_layout::PaintLayout::over_packed`]). Until they come back
+    /// ([`PackCache::return_colors`]) the cache has no colours: [`PackCache::update`] refuses
+    /// and a relayout packs in full.
+    pub fn lend_colors(&mut self) -> Vec<u8> {
+        std::mem::take(&mut self.packed.colors)
+    }
+
+    /// Takes back the bytes [`PackCache::lend_colors`] lent, cut to this packing's length
+    /// (paint mode may have grown them). Their chains must differ from this packing's only in
+    /// level 0 of elements the next update or relayout is told are dirty, which it rewrites
+    /// with the chains that read them.
+    pub fn return_colors(&mut self, mut bytes: Vec<u8>) {
+        bytes.truncate(self.sections.total * self.packed.format.bytes_per_sample());
+        self.packed.colors = bytes;
+    }
+
+    /// Heap bytes of the packing and what an incremental repack keeps beside it.
+    pub fn heap_bytes(&self) -> PackBytes {
+        fn bytes<T>(v: &[T]) -> u64 {
+            std::mem::size_of_val(v) as u64
+        }
+        let p = &self.packed;
+        PackBytes {
+            colors: bytes(&p.colors),
+            records_and_geometry: bytes(&p.face_records) + bytes(&p.positions) + bytes(&p.indices),
+            levels: bytes(&self.chains) + bytes(&self.upper),
+            tables: bytes(&self.layout.edge_base)
+                + bytes(&self.layout.interior_base)
+                + bytes(&self.prefix.chain)
+                + bytes(&self.prefix.upper)
+                + bytes(&self.edges.chain)
+                + bytes(&self.edges.upper)
+                + bytes(&self.vertex_edge.0)
+                + bytes(&self.vertex_edge.1),
+        }
+    }
+
+    /// Whether the colour bytes are all here (not lent, or given back whole).
+    fn has_colors(&self) -> bool {
+        self.packed.colors.len() == self.sections.total * self.packed.format.bytes_per_sample()
     }
 
     /// The packed mesh, dropping the rest.

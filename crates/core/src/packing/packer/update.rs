@@ -38,6 +38,7 @@ impl PackCache {
         let format = self.packed.format;
         let (faces, edges) = (topology.face_count() as usize, topology.edge_count() as usize);
         if faces != self.packed.face_records.len()
+            || !self.has_colors()
             || edges != self.layout.edge_base.len()
             || topology.vertex_count as usize != self.packed.positions.len()
         {
@@ -127,6 +128,7 @@ impl PackCache {
         let topology = store.topology();
         if !dirty.resized_faces.is_empty()
             || !dirty.resized_edges.is_empty()
+            || !self.has_colors()
             || topology.face_count() as usize != self.packed.face_records.len()
             || topology.vertex_count as usize != self.packed.positions.len()
             || topology.edge_count() as usize != self.layout.edge_base.len()
