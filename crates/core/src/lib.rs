@@ -18,6 +18,7 @@
 //! | [`packing`] | [`packing::linear`] (16-byte face records, colour buffer with MIP chains), [`packing::canonical`] (where each chain starts), [`packing::packer`] (store ⇄ linear, eq. 2.5/2.6, rayon; `PackCache` repacks only the chains an edit reaches, lays out anew after resolution changes moving the chains no edit reached, or packs all of them into its old buffers), [`packing::reference`] (the serial packer both are tested against byte for byte), [`packing::unpack`] (linear → store), [`packing::paint_layout`] (paint-mode blocks with slack, dirty ranges), [`packing::sampler`] (the CPU reference sampler, the truth the GPU is tested against), [`packing::file`] (the packed file format) |
 //! | [`paint`] | [`paint::picking`] (obvhs BVH, watertight rays), [`paint::occlusion`] (a CPU depth map of the view: brush occlusion without a ray per sample), [`paint::brush`] (colour / blur / resolution brushes, tools, replay), [`paint::undo`] (per stroke, memory cap; the one write path, `StoreWriter`), [`paint::split`] (that write path split per element for parallel dabs), [`paint::optimize`] (lower each face's R while the error stays within a bound) |
 //! | [`mct`] | Mesh Color Textures (Yuksel 2017): packed mesh colors → one 2D atlas the GPU's bilinear sampler filters ([`mct::layout`]: pairs, tents and squares, 4-byte records; [`mct::build`]; [`mct::sample`]: the CPU evaluation the shader is tested against; [`mct::file`]: the MCT file, docs/MCT_FORMAT.md) |
+//! | [`htex`] | Htex (Barbier & Dupuy 2022): packed mesh colors → one square texture per edge (halfedge + twin) in atlas pages with zero borders, three fetches with a border-normalisation channel ([`htex::halfedge`], [`htex::layout`], [`htex::build`], [`htex::sample`]: the CPU evaluation the shader is tested against, [`htex::jumps`]) |
 //! | [`convert`] | one signal into another: [`convert::bake`] (texture → mesh colors, point bake), [`convert::least_squares`] (the bake refined to the least-squares fit of the reconstruction), [`convert::adaptive`] (each face at the resolution its content needs), [`convert::bake_uv`] (mesh colors → the model's UV texture), [`convert::subdivide`] (1→4 midpoint split of a scene, budget first) |
 //! | [`io`] | files only: [`io::document`] (open glTF, OBJ, PLY, STL or packed files into a store — the one open path; pack for export), [`io::export_gltf`], [`io::export_fit`], [`io::export_textured`], [`io::autosave`] |
 //! | [`synth`] | synthetic inputs for tests, benchmarks and the fuzzer: the deterministic random sources and small meshes built in code (one copy each) |
@@ -52,6 +53,7 @@ pub mod atomic_write;
 pub mod camera;
 pub mod colors;
 pub mod convert;
+pub mod htex;
 pub mod io;
 pub mod mct;
 pub mod memory;

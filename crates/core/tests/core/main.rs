@@ -9,6 +9,7 @@ mod examples;
 mod follow_brush;
 mod fuzz;
 mod hard_edge;
+mod htex;
 mod import;
 mod layout;
 mod least_squares;
