@@ -328,15 +328,20 @@ impl Editor {
         }
     }
 
-    /// Builds the Mesh Color Texture of the open document's packed mesh on a job, when the
+    /// Builds the Mesh Color Texture or the Htex of the open document's packed mesh on a job, when the
     /// view shows that representation and it is missing (never in paint mode, which draws
     /// the paint layout; leaving it repacks, and the texture is built again from the result).
     pub fn prepare_mct(&mut self) {
         let (Some(open), Some(gpu)) = (&self.document.open, &self.gpu) else {
             return;
         };
-        let wanted = self.panels.view.settings.representation == Representation::MeshColorTexture;
-        if !wanted || !open.mct_missing() || self.document.level0_only() || self.jobs.is_busy() {
+        let representation = self.panels.view.settings.representation;
+        let missing = match representation {
+            Representation::MeshColors => false,
+            Representation::MeshColorTexture => open.mct_missing(),
+            Representation::Htex => open.htex_missing(),
+        };
+        if !missing || self.document.level0_only() || self.jobs.is_busy() {
             return;
         }
         let Some((packed, geometry)) = open.mct_source() else {
@@ -344,10 +349,13 @@ impl Editor {
         };
         let (path, generation) = (open.path.clone(), open.mesh_generation);
         let (gpu, budget) = (Arc::clone(gpu), self.budget());
-        let name = Representation::MeshColorTexture.name();
-        let started = self.jobs.start(JobKind::View, format!("Preparing {name}"), move |job| {
-            let built = document::build_mct(&packed, &geometry, &budget, &gpu, job);
-            Ok(JobOutput::View(path, Box::new(AlternateView::Mct(generation, Box::new(built)))))
+        let started = self.jobs.start(JobKind::View, format!("Preparing {}", representation.name()), move |job| {
+            let view = if representation == Representation::Htex {
+                AlternateView::Htex(generation, Box::new(document::build_htex(&packed, &geometry, &budget, &gpu, job)))
+            } else {
+                AlternateView::Mct(generation, Box::new(document::build_mct(&packed, &geometry, &budget, &gpu, job)))
+            };
+            Ok(JobOutput::View(path, Box::new(view)))
         });
         if let Err(message) = started {
             self.set_status(Severity::Error, message);
@@ -372,7 +380,8 @@ impl Editor {
         let open = self.document.open.as_ref();
         let mesh = open.and_then(|d| d.gpu_mesh.as_ref()).map_or(0, |m| m.gpu_bytes());
         let mct = open.and_then(|d| d.current_mct()).and_then(Result::ok).map_or(0, |b| b.mct.gpu_bytes());
-        mesh + mct + self.viewport.gpu_bytes
+        let htex = open.and_then(|d| d.current_htex()).and_then(Result::ok).map_or(0, |b| b.htex.gpu_bytes());
+        mesh + mct + htex + self.viewport.gpu_bytes
     }
 
     /// The window title.
@@ -490,7 +499,8 @@ impl Editor {
             Action::ToggleRepresentation => {
                 view.representation = match view.representation {
                     Representation::MeshColors => Representation::MeshColorTexture,
-                    Representation::MeshColorTexture => Representation::MeshColors,
+                    Representation::MeshColorTexture => Representation::Htex,
+                    Representation::Htex => Representation::MeshColors,
                 };
                 self.prepare_mct();
             }

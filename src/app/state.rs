@@ -102,17 +102,22 @@ pub enum Representation {
     /// the shared vertex and edge colours duplicated, filtered by the GPU's bilinear sampler
     /// (crates/core/src/mct; built from the packed mesh when shown, again after each repack).
     MeshColorTexture,
+    /// Htex (Barbier & Dupuy 2022): one square texture per edge in atlas pages, three
+    /// hardware bilinear fetches per pixel (crates/core/src/htex; built like MCT).
+    Htex,
 }
 
 impl Representation {
     /// Every choice, in the order the view panel lists them.
-    pub const ALL: [Representation; 2] = [Representation::MeshColors, Representation::MeshColorTexture];
+    pub const ALL: [Representation; 3] =
+        [Representation::MeshColors, Representation::MeshColorTexture, Representation::Htex];
 
     /// The name the view panel shows.
     pub fn name(self) -> &'static str {
         match self {
             Representation::MeshColors => "Mesh colors (software filter)",
             Representation::MeshColorTexture => "Mesh Color Textures (hardware filter)",
+            Representation::Htex => "Htex (per-edge textures, hardware filter)",
         }
     }
 }
@@ -212,7 +217,7 @@ pub enum Action {
     ToggleShading,
     /// Cycle the filter: nearest, linear, trilinear.
     CycleFilter,
-    /// Switch the representation: mesh colors / Mesh Color Textures.
+    /// Switch the representation: mesh colors → Mesh Color Textures → Htex.
     ToggleRepresentation,
     /// Show or hide the shortcut help window.
     ToggleHelp,

@@ -1,8 +1,8 @@
 //! `meshpaint bench render`: frame time of the UV-texture baseline, of every mesh-colors
-//! filter mode and of the Mesh Color Textures built from the same buffers (the
+//! filter mode and of the Mesh Color Textures and the Htex built from the same buffers (the
 //! representation axis: every row names its representation) on the same mesh, view and
 //! image size, interleaved in one run, as ratios to the baseline; plus the GPU memory each
-//! path holds and the MCT's build time.
+//! path holds and the MCT's and the Htex's build times.
 //!
 //! A frame is one render pass into an offscreen target, submitted and waited for
 //! (`poll(wait)`), so on lavapipe it measures the rasteriser's whole work. Modes are
@@ -18,6 +18,7 @@ use std::time::Instant;
 
 use meshpaint_core::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera, default_camera};
 use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::htex::HtexOptions;
 use meshpaint_core::io::document::{Document, bounds};
 use meshpaint_core::mesh::import::import_gltf;
 use meshpaint_core::mesh::scene::Texture;
@@ -31,9 +32,9 @@ use meshpaint_render::{
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeTiming {
     /// `baseline-uv`, `nearest`, `linear`, `mip-1`, `trilinear`, `mct-linear`, `mct-mip-1`,
-    /// `mct-trilinear`, `mct-anisotropic`.
+    /// `mct-trilinear`, `htex-linear`, `htex-mip-1`, `htex-trilinear`, `mct-anisotropic`.
     pub name: String,
-    /// `uv-texture`, `mesh-colors` or `mct`.
+    /// `uv-texture`, `mesh-colors`, `mct` or `htex`.
     pub representation: &'static str,
     /// Median frame time, seconds.
     pub median_seconds: f64,
@@ -68,6 +69,13 @@ pub struct RenderBench {
     pub modes: Vec<ModeTiming>,
     /// Seconds to build the Mesh Color Texture from the packed buffers.
     pub mct_build_seconds: f64,
+    /// Seconds to build the Htex from the packed buffers.
+    pub htex_build_seconds: f64,
+    /// Htex's quad textures (the paper's E) and the faces (F).
+    pub htex_textures: (u64, u64),
+    /// The largest colour jump across Htex's intrinsic edges per level (equalised corners),
+    /// then at level 0 without equalisation.
+    pub htex_jumps: Vec<serde_json::Value>,
 }
 
 impl RenderBench {
@@ -101,6 +109,10 @@ impl RenderBench {
             "triangles": self.triangles,
             "baseline": self.baseline,
             "mct_build_ms": self.mct_build_seconds * 1e3,
+            "htex_build_ms": self.htex_build_seconds * 1e3,
+            "htex_textures": self.htex_textures.0,
+            "htex_faces": self.htex_textures.1,
+            "htex_jumps": self.htex_jumps,
             "modes": modes,
         })
     }
@@ -204,12 +216,13 @@ pub fn bench_render(
     let texture = meshpaint_core::mct::build(&packed, max_dimension, u64::MAX)?;
     let mct_build_seconds = build_start.elapsed().as_secs_f64();
     let mct = gpu.upload_mct(&mesh.geometry(), &texture)?;
+    let (htex, htex_build_seconds, htex_textures, htex_jumps) = build_htex(&gpu, &packed, &mesh)?;
 
     let camera: OrbitCamera = default_camera(mesh.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
     let timer = FrameTimer::new(&gpu, width, height);
 
     let geometry_bytes = mesh.gpu_bytes() - mesh.atlas_bytes() - mesh.face_record_bytes();
-    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 9] = [
+    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 12] = [
         ("baseline-uv", "uv-texture", DrawItem::Baseline(&baseline), FilterMode::Linear, baseline.gpu_bytes()),
         ("nearest", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Nearest, mesh.gpu_bytes()),
         ("linear", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Linear, mesh.gpu_bytes()),
@@ -218,6 +231,9 @@ pub fn bench_render(
         ("mct-linear", "mct", DrawItem::Mct(&mct), FilterMode::Linear, geometry_bytes + mct.gpu_bytes()),
         ("mct-mip-1", "mct", DrawItem::Mct(&mct), FilterMode::MipLevel(1), geometry_bytes + mct.gpu_bytes()),
         ("mct-trilinear", "mct", DrawItem::Mct(&mct), FilterMode::Trilinear, geometry_bytes + mct.gpu_bytes()),
+        ("htex-linear", "htex", DrawItem::Htex(&htex), FilterMode::Linear, geometry_bytes + htex.gpu_bytes()),
+        ("htex-mip-1", "htex", DrawItem::Htex(&htex), FilterMode::MipLevel(1), geometry_bytes + htex.gpu_bytes()),
+        ("htex-trilinear", "htex", DrawItem::Htex(&htex), FilterMode::Trilinear, geometry_bytes + htex.gpu_bytes()),
         // Trilinear where the adapter has no anisotropic filtering (`anisotropic` in the report).
         // Last and timed after the interleaved rounds (`INTERLEAVED`): on lavapipe it is ~100×
         // the others and would leave the frame after it with cold caches.
@@ -229,7 +245,7 @@ pub fn bench_render(
     for &(_, _, item, filter, _) in &paths {
         timer.frame(item, filter, camera);
     }
-    const INTERLEAVED: usize = 8;
+    const INTERLEAVED: usize = 11;
     for modes in [0..INTERLEAVED, INTERLEAVED..paths.len()] {
         for _ in 0..frames.max(1) {
             for k in modes.clone() {
@@ -266,6 +282,39 @@ pub fn bench_render(
         baseline: baseline_name,
         modes,
         mct_build_seconds,
+        htex_build_seconds,
+        htex_textures,
+        htex_jumps,
+    })
+}
+
+/// The Htex of `packed` uploaded with `mesh`'s geometry, its build time in seconds, its
+/// texture count (E, F) and the largest colour jumps across its intrinsic edges per level
+/// (CPU evaluation), then at level 0 without corner equalisation (the paper's corner-texel
+/// discontinuity).
+fn build_htex(
+    gpu: &Gpu,
+    packed: &meshpaint_core::packing::linear::PackedMesh,
+    mesh: &meshpaint_render::GpuMesh,
+) -> Result<(meshpaint_render::GpuHtex, f64, (u64, u64), Vec<serde_json::Value>), BenchRenderError> {
+    let limits = gpu.ctx.limits();
+    let options = HtexOptions::within(limits.max_texture_dimension_2d, limits.max_texture_array_layers, u64::MAX);
+    let build_start = Instant::now();
+    let texture = meshpaint_core::htex::build(packed, &options)?;
+    let seconds = build_start.elapsed().as_secs_f64();
+    let htex = gpu.upload_htex(&mesh.geometry(), &texture)?;
+    let mut jumps: Vec<serde_json::Value> =
+        (0..texture.layout.levels).map(|level| jumps_json(level, true, texture.jumps(level, 17))).collect();
+    let raw = meshpaint_core::htex::build(packed, &HtexOptions { equalize_corners: false, ..options })?;
+    jumps.push(jumps_json(0, false, raw.jumps(0, 17)));
+    Ok((htex, seconds, texture.texture_count(), jumps))
+}
+
+/// One `htex_jumps` entry: the largest jumps (8-bit steps) at `level`.
+fn jumps_json(level: u32, equalized: bool, jumps: meshpaint_core::htex::jumps::Jumps) -> serde_json::Value {
+    serde_json::json!({
+        "level": level, "corners_equalized": equalized,
+        "mesh_edges_steps": jumps.mesh_edges, "spokes_steps": jumps.spokes,
     })
 }
 
@@ -333,6 +382,9 @@ pub enum BenchRenderError {
     /// The Mesh Color Texture cannot be built.
     #[error(transparent)]
     Mct(#[from] meshpaint_core::mct::MctError),
+    /// The Htex cannot be built.
+    #[error(transparent)]
+    Htex(#[from] meshpaint_core::htex::HtexError),
     /// The measurement needs a reference the file does not have.
     #[error("{0}")]
     NoReference(String),

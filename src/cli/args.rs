@@ -146,6 +146,9 @@ pub(super) enum Representation {
     /// A Mesh Color Texture: one 2D atlas whose texels duplicate the shared vertex and edge
     /// colours, filtered by the GPU's own sampler (the MCT file, docs/MCT_FORMAT.md).
     Mct,
+    /// Htex: one square texture per edge (a halfedge and its twin) in atlas pages, three
+    /// hardware bilinear fetches per pixel (docs/HTEX.md).
+    Htex,
 }
 
 /// What [`OutputArgs::write`] wrote.

@@ -136,7 +136,7 @@ pub(super) enum BenchCommand {
         #[arg(long, value_delimiter = ',')]
         rules: Vec<String>,
     },
-    /// What every choice costs and buys: representation (mesh colors, Mesh Color Texture) ×
+    /// What every choice costs and buys: representation (mesh colors, Mesh Color Texture, Htex) ×
     /// filter × resolution (uniform R 1…32 and --error bounds) × colour format, per view at
     /// several distances — PSNR, max error, FLIP against a 4×4-supersampled reference, samples,
     /// GPU bytes, pack and MCT build time, frame-time ratio to the UV baseline (interleaved),
@@ -252,12 +252,21 @@ pub(super) struct TradeArgs {
     /// Colour formats measured (comma-separated; default: rgba8, rgba16f, rgba32f).
     #[arg(long, value_parser = parse_format, value_delimiter = ',')]
     pub(super) formats: Vec<ColorFormat>,
-    /// Leave out the Mesh Color Texture rows (mesh colors only).
+    /// Leave out the Mesh Color Texture rows.
     #[arg(long)]
     pub(super) no_mct: bool,
+    /// The representations measured (comma-separated: mesh-colors, mct, htex; default all
+    /// three; mesh colors are always measured, --no-mct removes mct).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub(super) representation: Vec<super::args::Representation>,
 }
 
 impl TradeArgs {
+    /// Whether `--representation` lists `r` (or is empty: every representation).
+    fn wants(&self, r: super::args::Representation) -> bool {
+        self.representation.is_empty() || self.representation.contains(&r)
+    }
+
     /// The study these flags ask for.
     fn options(&self) -> Result<meshpaint::bench::trade::TradeOptions> {
         use meshpaint_core::colors::layout::Resolution;
@@ -270,7 +279,8 @@ impl TradeArgs {
             max_resolution: Resolution::new(self.max_resolution).context("--max-resolution")?,
             uniform: (0..=max_uniform.log2()).filter_map(|l| Resolution::from_log2(l).ok()).collect(),
             formats: if self.formats.is_empty() { ColorFormat::ALL.to_vec() } else { self.formats.clone() },
-            mct: !self.no_mct,
+            mct: !self.no_mct && self.wants(super::args::Representation::Mct),
+            htex: self.wants(super::args::Representation::Htex),
             frames: self.frames,
             error_bounds: self.errors.clone(),
             ..Default::default()

@@ -75,6 +75,11 @@ pub(super) fn run(args: ExportArgs) -> Result<()> {
     if args.representation == Representation::Mct {
         return export_mct(&args);
     }
+    if args.representation == Representation::Htex {
+        anyhow::bail!(
+            "--representation htex has no file format yet: render it with `meshpaint render --representation htex`"
+        );
+    }
     if let Some(size) = args.texture {
         return export_texture(&args, size);
     }

@@ -56,9 +56,10 @@ pub(super) struct RenderArgs {
     /// shape and its samples; the document is unchanged).
     #[arg(long, conflicts_with = "baseline_uv")]
     position_colors: bool,
-    /// mesh-colors (software filter in the shader) or mct (Mesh Color Textures: the same
-    /// colours in a 2D atlas filtered by the GPU's sampler; docs/MCT.md). Nearest filters
-    /// draw bilinear with mct.
+    /// mesh-colors (software filter in the shader), mct (Mesh Color Textures: the same
+    /// colours in a 2D atlas filtered by the GPU's sampler; docs/MCT.md) or htex (one texture
+    /// per edge, three hardware fetches; docs/HTEX.md). Nearest filters draw bilinear with
+    /// mct and htex.
     #[arg(long, value_enum, default_value_t = Representation::MeshColors, conflicts_with = "baseline_uv")]
     representation: Representation,
 }
@@ -100,6 +101,28 @@ fn filter_mode(filter: RenderFilter, level: Option<u32>) -> Result<FilterMode> {
         (RenderFilter::Anisotropic, None) => FilterMode::Anisotropic,
         (RenderFilter::Anisotropic, Some(_)) => anyhow::bail!("--level does not apply to --filter anisotropic"),
     })
+}
+
+/// `--representation htex`: the Htex of `packed` (the packed mesh of `mesh`) within
+/// `max_bytes`, drawn with `settings`.
+fn htex_image(
+    gpu: &Gpu,
+    packed: &meshpaint_core::packing::linear::PackedMesh,
+    mesh: &meshpaint_render::GpuMesh,
+    max_bytes: u64,
+    settings: &RenderSettings,
+    args: &RenderArgs,
+) -> Result<image::RgbaImage> {
+    let limits = gpu.ctx.limits();
+    let options = meshpaint_core::htex::HtexOptions::within(
+        limits.max_texture_dimension_2d,
+        limits.max_texture_array_layers,
+        max_bytes,
+    );
+    let texture = meshpaint_core::htex::build(packed, &options)
+        .with_context(|| format!("{}: building the Htex", args.file.display()))?;
+    let htex = gpu.upload_htex(&mesh.geometry(), &texture)?;
+    Ok(gpu.render_image(DrawItem::Htex(&htex), settings, args.width, args.height)?)
 }
 
 pub(super) fn run(args: RenderArgs) -> Result<()> {
@@ -174,6 +197,10 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
                     .with_context(|| format!("{}: building the Mesh Color Texture", args.file.display()))?;
                 let mct = gpu.upload_mct(&mesh.geometry(), &texture)?;
                 gpu.render_image(DrawItem::Mct(&mct), &settings(mesh.bounds), args.width, args.height)?
+            }
+            Representation::Htex => {
+                let packed = shown.pack(document.display_format())?;
+                htex_image(&gpu, &packed, &mesh, budget.memory_bytes, &settings(mesh.bounds), &args)?
             }
         };
         (image, mesh.face_count, mesh.atlas.samples)

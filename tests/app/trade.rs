@@ -49,8 +49,20 @@ fn bench_trade_on_box_textured_prints_complete_rows_and_writes_plots() {
     assert_eq!(representation("mesh-colors").len(), 5 * 3 * 5 * views);
     // The same packs as MCT × 4 filters (no nearest), less any format whose MCT was skipped.
     let skipped = kind("skipped");
-    assert_eq!(representation("mct").len() + skipped.len() * 4 * views, 5 * 3 * 4 * views, "{skipped:?}");
-    assert_eq!(representation("mesh-colors").len() + representation("mct").len(), configs.len());
+    let mct_skipped = skipped.iter().filter(|row| row["representation"] == "mct").count();
+    assert_eq!(representation("mct").len() + mct_skipped * 4 * views, 5 * 3 * 4 * views, "{skipped:?}");
+    let htex_skipped = skipped.iter().filter(|row| row["representation"] == "htex").count();
+    assert_eq!(representation("htex").len() + htex_skipped * 4 * views, 5 * 3 * 4 * views, "{skipped:?}");
+    let all = ["mesh-colors", "mct", "htex"].map(|r| representation(r).len());
+    assert_eq!(all.iter().sum::<usize>(), configs.len());
+    for row in representation("htex") {
+        for key in ["gpu_bytes", "htex_bytes", "htex_build_seconds", "htex_textures", "htex_e_over_f", "frame_ratio"] {
+            let value = number(row, key);
+            assert!(value.is_finite() && value > 0.0, "{key} = {value} in {row}");
+        }
+        assert!(number(row, "htex_bytes") > number(row, "htex_inside_texel_bytes"), "borders and tables: {row}");
+    }
+    assert!(kind("seam").iter().any(|row| row["representation"] == "htex"), "Htex seam rows");
     assert!(kind("baseline").iter().all(|row| row["representation"] == "uv-texture"));
     for row in representation("mct") {
         assert!(["linear", "mip-1", "mip-2", "trilinear"].contains(&row["filter"].as_str().unwrap()), "{row}");

@@ -61,6 +61,16 @@ impl Gpu {
         GpuMct::upload(&self.ctx, self.renderer.layouts(), geometry, mct)
     }
 
+    /// Uploads the Htex `htex`, built from the packed mesh whose GPU mesh has the geometry
+    /// `geometry`.
+    pub fn upload_htex(
+        &self,
+        geometry: &MeshGeometry,
+        htex: &meshpaint_core::htex::HtexTexture,
+    ) -> Result<super::GpuHtex, RenderError> {
+        super::GpuHtex::upload(&self.ctx, self.renderer.layouts(), geometry, htex)
+    }
+
     /// Puts `store` on the GPU in its paint `layout`, encoded in `format` (the one path of
     /// entering paint mode, of a layout that grew, and of `bench load` / `bench paint`).
     pub fn upload_paint_layout(

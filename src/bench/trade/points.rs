@@ -85,7 +85,11 @@ fn short((representation, resolution, format, filter): &Key) -> String {
         "trilinear" => "tri",
         other => other,
     };
-    let prefix = if representation == "mct" { "MCT " } else { "" };
+    let prefix = match representation.as_str() {
+        "mct" => "MCT ",
+        "htex" => "Htex ",
+        _ => "",
+    };
     format!("{prefix}{r} {f} {filter}")
 }
 
@@ -97,7 +101,7 @@ pub fn write_plots(rows: &[serde_json::Value], dir: &Path, stem: &str) -> Result
     let (bytes_path, frame_path) = (name("bytes"), name("frame"));
     plot_tradeoff(
         &bytes_path,
-        &format!("{stem}: error vs GPU memory (mesh colors and MCT × filter × resolution × format)"),
+        &format!("{stem}: error vs GPU memory (mesh colors, MCT and Htex × filter × resolution × format)"),
         "GPU bytes in total: geometry + colours (log scale)",
         true,
         &bytes,

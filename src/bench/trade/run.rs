@@ -6,7 +6,7 @@ use std::time::Instant;
 use super::bvh::bvh_rows;
 use super::choices::{Choice, prepare, resolution_choices};
 use super::metrics::merge;
-use super::seams::{SeamEdges, SeamJump, mct_seam_jumps, seam_jumps_over};
+use super::seams::{SeamEdges, SeamJump, htex_seam_jumps, mct_seam_jumps, seam_jumps_over};
 use super::study::{Study, views};
 use super::{DISTANCES, TradeOptions};
 use crate::bench::BenchRenderError;
@@ -54,12 +54,14 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
     let bounds =
         first.packs.first().map_or_else(|| BoundingSphere::of_points(&first.document.positions), |p| p.mesh.bounds);
     let face_count = first.document.store.topology().face_count();
+    let representations: Vec<&str> =
+        ["mesh-colors"].into_iter().chain(options.mct.then_some("mct")).chain(options.htex.then_some("htex")).collect();
     let mut rows = vec![serde_json::json!({
         "bench": "trade", "kind": "meta", "file": file, "adapter": gpu.describe(),
         "size": options.size, "supersample": crate::bench::adaptive::SUPERSAMPLE, "views": options.views,
         "distances": DISTANCES.iter().map(|(n, f)| serde_json::json!({"view": n, "distance_factor": f})).collect::<Vec<_>>(),
         "frames": options.frames, "triangles": face_count, "reference": reference_name,
-        "representations": if options.mct { vec!["mesh-colors", "mct"] } else { vec!["mesh-colors"] },
+        "representations": representations,
         "convert_seconds_total": started.elapsed().as_secs_f64(),
     })];
     rows.extend(skipped_rows(&choices, &file, options));
@@ -79,17 +81,18 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
 
 /// One `skipped` row per pack whose MCT was asked for but could not be built or uploaded.
 fn skipped_rows(choices: &[Choice], file: &str, options: &TradeOptions) -> Vec<serde_json::Value> {
-    if !options.mct {
-        return Vec::new();
-    }
     let mut rows = Vec::new();
     for choice in choices {
         for packed in &choice.packs {
-            if let Err(reason) = &packed.mct {
-                rows.push(serde_json::json!({
-                    "bench": "trade", "kind": "skipped", "file": file, "representation": "mct",
-                    "resolution": choice.label, "format": packed.format.name(), "reason": reason,
-                }));
+            let failures =
+                [("mct", options.mct, packed.mct.as_ref().err()), ("htex", options.htex, packed.htex.as_ref().err())];
+            for (representation, asked, failure) in failures {
+                if let (true, Some(reason)) = (asked, failure) {
+                    rows.push(serde_json::json!({
+                        "bench": "trade", "kind": "skipped", "file": file, "representation": representation,
+                        "resolution": choice.label, "format": packed.format.name(), "reason": reason,
+                    }));
+                }
             }
         }
     }
@@ -122,6 +125,9 @@ fn seam_rows(choice: &Choice, file: &str) -> Result<Vec<serde_json::Value>, Benc
     for packed in &choice.packs {
         if let Ok(mct) = &packed.mct {
             push(mct_seam_jumps(&packed.packed, &mct.texture), "mct", packed.format);
+        }
+        if let Ok(htex) = &packed.htex {
+            push(htex_seam_jumps(&packed.packed, &htex.texture), "htex", packed.format);
         }
     }
     Ok(rows)

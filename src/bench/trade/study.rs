@@ -4,7 +4,7 @@
 
 use image::RgbaImage;
 
-use super::choices::{Choice, MctPack, Packed};
+use super::choices::{Choice, HtexPack, MctPack, Packed};
 use super::metrics::{compare, error_json, median, merge};
 use super::{DISTANCES, FILTERS, MCT_FILTERS, TradeOptions};
 use crate::bench::BenchRenderError;
@@ -46,13 +46,31 @@ fn unlit(camera: OrbitCamera, filter: FilterMode) -> RenderSettings {
 }
 
 /// One configuration drawn in a view: a choice, one of its packs, the representation and
-/// an index into [`FILTERS`] (mesh colors) or [`MCT_FILTERS`] (MCT).
+/// an index into [`FILTERS`] (mesh colors) or [`MCT_FILTERS`] (MCT and Htex).
 #[derive(Debug, Clone, Copy)]
 struct Item {
     choice: usize,
     pack: usize,
-    mct: bool,
+    rep: Rep,
     filter: usize,
+}
+
+/// The representation of an [`Item`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Rep {
+    MeshColors,
+    Mct,
+    Htex,
+}
+
+impl Rep {
+    fn name(self) -> &'static str {
+        match self {
+            Rep::MeshColors => "mesh-colors",
+            Rep::Mct => "mct",
+            Rep::Htex => "htex",
+        }
+    }
 }
 
 /// What every view of the study draws and compares.
@@ -73,9 +91,11 @@ impl Study<'_> {
         let mut items = Vec::new();
         for (choice, c) in self.choices.iter().enumerate() {
             for (pack, p) in c.packs.iter().enumerate() {
-                items.extend((0..FILTERS.len()).map(|filter| Item { choice, pack, mct: false, filter }));
-                if p.mct.is_ok() {
-                    items.extend((0..MCT_FILTERS.len()).map(|filter| Item { choice, pack, mct: true, filter }));
+                items.extend((0..FILTERS.len()).map(|filter| Item { choice, pack, rep: Rep::MeshColors, filter }));
+                for (rep, ok) in [(Rep::Mct, p.mct.is_ok()), (Rep::Htex, p.htex.is_ok())] {
+                    if ok {
+                        items.extend((0..MCT_FILTERS.len()).map(|filter| Item { choice, pack, rep, filter }));
+                    }
                 }
             }
         }
@@ -88,18 +108,24 @@ impl Study<'_> {
 
     /// The item's MCT, when it is an MCT item.
     fn mct(&self, item: Item) -> Option<&MctPack> {
-        if item.mct { self.packed(item).mct.as_ref().ok() } else { None }
+        if item.rep == Rep::Mct { self.packed(item).mct.as_ref().ok() } else { None }
+    }
+
+    /// The item's Htex, when it is an Htex item.
+    fn htex(&self, item: Item) -> Option<&HtexPack> {
+        if item.rep == Rep::Htex { self.packed(item).htex.as_ref().ok() } else { None }
     }
 
     fn draw_item(&self, item: Item) -> DrawItem<'_> {
-        match self.mct(item) {
-            Some(mct) => DrawItem::Mct(&mct.gpu),
-            None => DrawItem::MeshColors(&self.packed(item).mesh),
+        match (self.mct(item), self.htex(item)) {
+            (Some(mct), _) => DrawItem::Mct(&mct.gpu),
+            (_, Some(htex)) => DrawItem::Htex(&htex.gpu),
+            _ => DrawItem::MeshColors(&self.packed(item).mesh),
         }
     }
 
     fn filter(item: Item) -> (&'static str, FilterMode) {
-        if item.mct { MCT_FILTERS[item.filter] } else { FILTERS[item.filter] }
+        if item.rep == Rep::MeshColors { FILTERS[item.filter] } else { MCT_FILTERS[item.filter] }
     }
 
     /// Median frame times in ms of the baseline and of every item, interleaved: each round
@@ -198,7 +224,7 @@ impl Study<'_> {
         let resolutions = choice.document.store.face_resolutions();
         let mut row = serde_json::json!({
             "bench": "trade", "kind": "config", "file": self.file,
-            "representation": if item.mct { "mct" } else { "mesh-colors" },
+            "representation": item.rep.name(),
             "filter": Self::filter(item).0, "resolution": choice.label, "error_bound": choice.error_bound,
             "resolution_min": resolutions.iter().map(|r| r.get()).min(),
             "resolution_max": resolutions.iter().map(|r| r.get()).max(),
@@ -210,8 +236,9 @@ impl Study<'_> {
             "pack_seconds": packed.pack_seconds,
             "convert_seconds": choice.convert_seconds,
         });
-        let more = match self.mct(item) {
-            Some(mct) => serde_json::json!({
+        let more = match (self.mct(item), self.htex(item)) {
+            (_, Some(htex)) => htex_json(packed, htex),
+            (Some(mct), _) => serde_json::json!({
                 "gpu_bytes": packed.geometry_bytes() + mct.gpu.gpu_bytes(),
                 "color_gpu_bytes": mct.gpu.gpu_bytes(),
                 "mct_bytes": mct.texture.gpu_bytes(),
@@ -222,7 +249,7 @@ impl Study<'_> {
                 "mct_clamped_ring_texels": mct.texture.stats.clamped_ring_texels,
                 "mct_max_ring_clamp": mct.texture.stats.max_ring_clamp,
             }),
-            None => serde_json::json!({
+            _ => serde_json::json!({
                 "gpu_bytes": packed.mesh.gpu_bytes(),
                 "color_gpu_bytes": packed.mesh.atlas_bytes() + packed.mesh.face_record_bytes(),
                 "dab_samples_per_second": choice.dab.get("samples_per_second_median"),
@@ -233,6 +260,26 @@ impl Study<'_> {
         merge(&mut row, &more);
         row
     }
+}
+
+/// The Htex columns of a `config` row: bytes (pages + tables; the pages' texels the colours
+/// need, without borders and free space), the paper's E/F texture count, build time, the
+/// largest colour jump at level 0 across intrinsic edges (corner texels equalised).
+fn htex_json(packed: &Packed, htex: &HtexPack) -> serde_json::Value {
+    let (e, f) = htex.texture.texture_count();
+    let layout = &htex.texture.layout;
+    let bpp = htex.texture.format.bytes_per_sample() as u64;
+    serde_json::json!({
+        "gpu_bytes": packed.geometry_bytes() + htex.gpu.gpu_bytes(),
+        "color_gpu_bytes": htex.gpu.gpu_bytes(),
+        "htex_bytes": htex.texture.gpu_bytes(),
+        "htex_inside_texel_bytes": layout.inside_texels() * bpp,
+        "htex_bytes_over_mesh_colors": htex.texture.gpu_bytes() as f64 / packed.mesh_colors_bytes().max(1) as f64,
+        "htex_build_seconds": htex.build_seconds,
+        "htex_textures": e, "htex_faces": f, "htex_e_over_f": e as f64 / f.max(1) as f64,
+        "htex_pages": [layout.page_size, layout.pages],
+        "htex_levels": layout.levels,
+    })
 }
 
 /// The pixels compared: all 16 subsamples of the reference covered, and the test covers the pixel.

@@ -99,6 +99,14 @@ impl Default for HtexOptions {
     }
 }
 
+impl HtexOptions {
+    /// Pages up to a device's largest texture side and array layers, within `max_bytes`,
+    /// corners equalised.
+    pub fn within(max_dimension: u32, max_pages: u32, max_bytes: u64) -> Self {
+        HtexOptions { max_dimension, max_pages, max_bytes, equalize_corners: true }
+    }
+}
+
 /// An Htex: the layout, the pages' texels (page-major, row-major, `page_size²` each, in
 /// `format`), the R8 weight texture and the per-vertex density trilinear filtering needs.
 #[derive(Debug, Clone, PartialEq)]
