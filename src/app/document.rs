@@ -94,8 +94,8 @@ pub struct BuiltHtex {
     pub build: Duration,
     /// Quad textures (the paper's E) and faces (F).
     pub textures: (u64, u64),
-    /// Pages (side, count).
-    pub pages: (u32, u32),
+    /// Pages (width and height, count).
+    pub pages: ([u32; 2], u32),
     /// GPU bytes over the packed mesh's face records and colours.
     pub bytes_over_mesh_colors: f64,
 }
@@ -125,7 +125,7 @@ pub fn build_htex(
     Ok(BuiltHtex {
         build,
         textures: texture.texture_count(),
-        pages: (texture.layout.page_size, texture.layout.pages),
+        pages: ([texture.layout.page_size, texture.layout.page_height], texture.layout.pages),
         bytes_over_mesh_colors: htex.gpu_bytes() as f64 / mesh_colors as f64,
         htex,
     })

@@ -55,10 +55,10 @@ impl GpuHtex {
     ) -> Result<Self, RenderError> {
         check(ctx, mesh, htex)?;
         let layout = &htex.layout;
-        let (side, pages_count) = (layout.page_size, layout.pages);
+        let (side, height, pages_count) = (layout.page_size, layout.page_height, layout.pages);
         let pages = ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("htex pages"),
-            size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: pages_count },
+            size: wgpu::Extent3d { width: side, height, depth_or_array_layers: pages_count },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -143,15 +143,15 @@ impl GpuHtex {
 
 /// Uploads every page in bands of rows, so that no single write stages a whole page.
 fn write_pages(ctx: &GpuContext, pages: &wgpu::Texture, htex: &HtexTexture) {
-    let side = htex.layout.page_size;
+    let (side, height) = (htex.layout.page_size, u64::from(htex.layout.page_height));
     let bpp = htex.format.bytes_per_sample() as u64;
     let row_bytes = u64::from(side) * bpp;
-    let band_rows = ((64u64 << 20) / row_bytes).clamp(1, u64::from(side));
+    let band_rows = ((64u64 << 20) / row_bytes).clamp(1, height);
     for page in 0..htex.layout.pages {
         let mut y = 0u64;
-        while y < u64::from(side) {
-            let rows = band_rows.min(u64::from(side) - y);
-            let start = ((u64::from(page) * u64::from(side) + y) * row_bytes) as usize;
+        while y < height {
+            let rows = band_rows.min(height - y);
+            let start = ((u64::from(page) * height + y) * row_bytes) as usize;
             let bytes = &htex.texels[start..start + (rows * row_bytes) as usize];
             write(ctx, pages, [0, y as u32, page], bytes, row_bytes, [side, rows as u32]);
             y += rows;
@@ -184,7 +184,7 @@ fn write(
 fn check(ctx: &GpuContext, mesh: &MeshGeometry, htex: &HtexTexture) -> Result<(), RenderError> {
     let layout = &htex.layout;
     let limits = ctx.limits();
-    let side = layout.page_size;
+    let side = layout.page_size.max(layout.page_height);
     if side == 0 || side > limits.max_texture_dimension_2d || layout.pages > limits.max_texture_array_layers {
         return Err(RenderError::InvalidTexture(format!(
             "{} Htex pages of {side}² texels exceed the device ({} per side, {} layers)",

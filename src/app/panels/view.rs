@@ -252,10 +252,10 @@ fn htex_ui(ui: &mut egui::Ui, open: &OpenDocument) {
             ui.colored_label(ui.visuals().warn_fg_color, format!("Showing the mesh colors: {message}"));
         }
         Some(Ok(built)) => {
-            let ((e, f), (side, pages)) = (built.textures, built.pages);
+            let ((e, f), ([w, h], pages)) = (built.textures, built.pages);
             ui.label(
                 egui::RichText::new(format!(
-                    "{e} edge textures for {f} faces (E/F {:.2}) in {pages} page(s) of {side}²: {} ({:.2}× the mesh \
+                    "{e} edge textures for {f} faces (E/F {:.2}) in {pages} page(s) of {w} × {h}: {} ({:.2}× the mesh \
                      colors' buffers), built in {:.0} ms",
                     e as f64 / f.max(1) as f64,
                     human_bytes(built.htex.gpu_bytes()),

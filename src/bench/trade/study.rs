@@ -277,7 +277,7 @@ fn htex_json(packed: &Packed, htex: &HtexPack) -> serde_json::Value {
         "htex_bytes_over_mesh_colors": htex.texture.gpu_bytes() as f64 / packed.mesh_colors_bytes().max(1) as f64,
         "htex_build_seconds": htex.build_seconds,
         "htex_textures": e, "htex_faces": f, "htex_e_over_f": e as f64 / f.max(1) as f64,
-        "htex_pages": [layout.page_size, layout.pages],
+        "htex_pages": [layout.page_size, layout.page_height, layout.pages],
         "htex_levels": layout.levels,
     })
 }

@@ -27,14 +27,14 @@ pub fn build(packed: &PackedMesh, options: &HtexOptions) -> Result<HtexTexture, 
         .into_par_iter()
         .map(|q| fill_quad(packed, &layout, q, options.equalize_corners))
         .collect::<Result<_, _>>()?;
-    let page = u64::from(layout.page_size);
+    let (page, height) = (u64::from(layout.page_size), u64::from(layout.page_height));
     for (q, levels) in blocks.iter().enumerate() {
         for (level, data) in levels {
             let n = u64::from(layout.size(q as u32, *level));
             let o = layout.origin(q as u32, *level);
             let row_bytes = (n * bpp) as usize;
             for j in 0..n {
-                let texel = (u64::from(o.page) * page + u64::from(o.y) + 1 + j) * page + u64::from(o.x) + 1;
+                let texel = (u64::from(o.page) * height + u64::from(o.y) + 1 + j) * page + u64::from(o.x) + 1;
                 let at = (texel * bpp) as usize;
                 let src = (j as usize) * row_bytes;
                 texels[at..at + row_bytes].copy_from_slice(&data[src..src + row_bytes]);
@@ -92,10 +92,11 @@ pub fn texel_point(i: u32, j: u32, n: u32, equalize: bool) -> [f32; 2] {
             None
         }
     };
-    if equalize && n >= 2 {
-        if let (Some(x), Some(y)) = (corner(i), corner(j)) {
-            return [x, y];
-        }
+    if equalize
+        && n >= 2
+        && let (Some(x), Some(y)) = (corner(i), corner(j))
+    {
+        return [x, y];
     }
     let nf = n as f32;
     [(i as f32 + 0.5) / nf, (j as f32 + 0.5) / nf]

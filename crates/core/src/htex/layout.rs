@@ -58,8 +58,10 @@ pub struct HtexLayout {
     pub levels: u32,
     /// Block origins, `levels` per quad: `x | y << 13 | page << 26`.
     pub origins: Vec<u32>,
-    /// Page side in texels.
+    /// Page width in texels.
     pub page_size: u32,
+    /// Page height in texels (a lone page is cut to its last row of blocks).
+    pub page_height: u32,
     /// Number of pages.
     pub pages: u32,
     /// Weight texture size (width, height).
@@ -136,8 +138,18 @@ impl HtexLayout {
         if weight_size[0] > limit {
             return Err(HtexError::AtlasTooLarge { side: weight_size[0], max_dimension: limit });
         }
-        let (origins, page_size, pages) = pack(&quad_log2, levels, limit, max_pages.min(MAX_PAGES))?;
-        Ok(HtexLayout { halfedges, quad_log2, face_records, levels, origins, page_size, pages, weight_size })
+        let (origins, [page_size, page_height], pages) = pack(&quad_log2, levels, limit, max_pages.min(MAX_PAGES))?;
+        Ok(HtexLayout {
+            halfedges,
+            quad_log2,
+            face_records,
+            levels,
+            origins,
+            page_size,
+            page_height,
+            pages,
+            weight_size,
+        })
     }
 
     /// Side of quad `q` at `level` (`max(1, n >> level)`).
@@ -154,7 +166,7 @@ impl HtexLayout {
 
     /// Texels in all pages.
     pub fn texel_count(&self) -> u64 {
-        u64::from(self.page_size) * u64::from(self.page_size) * u64::from(self.pages)
+        u64::from(self.page_size) * u64::from(self.page_height) * u64::from(self.pages)
     }
 
     /// Texels inside blocks (not borders, not free space): what the colours need.
@@ -173,16 +185,16 @@ impl HtexLayout {
     }
 }
 
-/// Shelf-packs every quad's blocks, largest first; returns the origin words, page side
-/// and page count.
-fn pack(quad_log2: &[u8], levels: u32, limit: u32, max_pages: u32) -> Result<(Vec<u32>, u32, u32), HtexError> {
+/// Shelf-packs every quad's blocks, largest first; returns the origin words, page width
+/// and height, and page count.
+fn pack(quad_log2: &[u8], levels: u32, limit: u32, max_pages: u32) -> Result<(Vec<u32>, [u32; 2], u32), HtexError> {
     let area: u64 = quad_log2
         .iter()
         .map(|&log2| (0..levels).map(|l| ((1u64 << u32::from(log2).saturating_sub(l)) + 2).pow(2)).sum::<u64>())
         .sum();
     let largest = (1u32 << quad_log2.iter().copied().max().unwrap_or(1)) + 2;
-    // The smallest power-of-two page that would hold all blocks with ~10 % shelf slack.
-    let wanted = ((area as f64 * 1.1).sqrt().ceil() as u32).max(largest).next_power_of_two();
+    // A square that would hold all blocks with ~10 % shelf slack, in whole 64-texel steps.
+    let wanted = ((area as f64 * 1.1).sqrt().ceil() as u32).max(largest).next_multiple_of(64);
     let page_size = wanted.min(limit);
     if largest > page_size {
         return Err(HtexError::AtlasTooLarge { side: largest, max_dimension: limit });
@@ -212,5 +224,7 @@ fn pack(quad_log2: &[u8], levels: u32, limit: u32, max_pages: u32) -> Result<(Ve
         x += side;
         row = row.max(side);
     }
-    Ok((origins, page_size, page + 1))
+    // A lone page ends at its last row of blocks.
+    let height = if page == 0 { y + row } else { page_size };
+    Ok((origins, [page_size, height.max(1)], page + 1))
 }

@@ -107,7 +107,7 @@ impl HtexOptions {
     }
 }
 
-/// An Htex: the layout, the pages' texels (page-major, row-major, `page_size²` each, in
+/// An Htex: the layout, the pages' texels (page-major, row-major, `page_size × page_height` each, in
 /// `format`), the R8 weight texture and the per-vertex density trilinear filtering needs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HtexTexture {
@@ -115,7 +115,7 @@ pub struct HtexTexture {
     pub layout: HtexLayout,
     /// Texel encoding (the packed buffers' colour format).
     pub format: ColorFormat,
-    /// `pages · page_size² · bytes_per_sample` bytes.
+    /// `pages · page_size · page_height · bytes_per_sample` bytes.
     pub texels: Vec<u8>,
     /// The border-normalisation texture, R8 (`weight_size`).
     pub weights: Vec<u8>,

@@ -17,10 +17,10 @@ use crate::htex::layout::{decode_record, weight_block_x};
 impl HtexTexture {
     /// The decoded texel at `(x, y)` of `page` (clamped to the page).
     pub fn texel(&self, page: u32, x: i64, y: i64) -> Rgba {
-        let s = i64::from(self.layout.page_size);
-        let (x, y) = (x.clamp(0, s - 1) as u64, y.clamp(0, s - 1) as u64);
+        let (w, h) = (i64::from(self.layout.page_size), i64::from(self.layout.page_height));
+        let (x, y) = (x.clamp(0, w - 1) as u64, y.clamp(0, h - 1) as u64);
         let bpp = self.format.bytes_per_sample() as u64;
-        let at = (((u64::from(page) * s as u64 + y) * s as u64 + x) * bpp) as usize;
+        let at = (((u64::from(page) * h as u64 + y) * w as u64 + x) * bpp) as usize;
         self.format.decode(&self.texels[at..at + bpp as usize])
     }
 

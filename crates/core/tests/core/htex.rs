@@ -209,15 +209,15 @@ fn every_texel_is_the_reference_at_its_position_at_every_level() {
 fn blocks_never_overlap_and_stay_in_their_page() {
     let packed = packed_mesh(Shape::Open, 2, mixed, ColorFormat::Rgba8Srgb, 3);
     let htex = build(&packed, true);
-    let s = htex.layout.page_size as usize;
-    let mut owner = vec![u32::MAX; s * s * htex.layout.pages as usize];
+    let (s, h) = (htex.layout.page_size as usize, htex.layout.page_height as usize);
+    let mut owner = vec![u32::MAX; s * h * htex.layout.pages as usize];
     for q in 0..htex.layout.halfedges.quads.len() as u32 {
         for level in 0..htex.layout.levels {
             let (n, o) = (htex.layout.size(q, level) as usize, htex.layout.origin(q, level));
-            assert!(o.x as usize + n + 2 <= s && o.y as usize + n + 2 <= s && o.page < htex.layout.pages);
+            assert!(o.x as usize + n + 2 <= s && o.y as usize + n + 2 <= h && o.page < htex.layout.pages);
             for y in o.y as usize..o.y as usize + n + 2 {
                 for x in o.x as usize..o.x as usize + n + 2 {
-                    let at = (o.page as usize * s + y) * s + x;
+                    let at = (o.page as usize * h + y) * s + x;
                     assert_eq!(owner[at], u32::MAX, "quad {q} level {level} overlaps");
                     owner[at] = q;
                 }
