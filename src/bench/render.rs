@@ -288,6 +288,9 @@ pub fn bench_render(
     })
 }
 
+/// [`build_htex`]'s result: the uploaded Htex, build seconds, (E, F) and the jump entries.
+type BuiltHtex = (meshpaint_render::GpuHtex, f64, (u64, u64), Vec<serde_json::Value>);
+
 /// The Htex of `packed` uploaded with `mesh`'s geometry, its build time in seconds, its
 /// texture count (E, F) and the largest colour jumps across its intrinsic edges per level
 /// (CPU evaluation), then at level 0 without corner equalisation (the paper's corner-texel
@@ -296,7 +299,7 @@ fn build_htex(
     gpu: &Gpu,
     packed: &meshpaint_core::packing::linear::PackedMesh,
     mesh: &meshpaint_render::GpuMesh,
-) -> Result<(meshpaint_render::GpuHtex, f64, (u64, u64), Vec<serde_json::Value>), BenchRenderError> {
+) -> Result<BuiltHtex, BenchRenderError> {
     let limits = gpu.ctx.limits();
     let options = HtexOptions::within(limits.max_texture_dimension_2d, limits.max_texture_array_layers, u64::MAX);
     let build_start = Instant::now();
