@@ -50,7 +50,8 @@ fn u64_at(bytes: &[u8], at: usize) -> u64 {
 pub fn read_packed(path: &Path) -> Result<Packed> {
     let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
     ensure!(bytes.len() >= 256 && bytes.starts_with(b"MESHPAK\0"), "{}: not a packed file", path.display());
-    ensure!(u32_at(&bytes, 8) == 1 && u32_at(&bytes, 12) == 128, "{}: unknown version", path.display());
+    // Version 2 only adds a layers section after the colours (their composite): ignored here.
+    ensure!(matches!(u32_at(&bytes, 8), 1 | 2) && u32_at(&bytes, 12) == 128, "{}: unknown version", path.display());
     ensure!(u64_at(&bytes, 16) == bytes.len() as u64, "{}: truncated", path.display());
     let mut crc = crc32fast::Hasher::new();
     crc.update(&bytes[..124]);

@@ -23,7 +23,7 @@ use meshpaint_core::packing::linear::PackedMesh;
 use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::paint::picking::MeshBvh;
 use meshpaint_core::progress::Reporter;
-use meshpaint_render::{BaselineMesh, DrawItem, Gpu, GpuHtex, GpuMct, GpuMesh, MeshGeometry};
+use meshpaint_render::{BaselineMesh, DrawItem, Gpu, GpuHtex, GpuMct, GpuMesh, GpuPtex, MeshGeometry};
 
 use super::jobs::JobContext;
 use super::state::{Representation, Shown};
@@ -83,6 +83,8 @@ pub struct AlternateViews {
     pub mct: Option<(u64, Result<BuiltMct, String>)>,
     /// The Htex of the packed mesh, with the mesh generation it was built for.
     pub htex: Option<(u64, Result<BuiltHtex, String>)>,
+    /// The packed Ptex of the packed mesh, with the mesh generation it was built for.
+    pub ptex: Option<(u64, Result<BuiltPtex, String>)>,
 }
 
 /// An Htex on the GPU and what building it cost.
@@ -131,6 +133,37 @@ pub fn build_htex(
     })
 }
 
+/// A packed Ptex on the GPU and what building it cost.
+#[derive(Debug)]
+pub struct BuiltPtex {
+    /// The texture, records and tables, drawn with the document's GPU mesh geometry.
+    pub ptex: GpuPtex,
+    /// Store-independent build time (packed mesh → texture), without the upload.
+    pub build: Duration,
+    /// Texture, records and tables over the packed mesh's face records and colours.
+    pub bytes_over_mesh_colors: f64,
+}
+
+/// Builds the packed Ptex of `packed` (as [`build_mct`]) within `budget` and uploads it.
+pub fn build_ptex(
+    packed: &PackedMesh,
+    geometry: &MeshGeometry,
+    budget: &Budget,
+    gpu: &Gpu,
+    job: &JobContext,
+) -> Result<BuiltPtex, String> {
+    job.progress(0.1, "packing the per-face blocks");
+    let started = Instant::now();
+    let max_dimension = gpu.ctx.limits().max_texture_dimension_2d;
+    let texture = meshpaint_core::ptex::build(packed, max_dimension, budget.memory_bytes)
+        .map_err(|error| format!("building the packed Ptex: {error}"))?;
+    let build = started.elapsed();
+    job.progress(0.8, "uploading the texture");
+    let ptex = gpu.upload_ptex(geometry, &texture).map_err(|error| format!("uploading the packed Ptex: {error}"))?;
+    let mesh_colors = (packed.face_record_bytes() + packed.color_bytes()).max(1);
+    Ok(BuiltPtex { ptex, build, bytes_over_mesh_colors: texture.gpu_bytes() as f64 / mesh_colors as f64 })
+}
+
 /// A Mesh Color Texture on the GPU and what building it cost.
 #[derive(Debug)]
 pub struct BuiltMct {
@@ -175,6 +208,8 @@ pub enum AlternateView {
     Mct(u64, Box<Result<BuiltMct, String>>),
     /// [`AlternateViews::htex`], built for this mesh generation.
     Htex(u64, Box<Result<BuiltHtex, String>>),
+    /// [`AlternateViews::ptex`], built for this mesh generation.
+    Ptex(u64, Box<Result<BuiltPtex, String>>),
 }
 
 /// Builds the view `shown` of `document`, opened from `source`, on `gpu` (`None` for
@@ -279,6 +314,21 @@ impl OpenDocument {
         }
     }
 
+    /// Whether the packed Ptex of the current GPU mesh still has to be built.
+    pub fn ptex_missing(&self) -> bool {
+        self.alternates.ptex.as_ref().is_none_or(|(generation, _)| *generation != self.mesh_generation)
+    }
+
+    /// The packed Ptex of the current GPU mesh, if it is built; `Err` says why it cannot be.
+    pub fn current_ptex(&self) -> Option<Result<&BuiltPtex, &str>> {
+        match &self.alternates.ptex {
+            Some((generation, built)) if *generation == self.mesh_generation => {
+                Some(built.as_ref().map_err(String::as_str))
+            }
+            _ => None,
+        }
+    }
+
     /// The packed mesh and GPU geometry a Mesh Color Texture is built from (`None` without
     /// a GPU mesh or while paint mode holds the packing).
     pub fn mct_source(&self) -> Option<(PackedMesh, MeshGeometry)> {
@@ -295,6 +345,7 @@ impl OpenDocument {
                 Representation::MeshColorTexture => {
                     self.current_mct().and_then(Result::ok).map(|b| DrawItem::Mct(&b.mct))
                 }
+                Representation::PackedPtex => self.current_ptex().and_then(Result::ok).map(|b| DrawItem::Ptex(&b.ptex)),
                 Representation::Htex => self.current_htex().and_then(Result::ok).map(|b| DrawItem::Htex(&b.htex)),
                 Representation::MeshColors => None,
             },
@@ -376,7 +427,11 @@ pub fn write_packed(document: &Document, format: ColorFormat, path: &Path, job: 
     let packed = document.pack(format).with_context(|| format!("packing for {}", path.display()))?;
     let repack = started.elapsed();
     job.progress(0.6, "writing");
-    meshpaint_core::packing::file::write_file(path, &packed)?;
+    // The editor's tools paint the store, not yet the layers: when they did, the layers no
+    // longer make the store and saving them would lose the paint, so the save is flattened.
+    let flattened = !document.layers_in_sync();
+    let layers = if flattened { None } else { document.layers_section(format) };
+    meshpaint_core::packing::file::write_file_with_layers(path, &packed, layers.as_ref())?;
     let bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     job.progress(1.0, "done");
     Ok(Written {
@@ -384,7 +439,13 @@ pub fn write_packed(document: &Document, format: ColorFormat, path: &Path, job: 
         bytes,
         repack: Some(repack),
         format: Some(format),
-        summary: format!("{} samples ({}), {}", thousands(packed.sample_count()), format.name(), human_bytes(bytes)),
+        summary: format!(
+            "{} samples ({}), {}{}",
+            thousands(packed.sample_count()),
+            format.name(),
+            human_bytes(bytes),
+            if flattened { "; layers flattened (the store was painted outside them)" } else { "" }
+        ),
     })
 }
 

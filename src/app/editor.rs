@@ -328,9 +328,10 @@ impl Editor {
         }
     }
 
-    /// Builds the Mesh Color Texture or the Htex of the open document's packed mesh on a job, when the
-    /// view shows that representation and it is missing (never in paint mode, which draws
-    /// the paint layout; leaving it repacks, and the texture is built again from the result).
+    /// Builds the Mesh Color Texture (or packed Ptex, or Htex) of the open document's packed mesh on a
+    /// job, when the view shows that representation and it is missing (never in paint mode,
+    /// which draws the paint layout; leaving it repacks, and the texture is built again from
+    /// the result).
     pub fn prepare_mct(&mut self) {
         let (Some(open), Some(gpu)) = (&self.document.open, &self.gpu) else {
             return;
@@ -340,6 +341,7 @@ impl Editor {
             Representation::MeshColors => false,
             Representation::MeshColorTexture => open.mct_missing(),
             Representation::Htex => open.htex_missing(),
+            Representation::PackedPtex => open.ptex_missing(),
         };
         if !missing || self.document.level0_only() || self.jobs.is_busy() {
             return;
@@ -349,11 +351,21 @@ impl Editor {
         };
         let (path, generation) = (open.path.clone(), open.mesh_generation);
         let (gpu, budget) = (Arc::clone(gpu), self.budget());
-        let started = self.jobs.start(JobKind::View, format!("Preparing {}", representation.name()), move |job| {
-            let view = if representation == Representation::Htex {
-                AlternateView::Htex(generation, Box::new(document::build_htex(&packed, &geometry, &budget, &gpu, job)))
-            } else {
-                AlternateView::Mct(generation, Box::new(document::build_mct(&packed, &geometry, &budget, &gpu, job)))
+        let name = representation.name();
+        let started = self.jobs.start(JobKind::View, format!("Preparing {name}"), move |job| {
+            let view = match representation {
+                Representation::PackedPtex => AlternateView::Ptex(
+                    generation,
+                    Box::new(document::build_ptex(&packed, &geometry, &budget, &gpu, job)),
+                ),
+                Representation::Htex => AlternateView::Htex(
+                    generation,
+                    Box::new(document::build_htex(&packed, &geometry, &budget, &gpu, job)),
+                ),
+                _ => AlternateView::Mct(
+                    generation,
+                    Box::new(document::build_mct(&packed, &geometry, &budget, &gpu, job)),
+                ),
             };
             Ok(JobOutput::View(path, Box::new(view)))
         });
@@ -381,7 +393,8 @@ impl Editor {
         let mesh = open.and_then(|d| d.gpu_mesh.as_ref()).map_or(0, |m| m.gpu_bytes());
         let mct = open.and_then(|d| d.current_mct()).and_then(Result::ok).map_or(0, |b| b.mct.gpu_bytes());
         let htex = open.and_then(|d| d.current_htex()).and_then(Result::ok).map_or(0, |b| b.htex.gpu_bytes());
-        mesh + mct + htex + self.viewport.gpu_bytes
+        let ptex = open.and_then(|d| d.current_ptex()).and_then(Result::ok).map_or(0, |b| b.ptex.gpu_bytes());
+        mesh + mct + ptex + htex + self.viewport.gpu_bytes
     }
 
     /// The window title.
@@ -499,7 +512,8 @@ impl Editor {
             Action::ToggleRepresentation => {
                 view.representation = match view.representation {
                     Representation::MeshColors => Representation::MeshColorTexture,
-                    Representation::MeshColorTexture => Representation::Htex,
+                    Representation::MeshColorTexture => Representation::PackedPtex,
+                    Representation::PackedPtex => Representation::Htex,
                     Representation::Htex => Representation::MeshColors,
                 };
                 self.prepare_mct();

@@ -90,6 +90,7 @@ impl DocumentState {
                     open.mesh_generation += 1;
                     open.alternates.mct = None;
                     open.alternates.htex = None;
+                    open.alternates.ptex = None;
                     encoded = Some(upload.encoded);
                 }
                 Err(error) => {

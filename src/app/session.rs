@@ -170,6 +170,28 @@ impl DocumentState {
                 open.alternates.htex = Some((generation, *built));
                 failed
             }
+            AlternateView::Ptex(generation, built) => {
+                if generation != open.mesh_generation {
+                    log::info!("a packed Ptex finished for colours that changed since; ignored");
+                    return;
+                }
+                let failed = match built.as_ref() {
+                    Ok(built) => {
+                        let [w, h] = built.ptex.size;
+                        let text = format!(
+                            "Built the packed Ptex: {w} × {h} texture, {} ({:.2}× the mesh colors) in {:.0} ms",
+                            human_bytes(built.ptex.gpu_bytes()),
+                            built.bytes_over_mesh_colors,
+                            built.build.as_secs_f64() * 1000.0
+                        );
+                        status.set(Severity::Info, text);
+                        None
+                    }
+                    Err(message) => Some(message.clone()),
+                };
+                open.alternates.ptex = Some((generation, *built));
+                failed
+            }
         };
         if let Some(message) = failed {
             status.set(Severity::Warning, format!("Cannot show it: {message}"));
@@ -201,6 +223,7 @@ impl DocumentState {
         open.mesh_generation += 1;
         open.alternates.mct = None;
         open.alternates.htex = None;
+        open.alternates.ptex = None;
         open.samples_with_mips = repacked.samples_with_mips;
         open.packed_bytes = repacked.packed_bytes;
         open.samples = open.document.store.sample_count();
@@ -233,6 +256,10 @@ pub fn opened_text(document: &OpenDocument, elapsed: Duration) -> String {
         thousands(document.samples),
         elapsed.as_secs_f64()
     );
+    // The conversion's rule and PSNR against the texture, and the faces the budget held.
+    if let Some(conversion) = document.document.conversion.as_ref().filter(|c| c.texture_psnr_db.is_some()) {
+        text.push_str(&format!("; {}", conversion.summary()));
+    }
     let notes = &document.document.warnings;
     match notes.as_slice() {
         [] => {}

@@ -105,12 +105,20 @@ pub enum Representation {
     /// Htex (Barbier & Dupuy 2022): one square texture per edge in atlas pages, three
     /// hardware bilinear fetches per pixel (crates/core/src/htex; built like MCT).
     Htex,
+    /// Packed Ptex (Kim, Hillesland, Hensley 2011): per-pair square blocks with their MIP
+    /// chains and one-texel borders from the neighbours in one texture, filtered by the
+    /// GPU's bilinear sampler (crates/core/src/ptex; built as Mesh Color Textures are).
+    PackedPtex,
 }
 
 impl Representation {
     /// Every choice, in the order the view panel lists them.
-    pub const ALL: [Representation; 3] =
-        [Representation::MeshColors, Representation::MeshColorTexture, Representation::Htex];
+    pub const ALL: [Representation; 4] = [
+        Representation::MeshColors,
+        Representation::MeshColorTexture,
+        Representation::PackedPtex,
+        Representation::Htex,
+    ];
 
     /// The name the view panel shows.
     pub fn name(self) -> &'static str {
@@ -118,6 +126,7 @@ impl Representation {
             Representation::MeshColors => "Mesh colors (software filter)",
             Representation::MeshColorTexture => "Mesh Color Textures (hardware filter)",
             Representation::Htex => "Htex (per-edge textures, hardware filter)",
+            Representation::PackedPtex => "Packed Ptex (hardware filter)",
         }
     }
 }

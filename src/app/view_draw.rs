@@ -88,6 +88,7 @@ impl ViewDrawer {
             DrawItem::Baseline(_) => "the UV-textured source",
             DrawItem::Mct(_) => "Mesh Color Textures",
             DrawItem::Htex(_) => "Htex",
+            DrawItem::Ptex(_) => "packed Ptex",
         };
         if self.last_logged_pipeline != Some(pipeline) {
             log::info!("3D view draws {pipeline}");

@@ -6,7 +6,7 @@
 //! both are rendered unlit at `s`× the image size in each direction and box-filtered `s`×`s`
 //! to the image size (so the figure measures the colour signal, not edge aliasing), from
 //! `views` cameras around the model (yaw 30° + k·360°/views, pitch 20°, framing
-//! distance). PSNR is over the RGB channels of the 8-bit sRGB images, on the pixels that
+//! distance), or one close-up camera (`--look-at`). PSNR is over the RGB channels of the 8-bit sRGB images, on the pixels that
 //! either render covers; the row reports the mean over the views and the worst view.
 //! Mesh colors are packed in RGBA8 (the display and save format) and drawn with the
 //! linear filter at level 0, the reconstruction the conversion fits.
@@ -55,6 +55,21 @@ pub struct AdaptiveOptions {
     pub supersample: u32,
     /// Each rule is converted with each of these bakes.
     pub fits: Vec<BakeFit>,
+    /// With `Some`, one close-up camera instead of `views` cameras around the model.
+    pub close_up: Option<CloseUp>,
+}
+
+/// A camera looking at a point of the model (a logo, a detail) instead of framing all of it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CloseUp {
+    /// The point looked at, world space.
+    pub target: [f64; 3],
+    /// Eye distance from `target`.
+    pub distance: f64,
+    /// Camera yaw, degrees (0 looks along −Z, from +Z).
+    pub yaw_degrees: f64,
+    /// Camera pitch, degrees.
+    pub pitch_degrees: f64,
 }
 
 /// `bake` in the JSON rows: `least-squares` or `point`.
@@ -117,6 +132,8 @@ impl AdaptiveRow {
             "samples_with_mips": self.samples_with_mips,
             "packed_bytes": self.packed_bytes,
             "convert_seconds": self.convert_seconds,
+            "texture_psnr_db": self.phases.texture_psnr_db.filter(|db| db.is_finite()),
+            "faces_held_by_budget": self.phases.rule.faces_held_by_budget,
             "phase_seconds": {
                 "weld": self.phases.weld.as_secs_f64(),
                 "topology": self.phases.topology.as_secs_f64(),
@@ -125,6 +142,7 @@ impl AdaptiveRow {
                 "allocate": self.phases.rule.allocate.as_secs_f64(),
                 "bake": self.phases.bake.as_secs_f64(),
                 "store": self.phases.store.as_secs_f64(),
+                "measure": self.phases.measure.as_secs_f64(),
             },
             "psnr_db": mean,
             "psnr_db_worst_view": worst,
@@ -149,14 +167,21 @@ pub fn bench_adaptive(
     options: &AdaptiveOptions,
     on_row: &mut dyn FnMut(&AdaptiveRow),
 ) -> Result<Vec<AdaptiveRow>, BenchRenderError> {
-    let AdaptiveOptions { budget_max, size, views, supersample, ref fits } = *options;
+    let AdaptiveOptions { budget_max, size, views, supersample, ref fits, close_up } = *options;
     let gpu = Gpu::new_headless()?;
     let baseline = gpu
         .upload_baseline(scene)?
         .ok_or_else(|| BenchRenderError::NoReference(format!("{}: no base-colour texture", path.display())))?;
-    let cameras: Vec<_> = (0..views.max(1))
-        .map(|k| default_camera(baseline.bounds, 30.0 + 360.0 * f64::from(k) / f64::from(views.max(1)), 20.0, None))
-        .collect();
+    let cameras: Vec<_> = match close_up {
+        Some(c) => {
+            let mut camera = default_camera(baseline.bounds, c.yaw_degrees, c.pitch_degrees, Some(c.distance));
+            camera.target = c.target;
+            vec![camera]
+        }
+        None => (0..views.max(1))
+            .map(|k| default_camera(baseline.bounds, 30.0 + 360.0 * f64::from(k) / f64::from(views.max(1)), 20.0, None))
+            .collect(),
+    };
     let settings = |camera| {
         let mut settings = RenderSettings::new(camera);
         settings.shading = Shading::Unlit;

@@ -23,7 +23,7 @@ pub struct PlotPoint {
     /// Fill of the marker (the colour format: rgba8 filled, rgba16f hollow, rgba32f hollow
     /// with a dot).
     pub format: String,
-    /// Shape of the marker (`mesh-colors`: circle, `mct`: square).
+    /// Shape of the marker (`mesh-colors`: circle, `mct`: square, `ptex`: triangle).
     pub representation: String,
     /// Short name written next to Pareto points.
     pub label: String,
@@ -161,7 +161,7 @@ pub fn plot_tradeoff(
                 let dot =
                     |p: &PlotPoint| Circle::new((0, 0), if p.format == "rgba32f" { 2 } else { 0 }, color.filled());
                 let mut labelled = false;
-                for representation in ["mesh-colors", "mct"] {
+                for representation in ["mesh-colors", "mct", "ptex"] {
                     let group: Vec<&PlotPoint> = finite
                         .iter()
                         .copied()
@@ -174,6 +174,10 @@ pub fn plot_tradeoff(
                     let drawn = if representation == "mct" {
                         chart.draw_series(
                             group.iter().map(|p| at(p) + Rectangle::new([(-5, -5), (5, 5)], style(p)) + dot(p)),
+                        )
+                    } else if representation == "ptex" {
+                        chart.draw_series(
+                            group.iter().map(|p| at(p) + TriangleMarker::new((0, 0), 7, style(p)) + dot(p)),
                         )
                     } else {
                         chart.draw_series(group.iter().map(|p| at(p) + Circle::new((0, 0), 5, style(p)) + dot(p)))
@@ -198,6 +202,13 @@ pub fn plot_tradeoff(
                     .map_err(|e| draw_error(e.to_string()))?
                     .label("Mesh Color Texture (hardware filter)")
                     .legend(|(x, y)| Rectangle::new([(x - 5, y - 5), (x + 5, y + 5)], BLACK.filled()));
+            }
+            if finite.iter().any(|p| p.representation == "ptex") {
+                chart
+                    .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                    .map_err(|e| draw_error(e.to_string()))?
+                    .label("packed Ptex (hardware filter)")
+                    .legend(|(x, y)| TriangleMarker::new((x, y), 7, BLACK.filled()));
             }
             let line: Vec<(f64, f64)> = front.iter().map(|&i| (finite[i].cost, finite[i].quality)).collect();
             chart
@@ -254,8 +265,8 @@ pub fn plot_tradeoff(
         );
     }
     root.draw(&Text::new(
-        "colour: filter · circle: mesh colors, square: MCT · filled rgba8, hollow rgba16f, hollow with a dot rgba32f · \
-         labelled: the Pareto front of both",
+        "colour: filter · circle: mesh colors, square: MCT, triangle: packed Ptex · filled rgba8, hollow rgba16f, \
+         hollow with a dot rgba32f · labelled: the Pareto front of all",
         (90, 872),
         (FONT, 17).into_font(),
     ))

@@ -1,8 +1,8 @@
 //! `meshpaint bench render`: frame time of the UV-texture baseline, of every mesh-colors
-//! filter mode and of the Mesh Color Textures and the Htex built from the same buffers (the
-//! representation axis: every row names its representation) on the same mesh, view and
-//! image size, interleaved in one run, as ratios to the baseline; plus the GPU memory each
-//! path holds and the MCT's and the Htex's build times.
+//! filter mode and of the Mesh Color Textures, packed Ptex and Htex built from the same
+//! buffers (the representation axis: every row names its representation) on the same mesh,
+//! view and image size, interleaved in one run, as ratios to the baseline; plus the GPU
+//! memory each path holds and the MCT's, packed Ptex's and Htex's build times.
 //!
 //! A frame is one render pass into an offscreen target, submitted and waited for
 //! (`poll(wait)`), so on lavapipe it measures the rasteriser's whole work. Modes are
@@ -32,9 +32,10 @@ use meshpaint_render::{
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeTiming {
     /// `baseline-uv`, `nearest`, `linear`, `mip-1`, `trilinear`, `mct-linear`, `mct-mip-1`,
-    /// `mct-trilinear`, `htex-linear`, `htex-mip-1`, `htex-trilinear`, `mct-anisotropic`.
+    /// `mct-trilinear`, `ptex-linear`, `ptex-mip-1`, `ptex-trilinear`, `htex-linear`,
+    /// `htex-mip-1`, `htex-trilinear`, `mct-anisotropic`.
     pub name: String,
-    /// `uv-texture`, `mesh-colors`, `mct` or `htex`.
+    /// `uv-texture`, `mesh-colors`, `mct`, `ptex` or `htex`.
     pub representation: &'static str,
     /// Median frame time, seconds.
     pub median_seconds: f64,
@@ -76,6 +77,8 @@ pub struct RenderBench {
     /// The largest colour jump across Htex's intrinsic edges per level (equalised corners),
     /// then at level 0 without equalisation.
     pub htex_jumps: Vec<serde_json::Value>,
+    /// Seconds to build the packed Ptex from the packed buffers.
+    pub ptex_build_seconds: f64,
 }
 
 impl RenderBench {
@@ -113,6 +116,7 @@ impl RenderBench {
             "htex_textures": self.htex_textures.0,
             "htex_faces": self.htex_textures.1,
             "htex_jumps": self.htex_jumps,
+            "ptex_build_ms": self.ptex_build_seconds * 1e3,
             "modes": modes,
         })
     }
@@ -217,12 +221,17 @@ pub fn bench_render(
     let mct_build_seconds = build_start.elapsed().as_secs_f64();
     let mct = gpu.upload_mct(&mesh.geometry(), &texture)?;
     let (htex, htex_build_seconds, htex_textures, htex_jumps) = build_htex(&gpu, &packed, &mesh)?;
+    let build_start = Instant::now();
+    let packed_ptex = meshpaint_core::ptex::build(&packed, max_dimension, u64::MAX)?;
+    let ptex_build_seconds = build_start.elapsed().as_secs_f64();
+    let ptex = gpu.upload_ptex(&mesh.geometry(), &packed_ptex)?;
 
     let camera: OrbitCamera = default_camera(mesh.bounds, DEFAULT_YAW_DEGREES, DEFAULT_PITCH_DEGREES, None);
     let timer = FrameTimer::new(&gpu, width, height);
 
     let geometry_bytes = mesh.gpu_bytes() - mesh.atlas_bytes() - mesh.face_record_bytes();
-    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 12] = [
+    let (ptex_bytes, htex_bytes) = (geometry_bytes + ptex.gpu_bytes(), geometry_bytes + htex.gpu_bytes());
+    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 15] = [
         ("baseline-uv", "uv-texture", DrawItem::Baseline(&baseline), FilterMode::Linear, baseline.gpu_bytes()),
         ("nearest", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Nearest, mesh.gpu_bytes()),
         ("linear", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Linear, mesh.gpu_bytes()),
@@ -231,9 +240,12 @@ pub fn bench_render(
         ("mct-linear", "mct", DrawItem::Mct(&mct), FilterMode::Linear, geometry_bytes + mct.gpu_bytes()),
         ("mct-mip-1", "mct", DrawItem::Mct(&mct), FilterMode::MipLevel(1), geometry_bytes + mct.gpu_bytes()),
         ("mct-trilinear", "mct", DrawItem::Mct(&mct), FilterMode::Trilinear, geometry_bytes + mct.gpu_bytes()),
-        ("htex-linear", "htex", DrawItem::Htex(&htex), FilterMode::Linear, geometry_bytes + htex.gpu_bytes()),
-        ("htex-mip-1", "htex", DrawItem::Htex(&htex), FilterMode::MipLevel(1), geometry_bytes + htex.gpu_bytes()),
-        ("htex-trilinear", "htex", DrawItem::Htex(&htex), FilterMode::Trilinear, geometry_bytes + htex.gpu_bytes()),
+        ("ptex-linear", "ptex", DrawItem::Ptex(&ptex), FilterMode::Linear, ptex_bytes),
+        ("ptex-mip-1", "ptex", DrawItem::Ptex(&ptex), FilterMode::MipLevel(1), ptex_bytes),
+        ("ptex-trilinear", "ptex", DrawItem::Ptex(&ptex), FilterMode::Trilinear, ptex_bytes),
+        ("htex-linear", "htex", DrawItem::Htex(&htex), FilterMode::Linear, htex_bytes),
+        ("htex-mip-1", "htex", DrawItem::Htex(&htex), FilterMode::MipLevel(1), htex_bytes),
+        ("htex-trilinear", "htex", DrawItem::Htex(&htex), FilterMode::Trilinear, htex_bytes),
         // Trilinear where the adapter has no anisotropic filtering (`anisotropic` in the report).
         // Last and timed after the interleaved rounds (`INTERLEAVED`): on lavapipe it is ~100×
         // the others and would leave the frame after it with cold caches.
@@ -245,7 +257,7 @@ pub fn bench_render(
     for &(_, _, item, filter, _) in &paths {
         timer.frame(item, filter, camera);
     }
-    const INTERLEAVED: usize = 11;
+    const INTERLEAVED: usize = 14;
     for modes in [0..INTERLEAVED, INTERLEAVED..paths.len()] {
         for _ in 0..frames.max(1) {
             for k in modes.clone() {
@@ -285,6 +297,7 @@ pub fn bench_render(
         htex_build_seconds,
         htex_textures,
         htex_jumps,
+        ptex_build_seconds,
     })
 }
 
@@ -388,6 +401,9 @@ pub enum BenchRenderError {
     /// The Htex cannot be built.
     #[error(transparent)]
     Htex(#[from] meshpaint_core::htex::HtexError),
+    /// The packed Ptex cannot be built.
+    #[error(transparent)]
+    Ptex(#[from] meshpaint_core::ptex::PtexError),
     /// The measurement needs a reference the file does not have.
     #[error("{0}")]
     NoReference(String),

@@ -146,6 +146,9 @@ pub(super) enum Representation {
     /// A Mesh Color Texture: one 2D atlas whose texels duplicate the shared vertex and edge
     /// colours, filtered by the GPU's own sampler (the MCT file, docs/MCT_FORMAT.md).
     Mct,
+    /// Packed Ptex: per-pair square blocks with every MIP level, sorted by resolution into one
+    /// texture with one-texel borders from the neighbours (crates/core/src/ptex; docs/PTEX.md).
+    Ptex,
     /// Htex: one square texture per edge (a halfedge and its twin) in atlas pages, three
     /// hardware bilinear fetches per pixel (docs/HTEX.md).
     Htex,
@@ -202,6 +205,15 @@ pub(super) fn is_mct_file(path: &Path) -> Result<bool> {
     let mut file = std::fs::File::open(path).with_context(|| path.display().to_string())?;
     let read = file.read(&mut head).with_context(|| path.display().to_string())?;
     Ok(meshpaint_core::mct::file::looks_like_mct(&head[..read]))
+}
+
+/// Whether `path` starts with the packed Ptex file's magic (docs/PTEX_FORMAT.md).
+pub(super) fn is_ptex_file(path: &Path) -> Result<bool> {
+    use std::io::Read;
+    let mut head = [0u8; 8];
+    let mut file = std::fs::File::open(path).with_context(|| path.display().to_string())?;
+    let read = file.read(&mut head).with_context(|| path.display().to_string())?;
+    Ok(meshpaint_core::ptex::file::looks_like_ptex(&head[..read]))
 }
 
 pub(super) fn parse_format(name: &str) -> Result<ColorFormat, String> {

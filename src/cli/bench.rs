@@ -135,12 +135,15 @@ pub(super) enum BenchCommand {
         /// row beside each R ≥ 4, texel density and error bounds 0.05…0.0025.
         #[arg(long, value_delimiter = ',')]
         rules: Vec<String>,
+        #[command(flatten)]
+        close_up: CloseUpArgs,
     },
-    /// What every choice costs and buys: representation (mesh colors, Mesh Color Texture, Htex) ×
-    /// filter × resolution (uniform R 1…32 and --error bounds) × colour format, per view at
-    /// several distances — PSNR, max error, FLIP against a 4×4-supersampled reference, samples,
-    /// GPU bytes, pack and MCT build time, frame-time ratio to the UV baseline (interleaved),
-    /// dab throughput; plus seam jumps of both representations and BVH presets. One JSON object
+    /// What every choice costs and buys: representation (mesh colors, Mesh Color Texture,
+    /// packed Ptex, Htex) × filter × resolution (uniform R 1…32 and --error bounds) × colour
+    /// format, per view at several distances — PSNR, max error, FLIP against a
+    /// 4×4-supersampled reference, samples, GPU bytes, pack and build time, frame-time ratio
+    /// to the UV baseline (interleaved), dab throughput; plus seam jumps of every
+    /// representation and BVH presets. One JSON object
     /// per line; with --out, error-vs-cost plots (PNG).
     Trade(TradeArgs),
     /// Picking and painting: BVH presets, pick latency, dab time and samples/s for brushes
@@ -252,13 +255,16 @@ pub(super) struct TradeArgs {
     /// Colour formats measured (comma-separated; default: rgba8, rgba16f, rgba32f).
     #[arg(long, value_parser = parse_format, value_delimiter = ',')]
     pub(super) formats: Vec<ColorFormat>,
-    /// Leave out the Mesh Color Texture rows.
-    #[arg(long)]
-    pub(super) no_mct: bool,
-    /// The representations measured (comma-separated: mesh-colors, mct, htex; default all
-    /// three; mesh colors are always measured, --no-mct removes mct).
+    /// The representations measured (comma-separated: mesh-colors, mct, ptex, htex; default
+    /// all four; mesh colors are always measured).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub(super) representation: Vec<super::args::Representation>,
+    /// Leave out the Mesh Color Texture rows (removes mct from --representation).
+    #[arg(long)]
+    pub(super) no_mct: bool,
+    /// Leave out the packed Ptex rows (removes ptex from --representation).
+    #[arg(long)]
+    pub(super) no_ptex: bool,
 }
 
 impl TradeArgs {
@@ -280,6 +286,7 @@ impl TradeArgs {
             uniform: (0..=max_uniform.log2()).filter_map(|l| Resolution::from_log2(l).ok()).collect(),
             formats: if self.formats.is_empty() { ColorFormat::ALL.to_vec() } else { self.formats.clone() },
             mct: !self.no_mct && self.wants(super::args::Representation::Mct),
+            ptex: !self.no_ptex && self.wants(super::args::Representation::Ptex),
             htex: self.wants(super::args::Representation::Htex),
             frames: self.frames,
             error_bounds: self.errors.clone(),
@@ -309,8 +316,16 @@ pub(super) fn run(what: BenchCommand) -> Result<()> {
             Ok(())
         }
         BenchCommand::Trade(args) => trade(&args),
-        BenchCommand::Adaptive { file, max_resolution, size, views, supersample, bake, rules } => {
-            adaptive(file, max_resolution, size, views, supersample, bake, rules)
+        BenchCommand::Adaptive { file, max_resolution, size, views, supersample, bake, rules, close_up } => {
+            let options = meshpaint::bench::adaptive::AdaptiveOptions {
+                budget_max: None,
+                size,
+                views,
+                supersample,
+                fits: bake.iter().map(|&b| b.into()).collect(),
+                close_up: close_up.get()?,
+            };
+            adaptive(file, max_resolution, options, rules)
         }
         BenchCommand::Pack { file, resolution, format, runs, subdivide, stroke_samples } => {
             pack(file, resolution, format, runs, subdivide, stroke_samples)
@@ -369,10 +384,8 @@ fn unwrap(file: &std::path::Path, size: u32, subdivide: u32) -> Result<()> {
 fn trade(args: &TradeArgs) -> Result<()> {
     let options = args.options()?;
     let file = &args.file;
-    let rows = meshpaint::bench::trade::bench_trade(file, &options)?;
-    for row in &rows {
-        println!("{row}");
-    }
+    // One line per row as soon as its view is measured.
+    let rows = meshpaint::bench::trade::bench_trade_streaming(file, &options, &mut |row| println!("{row}"))?;
     if !args.no_extremes {
         let gpu = meshpaint_render::Gpu::new_headless()?;
         for mut row in meshpaint::bench::extremes::extremes_rows(&gpu)? {
@@ -394,10 +407,7 @@ fn trade(args: &TradeArgs) -> Result<()> {
 fn adaptive(
     file: PathBuf,
     max_resolution: u64,
-    size: u32,
-    views: u32,
-    supersample: u32,
-    bake: Vec<BakeArg>,
+    mut options: meshpaint::bench::adaptive::AdaptiveOptions,
     rules: Vec<String>,
 ) -> Result<()> {
     let max = meshpaint_core::colors::layout::Resolution::new(max_resolution).context("--max-resolution")?;
@@ -406,14 +416,8 @@ fn adaptive(
         .map(|rule| meshpaint::bench::adaptive::parse_rule(rule, max).map_err(|err| anyhow::anyhow!("--rules {err}")))
         .collect::<Result<Vec<_>>>()?;
     let scene = meshpaint_core::mesh::import::import_gltf(&file)?;
-    let fits: Vec<BakeFit> = bake.iter().map(|&b| b.into()).collect();
-    let options = meshpaint::bench::adaptive::AdaptiveOptions {
-        budget_max: chosen.is_empty().then_some(max),
-        size,
-        views,
-        supersample,
-        fits: fits.clone(),
-    };
+    options.budget_max = chosen.is_empty().then_some(max);
+    let fits = options.fits.clone();
     // One line per row as soon as it is measured: a large asset takes minutes per row.
     let mut print_row = |row: &meshpaint::bench::adaptive::AdaptiveRow| {
         let mut value = row.to_json();
@@ -432,6 +436,42 @@ fn adaptive(
         println!("{summary}");
     }
     Ok(())
+}
+
+// `--look-at X,Y,Z --distance D [--yaw --pitch]` of `bench adaptive`: one close-up view.
+#[derive(Debug, Clone, clap::Args)]
+pub(super) struct CloseUpArgs {
+    /// Measure one close-up view looking at this point (world X,Y,Z; e.g. a region's `center`
+    /// printed by `meshpaint synth`) instead of --views cameras around the model.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true, requires = "distance")]
+    look_at: Option<Vec<f64>>,
+    /// Eye distance from --look-at.
+    #[arg(long)]
+    distance: Option<f64>,
+    /// Yaw of the close-up, degrees (0: the eye on +Z looking along −Z).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    yaw: f64,
+    /// Pitch of the close-up, degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pitch: f64,
+}
+
+impl CloseUpArgs {
+    fn get(&self) -> Result<Option<meshpaint::bench::adaptive::CloseUp>> {
+        let Some(target) = &self.look_at else { return Ok(None) };
+        let distance = self.distance.unwrap_or(0.0);
+        anyhow::ensure!(distance.is_finite() && distance > 0.0, "--distance must be a positive number");
+        anyhow::ensure!(
+            target.len() == 3 && target.iter().all(|v| v.is_finite()),
+            "--look-at takes three finite numbers X,Y,Z"
+        );
+        Ok(Some(meshpaint::bench::adaptive::CloseUp {
+            target: [target[0], target[1], target[2]],
+            distance,
+            yaw_degrees: self.yaw,
+            pitch_degrees: self.pitch,
+        }))
+    }
 }
 
 /// `bench pack`: the full repack, the incremental repack after a stroke and the relayout after a resolution stroke, per format.

@@ -110,8 +110,10 @@ pub(super) fn run(args: ConvertArgs) -> Result<()> {
                 line["samples"] = report.samples.into();
                 line["samples_with_mips"] = report.samples_with_mips.into();
                 line["bytes"] = report.bytes.into();
-                // The PSNR against the UV render, once the conversion reports one (issue 42).
-                line["psnr_db"] = serde_json::Value::Null;
+                // Against the texture over the textured surface (null without a texture or
+                // when lossless: JSON has no infinity).
+                line["psnr_db"] = report.texture_psnr_db.filter(|db| db.is_finite()).into();
+                line["faces_held_by_budget"] = report.faces_held_by_budget.into();
             }
             Err(error) => {
                 failed += 1;
@@ -141,6 +143,8 @@ struct Report {
     samples: u64,
     samples_with_mips: u64,
     bytes: u64,
+    texture_psnr_db: Option<f64>,
+    faces_held_by_budget: u64,
 }
 
 fn convert_one(
@@ -162,9 +166,9 @@ fn convert_one(
         let document = open_with(&input, resolution, &budget(format), reporter.progress())?;
         let format = packed_format(format, document.source);
         let packed = document.pack(format).with_context(|| format!("packing {}", input.display()))?;
-        Ok((document.store.sample_count(), packed))
+        Ok((document.store.sample_count(), packed, document.conversion))
     }));
-    let (samples, packed) = match opened {
+    let (samples, packed, conversion) = match opened {
         Ok(result) => result?,
         Err(panic) => anyhow::bail!("the conversion panicked: {}", panic_text(&panic)),
     };
@@ -181,6 +185,8 @@ fn convert_one(
         samples,
         samples_with_mips: packed.sample_count(),
         bytes,
+        texture_psnr_db: conversion.as_ref().and_then(|c| c.texture_psnr_db),
+        faces_held_by_budget: conversion.map_or(0, |c| c.faces_held_by_budget),
     }))
 }
 

@@ -49,8 +49,10 @@ pub(super) struct ExportArgs {
     /// default with --level / --max-vertices), float, u16 or u8.
     #[arg(long, value_enum, conflicts_with = "texture")]
     colors: Option<ColorsArg>,
-    /// What a non-.glb OUT holds: mesh-colors (a packed file) or mct (a Mesh Color Texture
-    /// file: mesh, face records, band table and one atlas in --format; docs/MCT_FORMAT.md).
+    /// What a non-.glb OUT holds: mesh-colors (a packed file), mct (a Mesh Color Texture
+    /// file: mesh, face records, band table and one atlas in --format; docs/MCT_FORMAT.md) or
+    /// ptex (a packed Ptex file: mesh, face records, nRes/nRow tables and one texture;
+    /// docs/PTEX_FORMAT.md); htex has no file yet (render it).
     #[arg(
         long,
         value_enum,
@@ -79,6 +81,9 @@ pub(super) fn run(args: ExportArgs) -> Result<()> {
         anyhow::bail!(
             "--representation htex has no file format yet: render it with `meshpaint render --representation htex`"
         );
+    }
+    if args.representation == Representation::Ptex {
+        return export_ptex(&args);
     }
     if let Some(size) = args.texture {
         return export_texture(&args, size);
@@ -149,6 +154,36 @@ fn export_mct(args: &ExportArgs) -> Result<()> {
         texture.layout.levels,
         texture.gpu_bytes(),
         texture.stats.clamped_ring_texels
+    );
+    Ok(())
+}
+
+/// `--representation ptex`: the packed Ptex file (docs/PTEX_FORMAT.md), built as for
+/// `--representation mct`.
+fn export_ptex(args: &ExportArgs) -> Result<()> {
+    let (path, out) = (&args.file, &args.output.output);
+    let extension = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if matches!(extension.as_deref(), Some("glb" | "gltf")) {
+        anyhow::bail!("{}: --representation ptex writes a packed Ptex file; name it e.g. OUT.ptx", out.display());
+    }
+    let format = args.format.unwrap_or_default();
+    let budget = budget(Some(format));
+    let document = open(path, args.resolution, &budget)?;
+    let packed = document.pack(format).with_context(|| format!("packing {}", path.display()))?;
+    let texture = meshpaint_core::ptex::build(&packed, ATLAS_MAX_WIDTH as u32, budget.memory_bytes)
+        .with_context(|| format!("building the packed Ptex of {}", path.display()))?;
+    meshpaint_core::ptex::file::write_ptex(out, &packed.positions, &packed.indices, &texture)?;
+    eprintln!(
+        "{} → {}: {} faces, {} blocks, {}×{} texture in {}, {} levels, {} GPU bytes",
+        path.display(),
+        out.display(),
+        texture.layout.records.len(),
+        texture.layout.blocks.len(),
+        texture.layout.width,
+        texture.layout.height,
+        format.name(),
+        texture.layout.levels,
+        texture.gpu_bytes()
     );
     Ok(())
 }

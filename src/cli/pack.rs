@@ -41,5 +41,8 @@ pub(super) fn run(args: PackArgs) -> Result<()> {
         packed.color_bytes(),
         format.name()
     );
+    if let Some(conversion) = &document.conversion {
+        eprintln!("{}: {}", path.display(), conversion.summary());
+    }
     Ok(())
 }

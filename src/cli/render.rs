@@ -12,7 +12,7 @@ use meshpaint_core::packing::lod::VertexLod;
 use meshpaint_core::progress::Reporter;
 use meshpaint_render::{DrawItem, FilterMode, Gpu, MeshGeometry, Overlays, RenderSettings, Shading};
 
-use super::args::{CameraArgs, LOG_TARGET, Representation, ResolutionArg, is_mct_file};
+use super::args::{CameraArgs, LOG_TARGET, Representation, ResolutionArg, is_mct_file, is_ptex_file};
 
 /// Arguments of `meshpaint render`.
 #[derive(Debug, clap::Args)]
@@ -57,9 +57,10 @@ pub(super) struct RenderArgs {
     #[arg(long, conflicts_with = "baseline_uv")]
     position_colors: bool,
     /// mesh-colors (software filter in the shader), mct (Mesh Color Textures: the same
-    /// colours in a 2D atlas filtered by the GPU's sampler; docs/MCT.md) or htex (one texture
-    /// per edge, three hardware fetches; docs/HTEX.md). Nearest filters draw bilinear with
-    /// mct and htex.
+    /// colours in a 2D atlas filtered by the GPU's sampler; docs/MCT.md), ptex (packed Ptex:
+    /// per-pair square blocks with borders, hardware bilinear; docs/PTEX.md) or htex (one
+    /// texture per edge, three hardware fetches; docs/HTEX.md). Nearest filters draw bilinear
+    /// with mct, ptex and htex; anisotropic draws trilinear with ptex and htex.
     #[arg(long, value_enum, default_value_t = Representation::MeshColors, conflicts_with = "baseline_uv")]
     representation: Representation,
 }
@@ -125,6 +126,44 @@ fn htex_image(
     Ok(gpu.render_image(DrawItem::Htex(&htex), settings, args.width, args.height)?)
 }
 
+/// `--representation ptex`: the packed Ptex of `packed` (the packed mesh of `mesh`) within
+/// `max_bytes`, drawn with `settings`.
+fn ptex_image(
+    gpu: &Gpu,
+    packed: &meshpaint_core::packing::linear::PackedMesh,
+    mesh: &meshpaint_render::GpuMesh,
+    max_bytes: u64,
+    settings: &RenderSettings,
+    args: &RenderArgs,
+) -> Result<image::RgbaImage> {
+    let max_dimension = gpu.ctx.limits().max_texture_dimension_2d;
+    let texture = meshpaint_core::ptex::build(packed, max_dimension, max_bytes)
+        .with_context(|| format!("{}: building the packed Ptex", args.file.display()))?;
+    let ptex = gpu.upload_ptex(&mesh.geometry(), &texture)?;
+    Ok(gpu.render_image(DrawItem::Ptex(&ptex), settings, args.width, args.height)?)
+}
+
+/// A packed Ptex file (docs/PTEX_FORMAT.md) drawn as the texture it holds: the image and
+/// its face count.
+fn render_ptex_file(
+    args: &RenderArgs,
+    gpu: &Gpu,
+    settings: &dyn Fn(meshpaint_core::camera::BoundingSphere) -> RenderSettings,
+) -> Result<(image::RgbaImage, u32, u64)> {
+    anyhow::ensure!(
+        !args.baseline_uv && !args.position_colors,
+        "{}: a packed Ptex file holds its texture only (no --baseline-uv, no --position-colors)",
+        args.file.display()
+    );
+    let file = meshpaint_core::ptex::file::read_ptex(&args.file)?;
+    let lod = VertexLod::with_density(&file.positions, &file.indices, file.ptex.vertex_density.clone());
+    let (geometry, bounds) = MeshGeometry::upload(&gpu.ctx, &file.positions, &file.indices, &lod)
+        .with_context(|| format!("{}: uploading its mesh", args.file.display()))?;
+    let ptex = gpu.upload_ptex(&geometry, &file.ptex).with_context(|| format!("{}", args.file.display()))?;
+    let image = gpu.render_image(DrawItem::Ptex(&ptex), &settings(bounds), args.width, args.height)?;
+    Ok((image, geometry.face_count, 0))
+}
+
 pub(super) fn run(args: RenderArgs) -> Result<()> {
     let filter = filter_mode(args.filter, args.level)?;
     args.camera.check()?;
@@ -156,6 +195,8 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
         let mct = gpu.upload_mct(&geometry, &file.mct).with_context(|| format!("{}", args.file.display()))?;
         let image = gpu.render_image(DrawItem::Mct(&mct), &settings(bounds), args.width, args.height)?;
         (image, geometry.face_count, 0)
+    } else if is_ptex_file(&args.file)? {
+        render_ptex_file(&args, &gpu, &settings)?
     } else if args.baseline_uv {
         let (scene, _) = meshpaint_core::io::document::import_scene_within(&args.file, &budget)?;
         let mesh = gpu.upload_baseline(&scene)?.with_context(|| {
@@ -201,6 +242,10 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
             Representation::Htex => {
                 let packed = shown.pack(document.display_format())?;
                 htex_image(&gpu, &packed, &mesh, budget.memory_bytes, &settings(mesh.bounds), &args)?
+            }
+            Representation::Ptex => {
+                let packed = shown.pack(document.display_format())?;
+                ptex_image(&gpu, &packed, &mesh, budget.memory_bytes, &settings(mesh.bounds), &args)?
             }
         };
         (image, mesh.face_count, mesh.atlas.samples)

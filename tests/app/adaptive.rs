@@ -237,6 +237,7 @@ fn a_third_of_uniform_r4_samples_by_budget_beats_uniform_r4_on_the_fox_in_the_re
         views: 3,
         supersample: ADAPTIVE_SUPERSAMPLE,
         fits: vec![BakeFit::LeastSquares],
+        close_up: None,
     };
     let mut streamed = Vec::new();
     let rows =

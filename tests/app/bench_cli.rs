@@ -148,6 +148,10 @@ fn bench_render_reports_every_mode_against_the_baseline() {
     assert!(report["htex_textures"].as_u64().unwrap() > report["htex_faces"].as_u64().unwrap(), "{report}");
     let jumps = report["htex_jumps"].as_array().unwrap();
     assert!(jumps.iter().any(|j| j["corners_equalized"] == false), "{report}");
+    for mode in ["ptex-linear", "ptex-mip-1", "ptex-trilinear"] {
+        assert!(modes.iter().any(|m| m["mode"] == mode && m["representation"] == "ptex"), "{mode}: {report}");
+    }
+    assert!(report["ptex_build_ms"].as_f64().unwrap() > 0.0, "{report}");
 }
 
 #[test]

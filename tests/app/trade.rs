@@ -47,13 +47,14 @@ fn bench_trade_on_box_textured_prints_complete_rows_and_writes_plots() {
     let representation = |r: &str| configs.iter().copied().filter(|row| row["representation"] == r).collect::<Vec<_>>();
     // (R = 1, 2, 4 and two bounds) × 3 formats × 5 filters × 4 views.
     assert_eq!(representation("mesh-colors").len(), 5 * 3 * 5 * views);
-    // The same packs as MCT × 4 filters (no nearest), less any format whose MCT was skipped.
+    // The same packs as MCT, as packed Ptex and as Htex × 4 filters each (no nearest), less
+    // any format whose MCT, Ptex or Htex was skipped.
     let skipped = kind("skipped");
-    let mct_skipped = skipped.iter().filter(|row| row["representation"] == "mct").count();
-    assert_eq!(representation("mct").len() + mct_skipped * 4 * views, 5 * 3 * 4 * views, "{skipped:?}");
-    let htex_skipped = skipped.iter().filter(|row| row["representation"] == "htex").count();
-    assert_eq!(representation("htex").len() + htex_skipped * 4 * views, 5 * 3 * 4 * views, "{skipped:?}");
-    let all = ["mesh-colors", "mct", "htex"].map(|r| representation(r).len());
+    for r in ["mct", "ptex", "htex"] {
+        let skipped_here = skipped.iter().filter(|row| row["representation"] == r).count();
+        assert_eq!(representation(r).len() + skipped_here * 4 * views, 5 * 3 * 4 * views, "{r}: {skipped:?}");
+    }
+    let all = ["mesh-colors", "mct", "ptex", "htex"].map(|r| representation(r).len());
     assert_eq!(all.iter().sum::<usize>(), configs.len());
     for row in representation("htex") {
         for key in ["gpu_bytes", "htex_bytes", "htex_build_seconds", "htex_textures", "htex_e_over_f", "frame_ratio"] {
@@ -63,6 +64,17 @@ fn bench_trade_on_box_textured_prints_complete_rows_and_writes_plots() {
         assert!(number(row, "htex_bytes") > number(row, "htex_inside_texel_bytes"), "borders and tables: {row}");
     }
     assert!(kind("seam").iter().any(|row| row["representation"] == "htex"), "Htex seam rows");
+    for row in representation("ptex") {
+        assert!(["linear", "mip-1", "mip-2", "trilinear"].contains(&row["filter"].as_str().unwrap()), "{row}");
+        for key in ["gpu_bytes", "ptex_bytes", "ptex_bytes_over_mesh_colors", "ptex_build_seconds", "frame_ratio"] {
+            let value = number(row, key);
+            assert!(value.is_finite() && value > 0.0, "{key} = {value} in {row}");
+        }
+        assert!(number(row, "gpu_bytes") > number(row, "ptex_bytes"), "geometry counted too: {row}");
+        assert!(number(row, "ptex_border_over_interior") > 0.0, "{row}");
+    }
+    let ptex_seams = kind("seam").into_iter().filter(|row| row["representation"] == "ptex").count();
+    assert!(ptex_seams > 0, "packed Ptex seam rows");
     assert!(kind("baseline").iter().all(|row| row["representation"] == "uv-texture"));
     for row in representation("mct") {
         assert!(["linear", "mip-1", "mip-2", "trilinear"].contains(&row["filter"].as_str().unwrap()), "{row}");
@@ -229,7 +241,15 @@ fn bench_trade_mct_linear_is_close_to_mesh_colors_linear() {
         dabs: 1,
         ..Default::default()
     };
-    let rows = meshpaint::bench::trade::bench_trade(&common::model("BoxTextured/BoxTextured.glb"), &options).unwrap();
+    let mut streamed = Vec::new();
+    let rows = meshpaint::bench::trade::bench_trade_streaming(
+        &common::model("BoxTextured/BoxTextured.glb"),
+        &options,
+        &mut |row| streamed.push(row.clone()),
+    )
+    .unwrap();
+    // Every row reached the caller as it was measured (the CLI prints it then), in order.
+    assert_eq!(streamed, rows);
     let config = |representation: &str, filter: &str, view: &str| {
         rows.iter()
             .find(|r| {

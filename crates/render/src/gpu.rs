@@ -9,7 +9,7 @@ use image::RgbaImage;
 use super::{
     BaselineMesh, BaselineSource, DrawItem, GpuContext, GpuMesh, MeshUploadOptions, OFFSCREEN_FORMAT, RenderError,
 };
-use super::{GpuMct, MeshGeometry, RenderSettings, Renderer};
+use super::{GpuMct, GpuPtex, MeshGeometry, RenderSettings, Renderer};
 use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::colors::store::ColorStore;
 use meshpaint_core::mct::MeshColorTexture;
@@ -17,6 +17,7 @@ use meshpaint_core::mesh::scene::Scene;
 use meshpaint_core::mesh::weld::weld_scene;
 use meshpaint_core::packing::linear::PackedMesh;
 use meshpaint_core::packing::paint_layout::{EncodedBuffer, PaintLayout};
+use meshpaint_core::ptex::PackedPtex;
 
 /// A paint layout's buffers on the GPU ([`Gpu::upload_paint_layout`]).
 #[derive(Debug)]
@@ -69,6 +70,12 @@ impl Gpu {
         htex: &meshpaint_core::htex::HtexTexture,
     ) -> Result<super::GpuHtex, RenderError> {
         super::GpuHtex::upload(&self.ctx, self.renderer.layouts(), geometry, htex)
+    }
+
+    /// Uploads the packed Ptex `ptex`, built from the packed mesh whose GPU mesh has the
+    /// geometry `geometry` ([`GpuMesh::geometry`]).
+    pub fn upload_ptex(&self, geometry: &MeshGeometry, ptex: &PackedPtex) -> Result<GpuPtex, RenderError> {
+        GpuPtex::upload(&self.ctx, self.renderer.layouts(), geometry, ptex)
     }
 
     /// Puts `store` on the GPU in its paint `layout`, encoded in `format` (the one path of

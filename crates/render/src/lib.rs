@@ -43,6 +43,7 @@ mod layouts;
 mod mct;
 mod mesh_gpu;
 mod partial;
+mod ptex;
 mod readback;
 mod renderer;
 mod uniforms;
@@ -56,10 +57,11 @@ pub use layouts::BindLayouts;
 pub use mct::GpuMct;
 pub use mesh_gpu::{AtlasLayout, GpuMesh, MeshGeometry, MeshUploadOptions, atlas_texture_format, default_atlas_width};
 pub use partial::{FaceSubset, Scissor};
+pub use ptex::{GpuPtex, GpuPtexSlice, gpu_tables};
 pub use readback::read_texture;
 pub use renderer::{
-    DrawItem, FRAME_WGSL, FilterMode, HTEX_WGSL, MCT_WGSL, MESH_COLORS_WGSL, Overlays, RenderSettings, RenderTarget,
-    Renderer, Shading, UV_BASELINE_WGSL,
+    DrawItem, FRAME_WGSL, FilterMode, HTEX_WGSL, MCT_WGSL, MESH_COLORS_WGSL, Overlays, PTEX_WGSL, RenderSettings,
+    RenderTarget, Renderer, Shading, UV_BASELINE_WGSL,
 };
 pub use uniforms::FrameUniforms;
 

@@ -7,7 +7,7 @@ use image::RgbaImage;
 
 use super::layouts::BindLayouts;
 use super::uniforms::FrameUniforms;
-use super::{BaselineMesh, BaselineVertex, DEPTH_FORMAT, GpuContext, GpuMct, GpuMesh, RenderError};
+use super::{BaselineMesh, BaselineVertex, DEPTH_FORMAT, GpuContext, GpuMct, GpuMesh, GpuPtex, RenderError};
 use meshpaint_core::camera::OrbitCamera;
 use meshpaint_core::colors::format::Rgba;
 
@@ -41,6 +41,15 @@ pub const HTEX_WGSL: &str = concat!(
     include_str!("../shaders/mesh_common.wgsl"),
     "\n",
     include_str!("../shaders/htex.wgsl")
+);
+/// The packed Ptex shader exactly as its pipelines compile it: shaders/frame.wgsl,
+/// shaders/mesh_common.wgsl and shaders/ptex.wgsl (crates/render/tests/gpu/shaders.rs validates it).
+pub const PTEX_WGSL: &str = concat!(
+    include_str!("../shaders/frame.wgsl"),
+    "\n",
+    include_str!("../shaders/mesh_common.wgsl"),
+    "\n",
+    include_str!("../shaders/ptex.wgsl")
 );
 /// The UV-baseline shader exactly as its pipeline compiles it: shaders/frame.wgsl followed
 /// by shaders/uv_baseline.wgsl (crates/render/tests/gpu/shaders.rs validates this very string).
@@ -171,6 +180,9 @@ pub enum DrawItem<'a> {
     /// An Htex through the Htex pipeline (three bilinear fetches per level; nearest filter
     /// modes draw bilinear, anisotropic draws trilinear).
     Htex(&'a super::GpuHtex),
+    /// A packed Ptex through the Ptex pipeline (hardware bilinear; nearest filter modes
+    /// draw bilinear, anisotropic draws trilinear).
+    Ptex(&'a GpuPtex),
 }
 
 impl DrawItem<'_> {
@@ -181,6 +193,7 @@ impl DrawItem<'_> {
             DrawItem::Baseline(mesh) => mesh.origin,
             DrawItem::Mct(mct) => mct.origin,
             DrawItem::Htex(htex) => htex.origin,
+            DrawItem::Ptex(ptex) => ptex.origin,
         }
     }
 }
@@ -217,7 +230,14 @@ pub struct Renderer {
     mct_module: wgpu::ShaderModule,
     mct_pipelines: [OnceLock<wgpu::RenderPipeline>; MCT_PIPELINES],
     htex: HtexPipelines,
+    /// The packed Ptex shader and its pipelines, one per `LEVEL_MODE` (fixed, automatic) and
+    /// set of [`MCT_FLAG_BITS`], each built the first time it draws.
+    ptex_module: wgpu::ShaderModule,
+    ptex_pipelines: [OnceLock<wgpu::RenderPipeline>; PTEX_PIPELINES],
 }
+
+/// Ptex pipelines: `LEVEL_MODE` fixed or automatic, times every set of [`MCT_FLAG_BITS`].
+const PTEX_PIPELINES: usize = 2 * (MCT_FLAG_BITS as usize + 1);
 
 /// The `FLAG_*` bits the MCT shader is specialised for (its pipeline-overridable constant
 /// `MCT_FLAGS`), so that lighting and overlays that are off cost nothing: a software
@@ -329,6 +349,7 @@ impl Renderer {
             (color_format, FULL_DEPTH),
         );
         let mct_module = Self::module(ctx, "mesh color textures", MCT_WGSL);
+        let ptex_module = Self::module(ctx, "packed ptex", PTEX_WGSL);
         let renderer = Renderer {
             color_format,
             layouts,
@@ -339,10 +360,13 @@ impl Renderer {
             mct_module,
             mct_pipelines: std::array::from_fn(|_| OnceLock::new()),
             htex: HtexPipelines::new(ctx),
+            ptex_module,
+            ptex_pipelines: std::array::from_fn(|_| OnceLock::new()),
         };
         // The unlit ones now, so that shader errors surface here.
         for level_mode in [FrameUniforms::LEVEL_FIXED, FrameUniforms::LEVEL_AUTO] {
             renderer.mct_pipeline(ctx, level_mode, 0);
+            renderer.ptex_pipeline(ctx, level_mode, 0);
         }
         renderer
     }
@@ -356,6 +380,19 @@ impl Renderer {
             let label = format!("mesh color textures (level mode {level_mode}, flags {flags})");
             let target = (self.color_format, FULL_DEPTH);
             Self::pipeline(ctx, &label, &self.mct_module, &constants, self.layouts.mct(), &[], target)
+        })
+    }
+
+    /// The packed Ptex pipeline for `level_mode` (fixed or automatic) and `flags`, built on
+    /// first use.
+    fn ptex_pipeline(&self, ctx: &GpuContext, level_mode: u32, flags: u32) -> &wgpu::RenderPipeline {
+        let flags = flags & MCT_FLAG_BITS;
+        let level_mode = u32::from(level_mode != FrameUniforms::LEVEL_FIXED);
+        self.ptex_pipelines[level_mode as usize * (MCT_FLAG_BITS as usize + 1) + flags as usize].get_or_init(|| {
+            let constants = [("LEVEL_MODE", f64::from(level_mode)), ("PTEX_FLAGS", f64::from(flags))];
+            let label = format!("packed ptex (level mode {level_mode}, flags {flags})");
+            let target = (self.color_format, FULL_DEPTH);
+            Self::pipeline(ctx, &label, &self.ptex_module, &constants, self.layouts.mct(), &[], target)
         })
     }
 
@@ -503,6 +540,11 @@ impl Renderer {
                 uniforms.face_count = htex.face_count;
                 uniforms.vertex_count = htex.vertex_count;
             }
+            DrawItem::Ptex(ptex) => {
+                uniforms.vertex_levels = ptex.levels.max(1);
+                uniforms.face_count = ptex.face_count;
+                uniforms.vertex_count = ptex.vertex_count;
+            }
         }
         uniforms
     }
@@ -534,6 +576,7 @@ impl Renderer {
                 let target = (self.color_format, FULL_DEPTH);
                 (&htex.uniforms, self.htex.get(ctx, &self.layouts, target, uniforms.level_mode, uniforms.flags))
             }
+            DrawItem::Ptex(ptex) => (&ptex.uniforms, self.ptex_pipeline(ctx, uniforms.level_mode, uniforms.flags)),
         };
         ctx.queue.write_buffer(uniform_buffer, 0, bytemuck::bytes_of(&uniforms));
         let [r, g, b, a] = settings.background.map(f64::from);
@@ -576,6 +619,13 @@ impl Renderer {
             DrawItem::Htex(htex) => {
                 pass.set_bind_group(0, &htex.bind_group, &[]);
                 let vertex_count = htex.face_count.saturating_mul(3);
+                if vertex_count > 0 {
+                    pass.draw(0..vertex_count, 0..1);
+                }
+            }
+            DrawItem::Ptex(ptex) => {
+                pass.set_bind_group(0, &ptex.bind_group, &[]);
+                let vertex_count = ptex.face_count.saturating_mul(3);
                 if vertex_count > 0 {
                     pass.draw(0..vertex_count, 0..1);
                 }

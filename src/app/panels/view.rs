@@ -192,14 +192,19 @@ impl ViewPanel {
                 .labelled_by(label.id)
                 .on_hover_text(
                     "T — how the GPU draws the painted colours: mesh colors filtered in the shader (exact), \
-                     Mesh Color Textures (one 2D atlas the GPU's own sampler filters) or Htex (one texture per \
-                     edge, three hardware fetches)",
+                     Mesh Color Textures (one 2D atlas the GPU's own sampler filters), packed Ptex \
+                     (per-pair blocks with borders, the GPU's sampler too) or Htex (one texture per edge, three \
+                     hardware fetches)",
                 );
         });
         let Some(open) = ctx.document else {
             return;
         };
         if view.representation == Representation::MeshColors || view.shown != Shown::MeshColors {
+            return;
+        }
+        if view.representation == Representation::PackedPtex {
+            ptex_status(ui, open, ctx.level0_only);
             return;
         }
         if ctx.level0_only {
@@ -264,6 +269,33 @@ fn htex_ui(ui: &mut egui::Ui, open: &OpenDocument) {
                 ))
                 .weak(),
             );
+        }
+    }
+}
+
+/// The packed Ptex's state under the representation choice: building, why it cannot be
+/// shown, or its size and cost.
+fn ptex_status(ui: &mut egui::Ui, open: &OpenDocument, level0_only: bool) {
+    if level0_only {
+        ui.label(egui::RichText::new("Paint mode draws mesh colors; the texture follows when it ends").weak());
+        return;
+    }
+    match open.current_ptex() {
+        None => {
+            ui.label(egui::RichText::new("Building the packed Ptex…").weak());
+        }
+        Some(Err(message)) => {
+            ui.colored_label(ui.visuals().warn_fg_color, format!("Showing the mesh colors: {message}"));
+        }
+        Some(Ok(built)) => {
+            let [w, h] = built.ptex.size;
+            let text = format!(
+                "Texture {w} × {h}: {} ({:.2}× the mesh colors' buffers), built in {:.0} ms",
+                human_bytes(built.ptex.gpu_bytes()),
+                built.bytes_over_mesh_colors,
+                built.build.as_secs_f64() * 1000.0
+            );
+            ui.label(egui::RichText::new(text).weak());
         }
     }
 }

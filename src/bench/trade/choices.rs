@@ -17,7 +17,8 @@ use meshpaint_core::io::document::Document;
 use meshpaint_core::mct::MeshColorTexture;
 use meshpaint_core::mesh::scene::Scene;
 use meshpaint_core::packing::linear::PackedMesh;
-use meshpaint_render::{Gpu, GpuMct, GpuMesh};
+use meshpaint_core::ptex::PackedPtex;
+use meshpaint_render::{Gpu, GpuMct, GpuMesh, GpuPtex};
 
 /// One resolution choice: a document, its JSON label, and the meshes packed from it.
 pub(super) struct Choice {
@@ -44,12 +45,22 @@ pub(super) struct Packed {
     pub(super) mct: Result<MctPack, String>,
     /// The Htex built from `packed`, or why it could not be built or uploaded.
     pub(super) htex: Result<HtexPack, String>,
+    /// The packed Ptex built from `packed`, or why it could not be built or uploaded.
+    pub(super) ptex: Result<PtexPack, String>,
 }
 
 /// An Htex of one pack, on the CPU (for the seam evaluation) and the GPU.
 pub(super) struct HtexPack {
     pub(super) texture: meshpaint_core::htex::HtexTexture,
     pub(super) gpu: meshpaint_render::GpuHtex,
+    /// Best of three builds from the packed buffers.
+    pub(super) build_seconds: f64,
+}
+
+/// A packed Ptex of one pack, on the CPU (for the seam evaluation) and the GPU.
+pub(super) struct PtexPack {
+    pub(super) texture: PackedPtex,
+    pub(super) gpu: GpuPtex,
     /// Best of three builds from the packed buffers.
     pub(super) build_seconds: f64,
 }
@@ -132,7 +143,9 @@ pub(super) fn prepare(
             let mesh = gpu.upload(&packed)?;
             let mct = if options.mct { build_mct(gpu, &packed, &mesh) } else { Err("not asked (--no-mct)".into()) };
             let htex = if options.htex { build_htex(gpu, &packed, &mesh) } else { Err("not asked".into()) };
-            choice.packs.push(Packed { format, packed, mesh, pack_seconds: timing.best_seconds, mct, htex });
+            let ptex = if options.ptex { build_ptex(gpu, &packed, &mesh) } else { Err("not asked (--no-ptex)".into()) };
+            let pack_seconds = timing.best_seconds;
+            choice.packs.push(Packed { format, packed, mesh, pack_seconds, mct, htex, ptex });
         }
         if !textured {
             choice.reference = Some(gpu.upload(&choice.document.pack(ColorFormat::Rgba32F)?)?);
@@ -169,6 +182,16 @@ fn build_htex(gpu: &Gpu, packed: &PackedMesh, mesh: &GpuMesh) -> Result<HtexPack
     let texture = texture.map_err(|e| e.to_string())?;
     let gpu_htex = gpu.upload_htex(&mesh.geometry(), &texture).map_err(|e| e.to_string())?;
     Ok(HtexPack { texture, gpu: gpu_htex, build_seconds: timing.best_seconds })
+}
+
+/// The packed Ptex of `packed` (best of three builds, sides up to the device's largest
+/// texture) uploaded with `mesh`'s geometry, or why not.
+fn build_ptex(gpu: &Gpu, packed: &PackedMesh, mesh: &GpuMesh) -> Result<PtexPack, String> {
+    let max_dimension = gpu.ctx.limits().max_texture_dimension_2d;
+    let (timing, texture) = Timing::measure(3, || meshpaint_core::ptex::build(packed, max_dimension, u64::MAX));
+    let texture = texture.map_err(|e| e.to_string())?;
+    let gpu_ptex = gpu.upload_ptex(&mesh.geometry(), &texture).map_err(|e| e.to_string())?;
+    Ok(PtexPack { texture, gpu: gpu_ptex, build_seconds: timing.best_seconds })
 }
 
 /// The `resolution` of a document: its R when uniform, else `"R a..b"`.

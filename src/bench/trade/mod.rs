@@ -92,8 +92,8 @@ pub use crate::bench::plot::pareto_front;
 pub use bvh::brute_force;
 pub use metrics::{ImageError, compare};
 pub use points::{plot_points, write_plots};
-pub use run::bench_trade;
-pub use seams::{SeamEdges, SeamJump, mct_seam_jumps, seam_jumps, seam_jumps_over};
+pub use run::{bench_trade, bench_trade_streaming};
+pub use seams::{SeamEdges, SeamJump, mct_seam_jumps, ptex_seam_jumps, seam_jumps, seam_jumps_over};
 
 use meshpaint_core::colors::format::ColorFormat;
 use meshpaint_core::colors::layout::Resolution;
@@ -118,6 +118,8 @@ pub struct TradeOptions {
     pub mct: bool,
     /// Whether Htex rows are measured beside mesh colors.
     pub htex: bool,
+    /// Whether packed Ptex rows are measured beside mesh colors.
+    pub ptex: bool,
     /// Interleaved timing rounds per view (the median frame is reported).
     pub frames: usize,
     /// Dabs per throughput measurement.
@@ -135,6 +137,7 @@ impl Default for TradeOptions {
             formats: ColorFormat::ALL.to_vec(),
             mct: true,
             htex: true,
+            ptex: true,
             frames: 5,
             dabs: 10,
         }

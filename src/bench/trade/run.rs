@@ -6,7 +6,7 @@ use std::time::Instant;
 use super::bvh::bvh_rows;
 use super::choices::{Choice, prepare, resolution_choices};
 use super::metrics::merge;
-use super::seams::{SeamEdges, SeamJump, htex_seam_jumps, mct_seam_jumps, seam_jumps_over};
+use super::seams::{SeamEdges, SeamJump, htex_seam_jumps, mct_seam_jumps, ptex_seam_jumps, seam_jumps_over};
 use super::study::{Study, views};
 use super::{DISTANCES, TradeOptions};
 use crate::bench::BenchRenderError;
@@ -25,6 +25,16 @@ use meshpaint_render::Gpu;
 /// references, interleaved frame times and errors ([`Study::view_rows`]), then seams and BVH
 /// presets.
 pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json::Value>, BenchRenderError> {
+    bench_trade_streaming(path, options, &mut |_| {})
+}
+
+/// [`bench_trade`], giving each group of rows to `on_row` as soon as it is measured (the CLI
+/// prints them then: a large asset takes minutes per view).
+pub fn bench_trade_streaming(
+    path: &Path,
+    options: &TradeOptions,
+    on_row: &mut dyn FnMut(&serde_json::Value),
+) -> Result<Vec<serde_json::Value>, BenchRenderError> {
     let gpu = Gpu::new_headless()?;
     let budget = Budget::from_environment().with_gpu(gpu.budget_limits());
     let scene = import_gltf(path).ok();
@@ -55,7 +65,10 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
         first.packs.first().map_or_else(|| BoundingSphere::of_points(&first.document.positions), |p| p.mesh.bounds);
     let face_count = first.document.store.topology().face_count();
     let representations: Vec<&str> =
-        ["mesh-colors"].into_iter().chain(options.mct.then_some("mct")).chain(options.htex.then_some("htex")).collect();
+        [(true, "mesh-colors"), (options.mct, "mct"), (options.ptex, "ptex"), (options.htex, "htex")]
+            .into_iter()
+            .filter_map(|(on, name)| on.then_some(name))
+            .collect();
     let mut rows = vec![serde_json::json!({
         "bench": "trade", "kind": "meta", "file": file, "adapter": gpu.describe(),
         "size": options.size, "supersample": crate::bench::adaptive::SUPERSAMPLE, "views": options.views,
@@ -65,17 +78,23 @@ pub fn bench_trade(path: &Path, options: &TradeOptions) -> Result<Vec<serde_json
         "convert_seconds_total": started.elapsed().as_secs_f64(),
     })];
     rows.extend(skipped_rows(&choices, &file, options));
+    rows.iter().for_each(&mut *on_row);
+    let mut emit = |rows: &mut Vec<serde_json::Value>, new: Vec<serde_json::Value>| {
+        new.iter().for_each(&mut *on_row);
+        rows.extend(new);
+    };
     let study = Study { gpu: &gpu, choices: &choices, baseline: &timing_baseline, textured, file: &file, options };
     for view in views(bounds, options.views) {
-        rows.extend(study.view_rows(&view, face_count)?);
+        emit(&mut rows, study.view_rows(&view, face_count)?);
     }
     for choice in &choices {
-        rows.extend(seam_rows(choice, &file)?);
+        emit(&mut rows, seam_rows(choice, &file)?);
     }
-    for mut row in bvh_rows(&first.document, bounds) {
-        merge(&mut row, &serde_json::json!({"bench": "trade", "kind": "bvh", "file": file}));
-        rows.push(row);
+    let mut bvh = bvh_rows(&first.document, bounds);
+    for row in &mut bvh {
+        merge(row, &serde_json::json!({"bench": "trade", "kind": "bvh", "file": file}));
     }
+    emit(&mut rows, bvh);
     Ok(rows)
 }
 
@@ -84,8 +103,11 @@ fn skipped_rows(choices: &[Choice], file: &str, options: &TradeOptions) -> Vec<s
     let mut rows = Vec::new();
     for choice in choices {
         for packed in &choice.packs {
-            let failures =
-                [("mct", options.mct, packed.mct.as_ref().err()), ("htex", options.htex, packed.htex.as_ref().err())];
+            let failures = [
+                ("mct", options.mct, packed.mct.as_ref().err()),
+                ("ptex", options.ptex, packed.ptex.as_ref().err()),
+                ("htex", options.htex, packed.htex.as_ref().err()),
+            ];
             for (representation, asked, failure) in failures {
                 if let (true, Some(reason)) = (asked, failure) {
                     rows.push(serde_json::json!({
@@ -128,6 +150,9 @@ fn seam_rows(choice: &Choice, file: &str) -> Result<Vec<serde_json::Value>, Benc
         }
         if let Ok(htex) = &packed.htex {
             push(htex_seam_jumps(&packed.packed, &htex.texture), "htex", packed.format);
+        }
+        if let Ok(ptex) = &packed.ptex {
+            push(ptex_seam_jumps(&packed.packed, &ptex.texture), "ptex", packed.format);
         }
     }
     Ok(rows)

@@ -11,6 +11,7 @@ use meshpaint_core::htex::HtexTexture;
 use meshpaint_core::mct::MeshColorTexture;
 use meshpaint_core::packing::linear::PackedMesh;
 use meshpaint_core::packing::sampler::{Filter, sample, sample_trilinear};
+use meshpaint_core::ptex::PackedPtex;
 
 /// The fewest segments an edge is split into: points `t = k / segments`, `k = 0..=segments`.
 const MIN_SEGMENTS: u32 = 32;
@@ -223,6 +224,31 @@ pub fn mct_seam_jumps(packed: &PackedMesh, texture: &MeshColorTexture) -> Vec<Se
 /// its CPU evaluation of three bilinear fetches ([`HtexTexture::sample_level`],
 /// [`HtexTexture::sample_trilinear`]) at every level, trilinear at `level + 0.5`.
 pub fn htex_seam_jumps(packed: &PackedMesh, texture: &HtexTexture) -> Vec<SeamJump> {
+    let edges = edge_pairs(packed, SeamEdges::Every);
+    if edges.pairs.is_empty() {
+        return Vec::new();
+    }
+    let last = texture.layout.levels.saturating_sub(1);
+    let mut out = Vec::new();
+    for filter in ["linear", "trilinear"] {
+        for level in 0..=last {
+            if filter == "trilinear" && level == last {
+                continue;
+            }
+            let read = |face: u32, w: [f32; 3]| match filter {
+                "linear" => texture.sample_level(face, w, level),
+                _ => texture.sample_trilinear(face, w, level as f32 + 0.5),
+            };
+            out.push(measure(packed, &edges, filter, level, &read));
+        }
+    }
+    out
+}
+
+/// The packed Ptex `texture` (built from `packed`) over every edge, as [`mct_seam_jumps`]:
+/// hardware bilinear (`linear`) at every level, trilinear at `level + 0.5` below the last,
+/// with its CPU evaluation ([`PackedPtex::sample_level`], [`PackedPtex::sample_trilinear`]).
+pub fn ptex_seam_jumps(packed: &PackedMesh, texture: &PackedPtex) -> Vec<SeamJump> {
     let edges = edge_pairs(packed, SeamEdges::Every);
     if edges.pairs.is_empty() {
         return Vec::new();

@@ -4,7 +4,7 @@
 
 use image::RgbaImage;
 
-use super::choices::{Choice, HtexPack, MctPack, Packed};
+use super::choices::{Choice, HtexPack, Packed};
 use super::metrics::{compare, error_json, median, merge};
 use super::{DISTANCES, FILTERS, MCT_FILTERS, TradeOptions};
 use crate::bench::BenchRenderError;
@@ -45,21 +45,12 @@ fn unlit(camera: OrbitCamera, filter: FilterMode) -> RenderSettings {
     settings
 }
 
-/// One configuration drawn in a view: a choice, one of its packs, the representation and
-/// an index into [`FILTERS`] (mesh colors) or [`MCT_FILTERS`] (MCT and Htex).
-#[derive(Debug, Clone, Copy)]
-struct Item {
-    choice: usize,
-    pack: usize,
-    rep: Rep,
-    filter: usize,
-}
-
-/// The representation of an [`Item`].
+/// A representation of the study's rows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Rep {
     MeshColors,
     Mct,
+    Ptex,
     Htex,
 }
 
@@ -68,9 +59,21 @@ impl Rep {
         match self {
             Rep::MeshColors => "mesh-colors",
             Rep::Mct => "mct",
+            Rep::Ptex => "ptex",
             Rep::Htex => "htex",
         }
     }
+}
+
+/// One configuration drawn in a view: a choice, one of its packs, the representation and
+/// an index into [`FILTERS`] (mesh colors) or [`MCT_FILTERS`] (MCT, packed Ptex and Htex:
+/// all hardware bilinear, a fixed level or two levels).
+#[derive(Debug, Clone, Copy)]
+struct Item {
+    choice: usize,
+    pack: usize,
+    rep: Rep,
+    filter: usize,
 }
 
 /// What every view of the study draws and compares.
@@ -92,7 +95,8 @@ impl Study<'_> {
         for (choice, c) in self.choices.iter().enumerate() {
             for (pack, p) in c.packs.iter().enumerate() {
                 items.extend((0..FILTERS.len()).map(|filter| Item { choice, pack, rep: Rep::MeshColors, filter }));
-                for (rep, ok) in [(Rep::Mct, p.mct.is_ok()), (Rep::Htex, p.htex.is_ok())] {
+                let built = [(Rep::Mct, p.mct.is_ok()), (Rep::Ptex, p.ptex.is_ok()), (Rep::Htex, p.htex.is_ok())];
+                for (rep, ok) in built {
                     if ok {
                         items.extend((0..MCT_FILTERS.len()).map(|filter| Item { choice, pack, rep, filter }));
                     }
@@ -106,21 +110,13 @@ impl Study<'_> {
         &self.choices[item.choice].packs[item.pack]
     }
 
-    /// The item's MCT, when it is an MCT item.
-    fn mct(&self, item: Item) -> Option<&MctPack> {
-        if item.rep == Rep::Mct { self.packed(item).mct.as_ref().ok() } else { None }
-    }
-
-    /// The item's Htex, when it is an Htex item.
-    fn htex(&self, item: Item) -> Option<&HtexPack> {
-        if item.rep == Rep::Htex { self.packed(item).htex.as_ref().ok() } else { None }
-    }
-
     fn draw_item(&self, item: Item) -> DrawItem<'_> {
-        match (self.mct(item), self.htex(item)) {
-            (Some(mct), _) => DrawItem::Mct(&mct.gpu),
-            (_, Some(htex)) => DrawItem::Htex(&htex.gpu),
-            _ => DrawItem::MeshColors(&self.packed(item).mesh),
+        let packed = self.packed(item);
+        match (item.rep, &packed.mct, &packed.ptex, &packed.htex) {
+            (Rep::Mct, Ok(mct), _, _) => DrawItem::Mct(&mct.gpu),
+            (Rep::Ptex, _, Ok(ptex), _) => DrawItem::Ptex(&ptex.gpu),
+            (Rep::Htex, _, _, Ok(htex)) => DrawItem::Htex(&htex.gpu),
+            _ => DrawItem::MeshColors(&packed.mesh),
         }
     }
 
@@ -236,9 +232,10 @@ impl Study<'_> {
             "pack_seconds": packed.pack_seconds,
             "convert_seconds": choice.convert_seconds,
         });
-        let more = match (self.mct(item), self.htex(item)) {
-            (_, Some(htex)) => htex_json(packed, htex),
-            (Some(mct), _) => serde_json::json!({
+        let more = match (item.rep, &packed.mct, &packed.ptex, &packed.htex) {
+            (Rep::Htex, _, _, Ok(htex)) => htex_json(packed, htex),
+            (Rep::Ptex, _, Ok(ptex), _) => ptex_json(packed, ptex),
+            (Rep::Mct, Ok(mct), _, _) => serde_json::json!({
                 "gpu_bytes": packed.geometry_bytes() + mct.gpu.gpu_bytes(),
                 "color_gpu_bytes": mct.gpu.gpu_bytes(),
                 "mct_bytes": mct.texture.gpu_bytes(),
@@ -279,6 +276,33 @@ fn htex_json(packed: &Packed, htex: &HtexPack) -> serde_json::Value {
         "htex_textures": e, "htex_faces": f, "htex_e_over_f": e as f64 / f.max(1) as f64,
         "htex_pages": [layout.page_size, layout.page_height, layout.pages],
         "htex_levels": layout.levels,
+    })
+}
+
+/// The packed Ptex columns of a `config` row: bytes (GPU, and over the packed mesh colors),
+/// where its texels go (the blocks' own, borders, unused: the paper's ~8 % packing and ~10 %
+/// border anchors are `ptex_unused_over_interior` and `ptex_border_over_interior`) and the
+/// build time.
+fn ptex_json(packed: &Packed, ptex: &super::choices::PtexPack) -> serde_json::Value {
+    let t = &ptex.texture;
+    let interior = t.stats.interior_texels.max(1) as f64;
+    serde_json::json!({
+        "gpu_bytes": packed.geometry_bytes() + ptex.gpu.gpu_bytes(),
+        "color_gpu_bytes": ptex.gpu.gpu_bytes(),
+        "ptex_bytes": t.gpu_bytes(),
+        "ptex_bytes_over_mesh_colors": t.gpu_bytes() as f64 / packed.mesh_colors_bytes().max(1) as f64,
+        "ptex_build_seconds": ptex.build_seconds,
+        "ptex_texture": [t.layout.width, t.layout.height],
+        "ptex_blocks": t.layout.blocks.len(),
+        "ptex_lone_blocks": t.layout.blocks.iter().filter(|b| !b.paired).count(),
+        "ptex_levels": t.layout.levels,
+        "ptex_interior_texels": t.stats.interior_texels,
+        "ptex_border_texels": t.stats.border_texels(),
+        "ptex_unused_texels": t.unused_texels(),
+        "ptex_border_over_interior": t.stats.border_texels() as f64 / interior,
+        "ptex_unused_over_interior": t.unused_texels() as f64 / interior,
+        "ptex_resampled_border_texels": t.stats.resampled_border_texels,
+        "ptex_unfolded_border_texels": t.stats.unfolded_border_texels,
     })
 }
 

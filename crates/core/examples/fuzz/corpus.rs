@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::rng::Rng;
-use super::{gltf, mct_file, packed};
+use super::{gltf, mct_file, packed, ptex_file};
 
 /// What is fuzzed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -14,6 +14,8 @@ pub enum Target {
     Gltf,
     /// The MCT-file reader, then every block's texels, sampling and re-writing.
     Mct,
+    /// The packed Ptex file reader, then every block's place, sampling and re-writing.
+    Ptex,
     /// A target that panics, aborts, hangs and over-allocates on purpose, to test the
     /// supervisor itself.
     SelfTest,
@@ -26,13 +28,16 @@ impl Target {
             Target::Packed => "packed",
             Target::Gltf => "gltf",
             Target::Mct => "mct",
+            Target::Ptex => "ptex",
             Target::SelfTest => "selftest",
         }
     }
 
     /// The inverse of [`Target::name`].
     pub fn from_name(name: &str) -> Option<Self> {
-        [Target::Packed, Target::Gltf, Target::Mct, Target::SelfTest].into_iter().find(|t| t.name() == name)
+        [Target::Packed, Target::Gltf, Target::Mct, Target::Ptex, Target::SelfTest]
+            .into_iter()
+            .find(|t| t.name() == name)
     }
 }
 
@@ -56,6 +61,8 @@ pub enum Corpus {
     Gltf(Vec<gltf::Seed>),
     /// MCT seed files.
     Mct(Vec<Vec<u8>>),
+    /// Packed Ptex seed files.
+    Ptex(Vec<Vec<u8>>),
     /// The self-test target.
     SelfTest,
 }
@@ -76,6 +83,7 @@ impl Corpus {
             Target::Packed => Corpus::Packed(packed::seeds(models)),
             Target::Gltf => Corpus::Gltf(gltf::seeds(models)),
             Target::Mct => Corpus::Mct(mct_file::seeds()),
+            Target::Ptex => Corpus::Ptex(ptex_file::seeds()),
             Target::SelfTest => Corpus::SelfTest,
         }
     }
@@ -89,6 +97,9 @@ impl Corpus {
             }
             Corpus::Mct(seeds) => {
                 Input { bytes: mct_file::mutate(seeds, &mut rng), extension: "mct", glb: false, resolution: 0 }
+            }
+            Corpus::Ptex(seeds) => {
+                Input { bytes: ptex_file::mutate(seeds, &mut rng), extension: "ptx", glb: false, resolution: 0 }
             }
             Corpus::Gltf(seeds) => {
                 let resolution = rng.pick(&[1, 2, 4]);
@@ -107,6 +118,7 @@ impl Corpus {
             Corpus::Packed(_) => packed::run(&input.bytes),
             Corpus::Gltf(_) => gltf::run(&input.bytes, input.glb, input.resolution),
             Corpus::Mct(_) => mct_file::run(&input.bytes),
+            Corpus::Ptex(_) => ptex_file::run(&input.bytes),
             Corpus::SelfTest => {
                 let behaviour = input.bytes.first().copied().map_or(0, u64::from);
                 match behaviour {

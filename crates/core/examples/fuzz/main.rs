@@ -2,7 +2,7 @@
 //! stable Rust.
 //!
 //! ```text
-//! cargo run --release -p meshpaint-core --example fuzz -- --iterations 10000000 [--seed 1] [--target packed|gltf|mct]
+//! cargo run --release -p meshpaint-core --example fuzz -- --iterations 10000000 [--seed 1] [--target packed|gltf|mct|ptex]
 //! ```
 //!
 //! Inputs come from structure-aware mutators (`packed.rs`, `gltf.rs`, `mct_file.rs`); input `I` of seed `S`
@@ -23,6 +23,7 @@ pub mod corpus;
 pub mod gltf;
 pub mod mct_file;
 pub mod packed;
+pub mod ptex_file;
 pub mod rng;
 pub mod supervisor;
 pub mod worker;
@@ -41,7 +42,7 @@ pub struct Args {
     /// Campaign seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// What to fuzz: packed, gltf or mct.
+    /// What to fuzz: packed, gltf, mct or ptex.
     #[arg(long, default_value = "packed", value_parser = parse_target)]
     pub target: Target,
     /// Per-input time limit in milliseconds.
@@ -64,7 +65,7 @@ pub struct Args {
 fn parse_target(name: &str) -> Result<Target, String> {
     match Target::from_name(name) {
         Some(target) => Ok(target),
-        None => Err(format!("unknown target {name:?}: packed, gltf or mct")),
+        None => Err(format!("unknown target {name:?}: packed, gltf, mct or ptex")),
     }
 }
 

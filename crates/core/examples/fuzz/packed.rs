@@ -1,7 +1,7 @@
 //! The packed-file target: seeds, a structure-aware mutator and the oracle.
 //!
-//! The mutator knows the format (docs/FORMAT.md): it splits a seed into its header and four
-//! sections, mutates elements (positions, indices, face-record words, colours), resizes
+//! The mutator knows the format (docs/FORMAT.md): it splits a seed into its header, four
+//! sections and (version 2) the layers section, mutates elements (positions, indices, face-record words, colours), resizes
 //! sections, drops or duplicates faces, changes counts and header fields, and then lays the
 //! file out again with aligned offsets and — almost always — a recomputed CRC-32, so the
 //! mutants get past the checksum and reach the content checks. A few mutants also get raw
@@ -10,7 +10,8 @@
 //! The oracle ([`run`]): the reader must not panic; a file it accepts must keep every read
 //! the face records imply (the addressing the shaders use, for every lattice point at every
 //! level) inside the colour buffer, sample at every level, unpack or be refused by the
-//! unpacker with an error, re-pack, and write and read back unchanged.
+//! unpacker with an error, re-pack, and write and read back unchanged; accepted layers must
+//! write and read back unchanged, and attach to the document or be refused with an error.
 
 use std::path::Path;
 
@@ -76,16 +77,42 @@ pub fn seeds(models: &Path) -> Vec<Vec<u8>> {
         add(&document, ColorFormat::Rgba32F);
         add(&document, ColorFormat::Rgba8Srgb);
     }
+    for format in [ColorFormat::Rgba8Srgb, ColorFormat::Rgba32F] {
+        if let Some(bytes) = open("BoxTextured/BoxTextured.glb", r(4)).and_then(|d| layered_seed(d, format)) {
+            out.push(bytes);
+        }
+    }
     if let Ok(bytes) = packed_file::to_bytes(&PackedMesh::default()) {
         out.push(bytes);
     }
     out
 }
 
-/// A decoded file: its header bytes and its four sections.
+/// A version-2 seed: `document` with three layers (one masked and painted, one hidden
+/// multiply layer) in `format`.
+fn layered_seed(mut document: Document, format: ColorFormat) -> Option<Vec<u8>> {
+    use meshpaint_core::layers::{BlendMode, LayerStack, PaintTarget};
+    let mut stack = LayerStack::from_store(&document.store);
+    stack.add_layer("paint", None).ok()?;
+    stack.add_mask(1, 0.5, None).ok()?;
+    stack.begin_paint(PaintTarget::Content, "seed").ok()?;
+    stack.writer().ok()?.fill_with(|site| [site.barycentric[0], 0.25, 1.0, 0.75]);
+    stack.end_paint();
+    stack.add_layer("hidden multiply", None).ok()?;
+    stack.set_blend(2, BlendMode::Multiply).ok()?;
+    stack.set_visible(2, false).ok()?;
+    stack.sync(&mut document.store);
+    document.layers = Some(stack);
+    let packed = document.pack(format).ok()?;
+    packed_file::to_bytes_with_layers(&packed, document.layers_section(format).as_ref()).ok()
+}
+
+/// A decoded file: its header bytes, its four sections and its layers section (empty in
+/// version 1).
 struct Parts {
     header: [u8; HEADER],
     sections: [Vec<u8>; 4],
+    layers: Vec<u8>,
 }
 
 fn read_u32(bytes: &[u8], at: usize) -> u32 {
@@ -112,7 +139,9 @@ impl Parts {
             let length = read_u64(bytes, 64 + 16 * k) as usize;
             bytes[offset..offset + length].to_vec()
         });
-        Parts { header, sections }
+        let colors_end = read_u64(bytes, 104) as usize + read_u64(bytes, 112) as usize;
+        let layers = bytes.get(colors_end.div_ceil(ALIGN) * ALIGN..).unwrap_or_default().to_vec();
+        Parts { header, sections, layers }
     }
 
     fn bytes_per_sample(&self) -> usize {
@@ -140,6 +169,10 @@ impl Parts {
             write_field(&mut out, 64 + 16 * k, 8, section.len() as u64);
             out.extend_from_slice(section);
         }
+        if !self.layers.is_empty() {
+            out.resize(out.len().div_ceil(ALIGN) * ALIGN, 0);
+            out.extend_from_slice(&self.layers);
+        }
         let len = out.len() as u64;
         write_field(&mut out, 16, 8, len);
         out
@@ -158,8 +191,51 @@ pub fn fix_checksum(bytes: &mut [u8]) {
     bytes[124..128].copy_from_slice(&crc.to_le_bytes());
 }
 
+/// One mutation of the layers section: a record or header word set to an interesting
+/// value, a name byte, a sample's bytes, or the section resized.
+fn mutate_layers(parts: &mut Parts, rng: &mut Rng) {
+    let data = &mut parts.layers;
+    if data.len() < 4 {
+        return;
+    }
+    match rng.below(4) {
+        0 => {
+            // Header words and the first records' flags, blend, opacity and name length.
+            let at = rng.pick(&[0usize, 4, 8, 12, 16, 20, 24, 28, 288, 292, 296, 300]);
+            let old = read_u32(data, at);
+            let value = match rng.below(3) {
+                0 => rng.interesting_u32(old),
+                1 => rng.pick(&[f32::NAN.to_bits(), 1.5f32.to_bits(), (-0.0f32).to_bits(), 1.0f32.to_bits()]),
+                _ => old ^ (1 << rng.below(32)),
+            };
+            write_field(data, at, 4, u64::from(value));
+        }
+        1 => {
+            let at = 32 + rng.index(256);
+            if let Some(byte) = data.get_mut(at) {
+                *byte = rng.pick(&[0x00, 0x41, 0xFF, 0xC3]);
+            }
+        }
+        2 => {
+            let at = rng.index(data.len() / 4) * 4;
+            write_field(data, at, 4, u64::from(rng.pick(&[0x7FC0_0000u32, 0xFF80_0000, 0xBF80_0000, 0x7F80_0000])));
+        }
+        _ => {
+            if rng.chance(1, 2) {
+                let keep = data.len().saturating_sub(4 * (1 + rng.index(8)));
+                data.truncate(keep);
+            } else {
+                data.extend((0..4 * (1 + rng.index(4))).map(|_| rng.next_u64() as u8));
+            }
+        }
+    }
+}
+
 /// One element-level mutation of a section.
 fn mutate_element(parts: &mut Parts, rng: &mut Rng) {
+    if !parts.layers.is_empty() && rng.chance(1, 3) {
+        return mutate_layers(parts, rng);
+    }
     let section = rng.index(4);
     let size = parts.element(section);
     let count = parts.sections[section].len() / size;
@@ -386,14 +462,19 @@ fn check_reads(mesh: &PackedMesh) {
 /// Runs one input through the reader and everything after it; returns the outcome's label.
 /// Panics (the fuzzer catches them) when an accepted file breaks a promise.
 pub fn run(bytes: &[u8]) -> String {
-    let mesh = match packed_file::from_bytes(bytes) {
-        Ok(mesh) => mesh,
+    let (mesh, layers) = match packed_file::from_bytes_with_layers(bytes) {
+        Ok(read) => read,
         Err(error) => return format!("refused: {}", variant(&format!("{error:?}"))),
     };
     check_reads(&mesh);
-    let written = packed_file::to_bytes(&mesh).expect("the writer refuses a file the reader accepted");
-    let reread = packed_file::from_bytes(&written).expect("the writer's output of an accepted file is refused");
-    assert!(reread == mesh, "an accepted file does not survive write + read");
+    let written = packed_file::to_bytes_with_layers(&mesh, layers.as_ref())
+        .expect("the writer refuses a file the reader accepted");
+    let reread =
+        packed_file::from_bytes_with_layers(&written).expect("the writer's output of an accepted file is refused");
+    assert!(reread.0 == mesh && reread.1 == layers, "an accepted file does not survive write + read");
+    if let Some(section) = &layers {
+        return run_layers(&mesh, section);
+    }
     let document = match Document::from_packed(&mesh) {
         Ok(document) => document,
         Err(error) => return format!("accepted, unpack refused: {}", variant(&format!("{error:?}"))),
@@ -403,4 +484,27 @@ pub fn run(bytes: &[u8]) -> String {
     let again = packed_file::from_bytes(&bytes).expect("a re-packed store does not read back");
     assert!(again == repacked, "a re-packed store does not survive write + read");
     "accepted, unpacked, re-packed".to_owned()
+}
+
+/// An accepted layers section must attach to its document or be refused with an error, and
+/// an attached stack must save and read back as it was read.
+fn run_layers(mesh: &PackedMesh, section: &packed_file::LayersSection) -> String {
+    let mut document = match Document::from_packed(mesh) {
+        Ok(document) => document,
+        Err(error) => return format!("accepted, unpack refused: {}", variant(&format!("{error:?}"))),
+    };
+    let budget = meshpaint_core::colors::budget::Budget::from_environment();
+    if let Err(error) = document.attach_layers(section, &budget) {
+        return format!("accepted, layers refused: {}", variant(&format!("{error:?}")));
+    }
+    let saved = document.layers_section(mesh.format).expect("an attached stack has layers");
+    let names = |s: &packed_file::LayersSection| -> Vec<(String, bool, u32, bool)> {
+        s.layers.iter().map(|l| (l.name.clone(), l.visible, l.blend, l.mask.is_some())).collect()
+    };
+    assert!(names(&saved) == names(section) && saved.active == section.active, "attached layers lost properties");
+    // Once attached, saving is a fixed point: save, read, attach, save gives the same section.
+    let mut reopened = Document::from_packed(mesh).expect("the document unpacked once");
+    reopened.attach_layers(&saved, &budget).expect("saved layers do not attach again");
+    assert!(reopened.layers_section(mesh.format).as_ref() == Some(&saved), "saved layers change when reopened");
+    "accepted with layers".to_owned()
 }

@@ -98,6 +98,14 @@ pub enum DocumentError {
         /// The cause.
         source: PackError,
     },
+    /// The saved layers do not fit the document or the budget.
+    #[error("{path}: {source}")]
+    Layers {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: crate::layers::LayerError,
+    },
     /// The caller cancelled the conversion ([`crate::progress::Reporter::cancel`]).
     #[error("{path}: cancelled")]
     Cancelled {
@@ -162,8 +170,14 @@ pub struct OpenPhases {
     /// rounds included).
     pub bake: Duration,
     /// Allocating and colouring the store (budget check, resolutions, bake or fill, vertex
-    /// colours): the phases above and the rest.
+    /// colours, the measure below): the phases above and the rest.
     pub store: Duration,
+    /// Measuring the converted store against the texture ([`Self::texture_psnr_db`]).
+    pub measure: Duration,
+    /// The converted colours' PSNR against the base-colour texture over the textured surface
+    /// ([`crate::convert::adaptive::texture_psnr`]); `None` without a texture (or for a
+    /// packed file), `+∞` when lossless.
+    pub texture_psnr_db: Option<f64>,
 }
 
 /// An open mesh with its editable colours.
@@ -183,6 +197,65 @@ pub struct Document {
     /// keep no texture). The editor turns "resolution follows the brush" on for untextured
     /// documents.
     pub textured: bool,
+    /// The layers (docs/LAYERS.md) when the document has them: `store` is then their
+    /// composite. `None`: the store is the document's only colour (as before layers).
+    pub layers: Option<crate::layers::LayerStack>,
+    /// What the conversion that made it showed (a glTF mesh; `None` for a packed file).
+    pub conversion: Option<ConversionReport>,
+}
+
+/// What a conversion from a mesh shows when it ends: the rule and how well the colours
+/// follow the texture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConversionReport {
+    /// The rule, as [`ResolutionRule::describe`] says it.
+    pub rule: String,
+    /// The colours' PSNR against the base-colour texture over the textured surface
+    /// ([`crate::convert::adaptive::texture_psnr`], before vertex colours multiply in);
+    /// `None` without a texture, `+∞` when lossless.
+    pub texture_psnr_db: Option<f64>,
+    /// Faces a sample budget held below what their texels could use (zero for other rules).
+    pub faces_held_by_budget: u64,
+}
+
+impl ConversionReport {
+    /// One line for a status bar or log: the rule, the PSNR, the faces the budget held.
+    pub fn summary(&self) -> String {
+        let mut line = self.rule.clone();
+        match self.texture_psnr_db {
+            Some(db) if db.is_finite() => line += &format!(", {db:.1} dB against the texture"),
+            Some(_) => line += ", lossless against the texture",
+            None => {}
+        }
+        if self.faces_held_by_budget > 0 {
+            line += &format!(
+                ", {} face{} held below {} texels by the budget",
+                self.faces_held_by_budget,
+                if self.faces_held_by_budget == 1 { "" } else { "s" },
+                if self.faces_held_by_budget == 1 { "its" } else { "their" }
+            );
+        }
+        line
+    }
+}
+
+/// Bakes the texture into `store` (fitted by `fit`, verified for an error bound) and measures
+/// the result against the texture, recording both in `phases`.
+fn bake_and_measure(
+    store: &mut ColorStore,
+    welded: &crate::mesh::weld::WeldedMesh,
+    scene: &Scene,
+    (rule, fit): (ResolutionRule, BakeFit),
+    phases: &mut OpenPhases,
+    progress: crate::progress::Progress<'_>,
+) -> Result<(), crate::progress::Cancelled> {
+    let baking = Instant::now();
+    crate::convert::adaptive::bake_and_verify_with(store, welded, scene, rule, fit, progress.part(0.0, 0.9))?;
+    phases.bake = baking.elapsed();
+    let measuring = Instant::now();
+    phases.texture_psnr_db = crate::convert::adaptive::texture_psnr(store, welded, scene, progress.part(0.9, 1.0))?;
+    phases.measure = measuring.elapsed();
+    Ok(())
 }
 
 /// A smooth, deterministic colour field over the bounding box that shows the shape and the
@@ -402,11 +475,17 @@ impl Document {
         progress.report(0.0, "reading and importing");
         let head = read_head(path)?;
         if packed_file::looks_like_packed(&head) {
-            let packed = packed_file::read_file(path)?;
-            return Self::from_packed_within(&packed, budget).map_err(|source| match source {
+            let (packed, layers) = packed_file::read_file_with_layers(path)?;
+            let mut document = Self::from_packed_within(&packed, budget).map_err(|source| match source {
                 PackError::Budget(source) => DocumentError::Budget { path: path.to_owned(), source },
                 source => DocumentError::Pack { path: path.to_owned(), source },
-            });
+            })?;
+            if let Some(section) = layers {
+                document
+                    .attach_layers(&section, budget)
+                    .map_err(|source| DocumentError::Layers { path: path.to_owned(), source })?;
+            }
+            return Ok(document);
         }
         let (scene, kind) = import_scene_after(path, &head, budget)?;
         let mut document = Self::from_scene_phased(
@@ -550,10 +629,7 @@ impl Document {
         let mut store = ColorStore::with_resolutions(topology, resolutions, uniform.unwrap_or([1.0; 4]))
             .map_err(|source| DocumentError::Store { path: name.to_owned(), source })?;
         if has_base_color {
-            let baking = Instant::now();
-            crate::convert::adaptive::bake_and_verify_with(&mut store, &welded, &scene, rule, fit, bake)
-                .map_err(cancelled)?;
-            phases.bake = baking.elapsed();
+            bake_and_measure(&mut store, &welded, &scene, (rule, fit), phases, bake).map_err(cancelled)?;
         } else if neutral && uniform.is_none() {
             fill_neutral(&mut store, &welded.triangle_materials, &scene);
         }
@@ -567,13 +643,20 @@ impl Document {
             .any(|m| m.and_then(|m| scene.materials.get(m as usize)).is_some_and(|m| m.base_color_texture.is_some()));
         phases.store = started.elapsed();
         progress.report(1.0, "converted");
+        let conversion = ConversionReport {
+            rule: rule.describe(),
+            texture_psnr_db: phases.texture_psnr_db,
+            faces_held_by_budget: phases.rule.faces_held_by_budget,
+        };
         Ok(Document {
             textured,
+            conversion: Some(conversion),
             positions: welded.positions_world,
             store,
             degenerate_triangles_dropped: welded.degenerate_triangles_dropped,
             source: SourceKind::Gltf,
             warnings: scene.warnings,
+            layers: None,
         })
     }
 
@@ -591,7 +674,47 @@ impl Document {
             source: SourceKind::Packed(packed.format),
             warnings: Vec::new(),
             textured: false,
+            conversion: None,
+            layers: None,
         })
+    }
+
+    /// Gives the document the layers of a saved layers section (its store becomes their
+    /// composite, recomputed from the layers: they are the source).
+    pub fn attach_layers(
+        &mut self,
+        section: &packed_file::LayersSection,
+        budget: &Budget,
+    ) -> Result<(), crate::layers::LayerError> {
+        let mut stack = crate::layers::file::from_section(section, &self.store, self.display_format(), budget)?;
+        stack.sync(&mut self.store);
+        self.store.take_dirty();
+        self.layers = Some(stack);
+        Ok(())
+    }
+
+    /// Whether the store is exactly its layers' composite (true without layers). False when
+    /// the store was changed without going through the layers (e.g. painted by a tool that
+    /// does not know them yet): saving the layers would then lose that change.
+    pub fn layers_in_sync(&self) -> bool {
+        let Some(stack) = &self.layers else {
+            return true;
+        };
+        let mut composite = self.store.clone();
+        stack.composite_into(&mut composite) == 0
+    }
+
+    /// The layers section a save in `format` writes (`None` without layers: a version-1 file).
+    pub fn layers_section(&self, format: ColorFormat) -> Option<packed_file::LayersSection> {
+        self.layers.as_ref().map(|stack| crate::layers::file::to_section(stack, format))
+    }
+
+    /// Packs the document and writes it to `path` as a packed file in `format`, with its
+    /// layers when it has them (atomically, [`packed_file::write_file_with_layers`]).
+    pub fn write_packed(&self, path: &Path, format: ColorFormat) -> Result<PackedMesh, DocumentError> {
+        let packed = self.pack(format).map_err(|source| DocumentError::Pack { path: path.to_owned(), source })?;
+        packed_file::write_file_with_layers(path, &packed, self.layers_section(format).as_ref())?;
+        Ok(packed)
     }
 
     /// Packs the document into linear buffers in `format`.

@@ -358,7 +358,7 @@ fn check_height(height: u64, max_dimension: u32, width: u32) -> Result<(), MctEr
 }
 
 /// `log2 R_b` of every face.
-fn block_resolutions(packed: &PackedMesh) -> Result<Vec<u8>, MctError> {
+pub(crate) fn block_resolutions(packed: &PackedMesh) -> Result<Vec<u8>, MctError> {
     packed
         .face_records
         .par_iter()
@@ -375,7 +375,7 @@ fn block_resolutions(packed: &PackedMesh) -> Result<Vec<u8>, MctError> {
 
 /// Pairs every face with an unpaired neighbour of the same `R_b` across a manifold edge
 /// (a near-maximum matching); lists per group, and the faces of every edge.
-fn pair_faces(packed: &PackedMesh, log2_blocks: &[u8]) -> (Vec<Vec<[u32; 2]>>, EdgeFaces) {
+pub(crate) fn pair_faces(packed: &PackedMesh, log2_blocks: &[u8]) -> (Vec<Vec<[u32; 2]>>, EdgeFaces) {
     // Half-edges (lo, hi, face) sorted, so the faces of an edge are adjacent.
     let mut half: Vec<(u64, u32)> = packed
         .indices

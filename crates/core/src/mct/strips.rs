@@ -58,14 +58,14 @@ fn row_mask(row: &[bool]) -> u32 {
 }
 
 /// Neighbour lookup across manifold edges: `(lo << 32 | hi, face)` sorted.
-pub(super) struct EdgeFaces(Vec<(u64, u32)>);
+pub(crate) struct EdgeFaces(Vec<(u64, u32)>);
 
 impl EdgeFaces {
-    pub(super) fn new(half: Vec<(u64, u32)>) -> Self {
+    pub(crate) fn new(half: Vec<(u64, u32)>) -> Self {
         EdgeFaces(half)
     }
     /// The faces of edge `{a, b}` when exactly two faces share it.
-    fn faces(&self, a: u32, b: u32) -> Option<[u32; 2]> {
+    pub(crate) fn faces(&self, a: u32, b: u32) -> Option<[u32; 2]> {
         let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
         let start = self.0.partition_point(|&(k, _)| k < key);
         let end = self.0.partition_point(|&(k, _)| k <= key);

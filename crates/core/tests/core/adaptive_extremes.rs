@@ -39,7 +39,7 @@ fn content_rules(max: u32) -> Vec<ResolutionRule> {
 
 /// A scene of unwelded triangles (three vertices each, so every corner has its own UV;
 /// bitwise-equal positions weld), all with material 0 = `texture` × white.
-fn scene_of(corners: &[([f32; 3], [f32; 2])], texture: Texture) -> Scene {
+pub(crate) fn scene_of(corners: &[([f32; 3], [f32; 2])], texture: Texture) -> Scene {
     let mesh = SourceMesh {
         name: "test".into(),
         positions_local: corners.iter().map(|c| c.0).collect(),
@@ -58,7 +58,7 @@ fn scene_of(corners: &[([f32; 3], [f32; 2])], texture: Texture) -> Scene {
     }
 }
 
-fn texture_from(width: u32, height: u32, texel: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
+pub(crate) fn texture_from(width: u32, height: u32, texel: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
     let mut rgba8_srgb = Vec::with_capacity((width * height * 4) as usize);
     for y in 0..height {
         for x in 0..width {

@@ -1,6 +1,6 @@
 //! The fuzz harness (examples/fuzz) in the test suite: its supervisor must report every kind
 //! of crash with the input saved, and short campaigns (a fixed seed, a few thousand inputs)
-//! against the packed-file reader, the glTF importer and the MCT-file reader must find nothing — while their
+//! against the packed-file reader (layers section included), the glTF importer and the MCT-file reader must find nothing — while their
 //! inputs reach far into the reader (the mutators fix the checksum and the layout, so most
 //! mutants are refused by content checks, not by the checksum, and some are accepted).
 //!
@@ -129,6 +129,10 @@ fn a_short_packed_campaign_finds_no_crash_and_reaches_the_content_checks() {
     assert!(checksum * 10 < total, "{checksum} of {total} mutants stop at the checksum\n{}", report.text());
     assert!(accepted * 50 > total, "only {accepted} of {total} mutants are accepted\n{}", report.text());
     assert!(kinds >= 15, "only {kinds} kinds of refusal\n{}", report.text());
+    // The layered seeds (version 2) reach the layers section: some accepted, some refused.
+    let layered = count(&report.outcomes, "accepted with layers");
+    let bad_layers = count(&report.outcomes, "refused: BadLayers");
+    assert!(layered > 0 && bad_layers > 0, "layers section not reached\n{}", report.text());
 }
 
 #[test]
@@ -174,16 +178,37 @@ fn a_short_mct_campaign_finds_no_crash_and_reaches_the_content_checks() {
     assert!(kinds >= 20, "only {kinds} kinds of refusal\n{}", report.text());
 }
 
+#[test]
+fn a_short_ptex_campaign_finds_no_crash_and_reaches_the_content_checks() {
+    let report = run(&campaign(Target::Ptex, 20_261_207, 4000, "ptex"));
+    assert!(report.crashes.is_empty(), "{}", report.text());
+    let total: u64 = report.outcomes.values().sum();
+    assert_eq!(total, 4000, "{}", report.text());
+    let checksum = count(&report.outcomes, "refused: ChecksumMismatch");
+    let accepted = count(&report.outcomes, "accepted");
+    assert!(checksum * 10 < total, "{checksum} of {total} mutants stop at the checksum\n{}", report.text());
+    assert!(accepted * 50 > total, "only {accepted} of {total} mutants are accepted\n{}", report.text());
+    assert!(count(&report.outcomes, "refused: Content") > 0, "the content checks are reached\n{}", report.text());
+}
+
 /// Regression fixtures: inputs the fuzzer once crashed on (tests/fixtures/fuzz/), each
 /// run through its target's full oracle, with the outcome it must have now.
 #[test]
 fn former_fuzz_crashes_are_handled() {
-    let expected = [(
-        // Finite positions and transforms whose product overflows f32: welded world
-        // positions were infinite and the packed writer refused the imported document.
-        "gltf-world-position-overflows-to-infinity.glb",
-        "imported, refused: NonFiniteWorldPosition",
-    )];
+    let expected = [
+        (
+            // Finite positions and transforms whose product overflows f32: welded world
+            // positions were infinite and the packed writer refused the imported document.
+            "gltf-world-position-overflows-to-infinity.glb",
+            "imported, refused: NonFiniteWorldPosition",
+        ),
+        (
+            // A packed Ptex header of sides near 2^32: the texel byte count overflowed u64
+            // before the sides were checked.
+            "ptex-texture-size-overflows.ptx",
+            "refused: Header",
+        ),
+    ];
     let dir = common::workspace_path("tests/fixtures/fuzz");
     let mut files: Vec<String> =
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
@@ -196,6 +221,7 @@ fn former_fuzz_crashes_are_handled() {
         let found = match name.rsplit('.').next() {
             Some("mpk") => harness::packed::run(&bytes),
             Some("mct") => harness::mct_file::run(&bytes),
+            Some("ptx") => harness::ptex_file::run(&bytes),
             Some("glb") => harness::gltf::run(&bytes, true, 2),
             _ => harness::gltf::run(&bytes, false, 2),
         };

@@ -153,8 +153,8 @@ fn round_trip_is_exact_and_deterministic_for_every_format() {
         assert!(looks_like_packed(&bytes));
         assert_eq!(bytes[..8], MAGIC);
         assert_eq!(&MAGIC, b"MESHPAK\0");
-        assert_eq!(get_u32(&bytes, VERSION_AT), VERSION);
-        assert_eq!(VERSION, 1);
+        assert_eq!(VERSION, 2, "the newest version");
+        assert_eq!(get_u32(&bytes, VERSION_AT), 1, "a file without layers is version 1");
         assert_eq!(get_u32(&bytes, HEADER_SIZE_AT), 128);
         assert_eq!(get_u64(&bytes, FILE_SIZE_AT), bytes.len() as u64);
         assert_eq!(get_u32(&bytes, FLAGS_AT), 0);
@@ -385,8 +385,12 @@ fn absurd_header_counts_are_refused_without_allocating() {
 #[test]
 fn malformed_headers_are_refused() {
     let f = ColorFormat::Rgba16F;
+    let message = hostile(f, |b| put_u32(b, VERSION_AT, 3));
+    assert_contains(&message, &["unsupported packed file version 3"]);
     let message = hostile(f, |b| put_u32(b, VERSION_AT, 2));
-    assert_contains(&message, &["unsupported packed file version 2"]);
+    assert_contains(&message, &["version-2 file must set flag bit 0"]);
+    let message = hostile(f, |b| put_u32(b, FLAGS_AT, 1));
+    assert_contains(&message, &["unknown flag bits 0x00000001"]);
     let message = hostile(f, |b| put_u32(b, HEADER_SIZE_AT, 256));
     assert_contains(&message, &["header size is 256"]);
     let message = hostile(f, |b| put_u32(b, FLAGS_AT, 1 << 5));

@@ -9,5 +9,6 @@ mod gpu_atlas_addressing;
 mod gpu_htex;
 mod gpu_mct;
 mod gpu_paint_upload;
+mod gpu_ptex;
 mod gpu_vs_cpu;
 mod shaders;

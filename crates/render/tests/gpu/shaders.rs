@@ -5,14 +5,15 @@
 
 use std::path::Path;
 
-use meshpaint_render::{FRAME_WGSL, FrameUniforms, HTEX_WGSL, MCT_WGSL, MESH_COLORS_WGSL, UV_BASELINE_WGSL};
+use meshpaint_render::{FRAME_WGSL, FrameUniforms, HTEX_WGSL, MCT_WGSL, MESH_COLORS_WGSL, PTEX_WGSL, UV_BASELINE_WGSL};
 
 /// The assembled sources, by the name of the file each one ends with.
-const SOURCES: [(&str, &str); 4] = [
+const SOURCES: [(&str, &str); 5] = [
     ("mesh_colors.wgsl", MESH_COLORS_WGSL),
     ("uv_baseline.wgsl", UV_BASELINE_WGSL),
     ("mct.wgsl", MCT_WGSL),
     ("htex.wgsl", HTEX_WGSL),
+    ("ptex.wgsl", PTEX_WGSL),
 ];
 
 fn validate(name: &str, source: &str) -> (naga::Module, naga::valid::ModuleInfo) {
@@ -26,7 +27,7 @@ fn validate(name: &str, source: &str) -> (naga::Module, naga::valid::ModuleInfo)
 
 #[test]
 fn every_shader_parses_and_validates() {
-    // shaders/ holds the shared parts and the three shaders the library assembles, nothing
+    // shaders/ holds the shared parts and the shaders the library assembles, nothing
     // that would go unvalidated.
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
     let mut names: Vec<String> = std::fs::read_dir(&dir)
@@ -37,7 +38,15 @@ fn every_shader_parses_and_validates() {
     names.sort();
     assert_eq!(
         names,
-        ["frame.wgsl", "htex.wgsl", "mct.wgsl", "mesh_colors.wgsl", "mesh_common.wgsl", "uv_baseline.wgsl"]
+        [
+            "frame.wgsl",
+            "htex.wgsl",
+            "mct.wgsl",
+            "mesh_colors.wgsl",
+            "mesh_common.wgsl",
+            "ptex.wgsl",
+            "uv_baseline.wgsl"
+        ]
     );
     for (name, source) in SOURCES {
         assert!(source.starts_with(FRAME_WGSL), "{name} does not start with shaders/frame.wgsl");
@@ -184,6 +193,26 @@ fn the_wgsl_mct_band_table_matches_the_rust_entries() {
     }
     // The shader's group count is the core's.
     assert!(MCT_WGSL.contains(&format!("const MCT_GROUPS: u32 = {}u;", meshpaint_core::mct::layout::GROUPS)));
+}
+
+/// The Ptex shader's tables are a runtime-sized array of the 16-byte entries
+/// crates/render/src/ptex.rs `gpu_tables` uploads, one per slice of the core's.
+#[test]
+fn the_wgsl_ptex_tables_match_the_rust_entries() {
+    let (module, _) = validate("ptex.wgsl", PTEX_WGSL);
+    let tables = module
+        .global_variables
+        .iter()
+        .find(|(_, global)| global.name.as_deref() == Some("ptex_tables"))
+        .map(|(_, global)| global.ty)
+        .unwrap();
+    match module.types[tables].inner {
+        naga::TypeInner::Array { size: naga::ArraySize::Dynamic, stride, .. } => {
+            assert_eq!(stride as usize, std::mem::size_of::<meshpaint_render::GpuPtexSlice>());
+        }
+        ref other => panic!("ptex_tables is not a runtime-sized array: {other:?}"),
+    }
+    assert!(PTEX_WGSL.contains(&format!("const PTEX_SLICES: u32 = {}u;", meshpaint_core::ptex::SLICES)));
 }
 
 /// The f32 literals of a constant expression, in order (vectors and arrays flattened).

@@ -263,16 +263,26 @@ impl<'a> FaceFit<'a> {
             .collect()
     }
 
-    /// The error (module docs) of the face alone, baked and reconstructed at `r`.
+    /// The error (module docs) of the face alone, baked and reconstructed at `r`. When the
+    /// lattice has more points than three per test point (a large face at a fine `R`: up to
+    /// `R²/2` texture reads where the test points are at most a 256² lattice plus the seam
+    /// strips), only the lattice points the test points' sub-triangles use are baked, each
+    /// where it is used: the same values (a lattice point's colour depends on `(i, j, R)`
+    /// alone), so the same error, at a cost that follows the test points, not `R²`.
     pub(super) fn error(&self, r: Resolution) -> f32 {
         let res = r.get();
+        let points = self.points_for(r);
+        let lattice_points = u64::from(res + 1) * u64::from(res + 2) / 2;
+        if lattice_points > 3 * points.len() as u64 {
+            return Self::error_at(r, &points, |i, j| self.lattice_color(i, j, res));
+        }
         let mut lattice = Vec::with_capacity(((res + 1) * (res + 2) / 2) as usize);
         for j in 0..=res {
             for i in 0..=res - j {
                 lattice.push(self.lattice_color(i, j, res));
             }
         }
-        self.error_of_lattice(r, &lattice)
+        self.error_of_lattice(r, &points, &lattice)
     }
 
     /// The error (module docs) of face `face` as `store` shows it at its resolution `r`
@@ -302,18 +312,24 @@ impl<'a> FaceFit<'a> {
                 }
             }
         }
-        self.error_of_lattice(r, &lattice)
+        self.error_of_lattice(r, &self.points_for(r), &lattice)
     }
 
     /// The error of the lattice of resolution `r` (`(i, j)` row by row, `j` outer),
     /// reconstructed with eq. 2.4 at the test points of a face shown at `r`.
-    fn error_of_lattice(&self, r: Resolution, lattice: &[Rgba]) -> f32 {
+    fn error_of_lattice(&self, r: Resolution, points: &TestPoints<'_>, lattice: &[Rgba]) -> f32 {
         let res = r.get();
         let row = |j: u32| (j * (2 * res + 3 - j) / 2) as usize;
-        self.points_for(r).rms(|bary, truth| {
+        Self::error_at(r, points, |i, j| lattice[row(j) + i as usize])
+    }
+
+    /// The error at `points` of the lattice of resolution `r` whose point `(i, j)` is
+    /// `color_at(i, j)`, reconstructed with eq. 2.4.
+    fn error_at(r: Resolution, points: &TestPoints<'_>, color_at: impl Fn(u32, u32) -> Rgba) -> f32 {
+        points.rms(|bary, truth| {
             let mut shown = [0.0f32; 4];
             for s in layout::linear_samples(r, bary) {
-                let color = lattice[row(s.j) + s.i as usize];
+                let color = color_at(s.i, s.j);
                 for c in 0..4 {
                     shown[c] += s.weight * color[c];
                 }
@@ -363,6 +379,11 @@ struct TestPoints<'a> {
 }
 
 impl TestPoints<'_> {
+    /// Points over all parts.
+    fn len(&self) -> usize {
+        self.parts.iter().map(|(points, _)| points.len()).sum()
+    }
+
     /// The root of the weighted mean of `squared(bary, truth)` (summed over the four
     /// channels) per channel.
     fn rms(&self, squared: impl Fn([f32; 3], Rgba) -> f64) -> f32 {

@@ -81,6 +81,9 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 
 mod face_fit;
+mod measure;
+
+pub use measure::texture_psnr;
 
 use face_fit::{FaceFit, SharedUvs, TestPoint, dense_lattice, shared_uvs};
 

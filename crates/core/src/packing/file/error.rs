@@ -27,6 +27,9 @@ pub enum PackedFileError {
         /// What is wrong.
         source: Box<PackedFileError>,
     },
+    /// The layers section (version 2) is malformed.
+    #[error("layers section: {0}")]
+    BadLayers(String),
     /// The file does not start with [`MAGIC`].
     #[error("not a meshpaint packed file: starts with {found:02x?}, expected {MAGIC:02x?} (\"MESHPAK\\0\")")]
     NotPacked {
@@ -53,11 +56,11 @@ pub enum PackedFileError {
         /// How many bytes follow.
         extra: u64,
     },
-    /// The file's version is not [`VERSION`].
-    #[error("unsupported packed file version {0} (this build reads version {VERSION})")]
+    /// The file's version is not 1 or [`VERSION`].
+    #[error("unsupported packed file version {0} (this build reads versions 1 to {VERSION})")]
     UnsupportedVersion(u32),
     /// The header size field is not [`HEADER_SIZE`].
-    #[error("header size is {0} bytes, version {VERSION} headers are {HEADER_SIZE} bytes")]
+    #[error("header size is {0} bytes, packed-file headers are {HEADER_SIZE} bytes")]
     HeaderSize(u32),
     /// The stored CRC-32 does not match the file content.
     #[error("checksum mismatch: stored CRC-32 {stored:#010x}, content has {computed:#010x} (file corrupt)")]
@@ -68,7 +71,7 @@ pub enum PackedFileError {
         computed: u32,
     },
     /// Flag bits this version does not define are set.
-    #[error("unknown flag bits {0:#010x} (version {VERSION} defines none)")]
+    #[error("unknown flag bits {0:#010x} (version 1 defines none, version 2 only bit 0: a layers section)")]
     UnknownFlags(u32),
     /// A reserved header field is not zero.
     #[error("reserved header field at byte {offset} is {value:#x}, must be 0")]

@@ -9,7 +9,11 @@
 //! offset 256·k indices       face_count × [u32; 3]
 //! offset 256·k face records  face_count × 4 u32 (see crate::packing::linear)
 //! offset 256·k colours       sample_count × bytes_per_sample(format)
+//! offset 256·k layers        version 2 only: the document's layers ([`layers`])
 //! ```
+//!
+//! A file without layers is written as version 1, byte for byte as before version 2; both
+//! versions are read ([`from_bytes_with_layers`] also returns the layers section).
 //!
 //! Every section starts at a multiple of [`SECTION_ALIGN`] (256) bytes, so each can be
 //! uploaded to the GPU with one write at an offset that satisfies wgpu's copy (4) and
@@ -36,6 +40,8 @@
 //!    that make any GPU read derived from the records safe), and every colour storable
 //!    (finite, R, G, B in `[0, 65504]`, alpha in `[0, 1]`: a file with any other colour is
 //!    refused, never repaired).
+//! 6. version 2: the layers section ([`LayersSection::parse`]: counts, flags, names, blend
+//!    codes, opacities, its exact length and every layer colour).
 //!
 //! Deeper layout consistency (e.g. two faces agreeing on a shared edge's chain base) is
 //! the unpacker's job ([`crate::packing::packer`]), not this module's.
@@ -47,22 +53,35 @@ use crate::colors::layout::{MAX_LOG2_RESOLUTION, Resolution, edge_chain_len, int
 use crate::packing::linear::{FaceRecord, MAX_SAMPLES, PackedMesh, unpack_word};
 
 mod error;
+pub mod layers;
 pub(crate) mod sections;
 
 use sections::{Fields, Section, align_up, checksum, le_words, section_bytes};
 
 pub use error::{Expected, PackedFileError};
+pub use layers::{LayerRecord, LayersSection};
 
 /// The first 8 bytes of every packed file.
 pub const MAGIC: [u8; 8] = *b"MESHPAK\0";
-/// The format version this module writes and reads.
-pub const VERSION: u32 = 1;
+/// The newest format version: 2 adds the layers section ([`layers`]). Files without layers
+/// are still written as version 1 ([`VERSION_WITHOUT_LAYERS`], byte for byte as before), and
+/// both versions are read.
+pub const VERSION: u32 = 2;
+/// The version of a file without a layers section.
+pub const VERSION_WITHOUT_LAYERS: u32 = 1;
+/// Flag bit (version 2): a layers section follows the colour section.
+pub const FLAG_LAYERS: u32 = 1;
 /// Size of the version-1 header in bytes (the header is zero-padded to [`SECTION_ALIGN`]).
 pub const HEADER_SIZE: usize = 128;
 /// Alignment of every section's offset in bytes.
 pub const SECTION_ALIGN: u64 = sections::SECTION_ALIGN;
-/// Flag bits defined by this version (none); any set bit is refused.
+/// Flag bits defined by version 1 (none); any set bit is refused.
 pub const KNOWN_FLAGS: u32 = 0;
+
+/// The flag bits `version` defines.
+fn known_flags(version: u32) -> u32 {
+    if version == VERSION { FLAG_LAYERS } else { KNOWN_FLAGS }
+}
 
 /// Byte offset of the CRC-32 field in the header.
 const CHECKSUM_OFFSET: usize = 124;
@@ -185,7 +204,7 @@ pub fn read_summary(path: &Path) -> Result<PackedSummary, PackedFileError> {
         return Err(PackedFileError::Truncated { what: "the header ends".to_owned(), end: HEADER_SIZE as u64, len });
     };
     let header = Header::parse(bytes);
-    if header.version != VERSION {
+    if !(VERSION_WITHOUT_LAYERS..=VERSION).contains(&header.version) {
         return Err(PackedFileError::UnsupportedVersion(header.version));
     }
     Ok(PackedSummary {
@@ -308,6 +327,13 @@ fn check_record(face: u64, record: &FaceRecord, vertex_levels: u32, sample_count
 /// would refuse (inconsistent buffer sizes, limits exceeded, non-finite positions,
 /// indices out of range, face records out of bounds), so every written file reads back.
 pub fn to_bytes(mesh: &PackedMesh) -> Result<Vec<u8>, PackedFileError> {
+    to_bytes_with_layers(mesh, None)
+}
+
+/// [`to_bytes`] with a layers section: a version-2 file when `layers` is given, else the
+/// version-1 file [`to_bytes`] writes.
+pub fn to_bytes_with_layers(mesh: &PackedMesh, layers: Option<&LayersSection>) -> Result<Vec<u8>, PackedFileError> {
+    let layer_bytes = layers.map(|section| section.to_bytes(mesh.format)).transpose()?;
     let vertex_count = u32::try_from(mesh.positions.len())
         .map_err(|_| PackedFileError::TooMany { what: "vertices", count: mesh.positions.len() as u64 })?;
     let face_count = u32::try_from(mesh.indices.len())
@@ -341,11 +367,16 @@ pub fn to_bytes(mesh: &PackedMesh) -> Result<Vec<u8>, PackedFileError> {
         cursor = section.offset.saturating_add(length);
     }
     let [positions_at, indices_at, records_at, colors_at] = sections.map(|section| section.offset);
+    let layers_at = align_up(cursor).unwrap_or(u64::MAX);
+    let file_size = match &layer_bytes {
+        Some(bytes) => layers_at.saturating_add(bytes.len() as u64),
+        None => cursor,
+    };
     let header = Header {
-        version: VERSION,
+        version: if layer_bytes.is_some() { VERSION } else { VERSION_WITHOUT_LAYERS },
         header_size: HEADER_SIZE as u32,
-        file_size: cursor,
-        flags: 0,
+        file_size,
+        flags: if layer_bytes.is_some() { FLAG_LAYERS } else { 0 },
         format_code: mesh.format.code(),
         vertex_count,
         face_count,
@@ -357,7 +388,7 @@ pub fn to_bytes(mesh: &PackedMesh) -> Result<Vec<u8>, PackedFileError> {
         checksum: 0,
     };
 
-    let capacity = usize::try_from(cursor).unwrap_or(0);
+    let capacity = usize::try_from(file_size).unwrap_or(0);
     let mut out = Vec::with_capacity(capacity);
     header.write(&mut out);
     let pad_to = |out: &mut Vec<u8>, offset: u64| {
@@ -384,6 +415,10 @@ pub fn to_bytes(mesh: &PackedMesh) -> Result<Vec<u8>, PackedFileError> {
     }
     pad_to(&mut out, colors_at);
     out.extend_from_slice(&mesh.colors);
+    if let Some(bytes) = &layer_bytes {
+        pad_to(&mut out, layers_at);
+        out.extend_from_slice(bytes);
+    }
 
     let crc = checksum(&out, CHECKSUM_OFFSET);
     if let Some(slot) = out.get_mut(CHECKSUM_OFFSET..CHECKSUM_OFFSET + 4) {
@@ -396,10 +431,11 @@ pub fn to_bytes(mesh: &PackedMesh) -> Result<Vec<u8>, PackedFileError> {
 
 /// Checks the section table against the file length (before the checksum, so that a
 /// truncated file is reported as truncated).
-fn check_sections(header: &Header, len: u64) -> Result<(), PackedFileError> {
+fn check_sections(header: &Header, layers: Option<Section>, len: u64) -> Result<(), PackedFileError> {
     let mut previous = "header";
     let mut previous_end = HEADER_SIZE as u64;
-    for (section, name) in header.sections.iter().zip(SECTION_NAMES) {
+    let table = header.sections.iter().copied().zip(SECTION_NAMES);
+    for (section, name) in table.chain(layers.map(|section| (section, "layers"))) {
         if !section.offset.is_multiple_of(SECTION_ALIGN) {
             return Err(PackedFileError::SectionMisaligned { section: name, offset: section.offset });
         }
@@ -440,9 +476,9 @@ fn check_sections(header: &Header, len: u64) -> Result<(), PackedFileError> {
 }
 
 /// Checks that every byte outside the header fields and the sections is zero.
-fn check_padding(bytes: &[u8], header: &Header) -> Result<(), PackedFileError> {
+fn check_padding(bytes: &[u8], header: &Header, layers: Option<Section>) -> Result<(), PackedFileError> {
     let mut gap_start = HEADER_SIZE as u64;
-    for section in &header.sections {
+    for section in header.sections.iter().chain(&layers) {
         let gap = section_bytes(bytes, Section { offset: gap_start, length: section.offset.saturating_sub(gap_start) });
         if let Some((at, &value)) = (gap_start..).zip(gap).find(|&(_, &byte)| byte != 0) {
             return Err(PackedFileError::NonZeroPadding { offset: at, value });
@@ -478,6 +514,12 @@ fn check_length(
 /// Never panics, and allocates at most about the size of `bytes`. See the module
 /// documentation for the checks and their order.
 pub fn from_bytes(bytes: &[u8]) -> Result<PackedMesh, PackedFileError> {
+    from_bytes_with_layers(bytes).map(|(mesh, _)| mesh)
+}
+
+/// [`from_bytes`] with the layers section of a version-2 file (`None` for version 1 or a
+/// version-2 file without the [`FLAG_LAYERS`] flag), checked as strictly as the rest.
+pub fn from_bytes_with_layers(bytes: &[u8]) -> Result<(PackedMesh, Option<LayersSection>), PackedFileError> {
     let len = bytes.len() as u64;
     if !looks_like_packed(bytes) {
         let found = bytes.get(..MAGIC.len()).unwrap_or(bytes);
@@ -494,26 +536,30 @@ pub fn from_bytes(bytes: &[u8]) -> Result<PackedMesh, PackedFileError> {
         return Err(PackedFileError::Truncated { what: "the header ends".to_owned(), end: HEADER_SIZE as u64, len });
     };
     let header = Header::parse(header_bytes);
-    if header.version != VERSION {
+    if !(VERSION_WITHOUT_LAYERS..=VERSION).contains(&header.version) {
         return Err(PackedFileError::UnsupportedVersion(header.version));
     }
     if header.header_size as usize != HEADER_SIZE {
         return Err(PackedFileError::HeaderSize(header.header_size));
     }
-    check_sections(&header, len)?;
+    let layers = layers_section(&header, len)?;
+    check_sections(&header, layers, len)?;
     let computed = checksum(bytes, CHECKSUM_OFFSET);
     if computed != header.checksum {
         return Err(PackedFileError::ChecksumMismatch { stored: header.checksum, computed });
     }
-    if header.flags & !KNOWN_FLAGS != 0 {
-        return Err(PackedFileError::UnknownFlags(header.flags & !KNOWN_FLAGS));
+    if header.flags & !known_flags(header.version) != 0 {
+        return Err(PackedFileError::UnknownFlags(header.flags & !known_flags(header.version)));
+    }
+    if header.version == VERSION && header.flags & FLAG_LAYERS == 0 {
+        return Err(PackedFileError::BadLayers("a version-2 file must set flag bit 0 and hold layers".to_owned()));
     }
     for (offset, value) in [(44, header.reserved_44), (120, header.reserved_120)] {
         if value != 0 {
             return Err(PackedFileError::ReservedNotZero { offset, value });
         }
     }
-    check_padding(bytes, &header)?;
+    check_padding(bytes, &header, layers)?;
     let format =
         ColorFormat::from_code(header.format_code).ok_or(PackedFileError::UnknownColorFormat(header.format_code))?;
     if header.sample_count > MAX_SAMPLES {
@@ -548,13 +594,43 @@ pub fn from_bytes(bytes: &[u8]) -> Result<PackedMesh, PackedFileError> {
         colors: section_bytes(bytes, colors).to_vec(),
     };
     check_content(&mesh, header.sample_count)?;
-    Ok(mesh)
+    let layers = layers.map(|section| LayersSection::parse(section_bytes(bytes, section), format)).transpose()?;
+    Ok((mesh, layers))
+}
+
+/// Where a version-2 file's layers section lies: from the first multiple of
+/// [`SECTION_ALIGN`] after the colour section to the end of the file (`None` without the
+/// flag). The section table checks that follow report a truncated file as such.
+fn layers_section(header: &Header, len: u64) -> Result<Option<Section>, PackedFileError> {
+    if header.version != VERSION || header.flags & FLAG_LAYERS == 0 {
+        // Refused later (flags are checked after the checksum).
+        return Ok(None);
+    }
+    let colors = header.sections[SECTION_COUNT - 1];
+    let Some(offset) = colors.offset.checked_add(colors.length).and_then(align_up) else {
+        return Err(PackedFileError::SectionOverflow {
+            section: "colors",
+            offset: colors.offset,
+            length: colors.length,
+        });
+    };
+    let end = header.file_size.min(len).max(offset);
+    Ok(Some(Section { offset, length: end - offset }))
 }
 
 /// Writes `mesh` to `path` atomically: the bytes go to a temporary file in the same
 /// directory, which is flushed to disk and then renamed over `path`. Errors name the path.
 pub fn write_file(path: &Path, mesh: &PackedMesh) -> Result<(), PackedFileError> {
-    let bytes = to_bytes(mesh)
+    write_file_with_layers(path, mesh, None)
+}
+
+/// [`write_file`] with a layers section ([`to_bytes_with_layers`]).
+pub fn write_file_with_layers(
+    path: &Path,
+    mesh: &PackedMesh,
+    layers: Option<&LayersSection>,
+) -> Result<(), PackedFileError> {
+    let bytes = to_bytes_with_layers(mesh, layers)
         .map_err(|source| PackedFileError::File { path: path.to_path_buf(), source: Box::new(source) })?;
     crate::atomic_write::write_atomically(path, &bytes).map_err(|error| PackedFileError::Io {
         path: error.path,
@@ -565,10 +641,16 @@ pub fn write_file(path: &Path, mesh: &PackedMesh) -> Result<(), PackedFileError>
 
 /// Reads and decodes the packed file at `path`. Errors name the path.
 pub fn read_file(path: &Path) -> Result<PackedMesh, PackedFileError> {
+    read_file_with_layers(path).map(|(mesh, _)| mesh)
+}
+
+/// [`read_file`] with the layers section ([`from_bytes_with_layers`]).
+pub fn read_file_with_layers(path: &Path) -> Result<(PackedMesh, Option<LayersSection>), PackedFileError> {
     let bytes = std::fs::read(path).map_err(|source| PackedFileError::Io {
         path: path.to_path_buf(),
         action: "read the file",
         source,
     })?;
-    from_bytes(&bytes).map_err(|source| PackedFileError::File { path: path.to_path_buf(), source: Box::new(source) })
+    from_bytes_with_layers(&bytes)
+        .map_err(|source| PackedFileError::File { path: path.to_path_buf(), source: Box::new(source) })
 }
