@@ -978,7 +978,7 @@ fn the_view_switches_to_mesh_color_textures_and_back_live() {
         "the Htex is not shown: {:?}",
         harness.state().status
     );
-    harness.get_by_label_contains("edge textures for");
+    harness.get_by_label_contains("page(s) of");
     harness.key_press(egui::Key::T);
     harness.run_steps(2);
     assert!(matches!(harness.state().shown_item(), Some(DrawItem::MeshColors(_))));
