@@ -23,7 +23,7 @@ use meshpaint_core::packing::linear::PackedMesh;
 use meshpaint_core::packing::packer::PackCache;
 use meshpaint_core::paint::picking::MeshBvh;
 use meshpaint_core::progress::Reporter;
-use meshpaint_render::{BaselineMesh, DrawItem, Gpu, GpuMct, GpuMesh, GpuPtex, MeshGeometry};
+use meshpaint_render::{BaselineMesh, DrawItem, Gpu, GpuHtex, GpuMct, GpuMesh, GpuPtex, MeshGeometry};
 
 use super::jobs::JobContext;
 use super::state::{Representation, Shown};
@@ -81,8 +81,56 @@ pub struct AlternateViews {
     /// The Mesh Color Texture of the packed mesh, with the mesh generation it was built for
     /// ([`OpenDocument::mesh_generation`]).
     pub mct: Option<(u64, Result<BuiltMct, String>)>,
+    /// The Htex of the packed mesh, with the mesh generation it was built for.
+    pub htex: Option<(u64, Result<BuiltHtex, String>)>,
     /// The packed Ptex of the packed mesh, with the mesh generation it was built for.
     pub ptex: Option<(u64, Result<BuiltPtex, String>)>,
+}
+
+/// An Htex on the GPU and what building it cost.
+#[derive(Debug)]
+pub struct BuiltHtex {
+    /// Pages, weight texture and records, drawn with the document's GPU mesh geometry.
+    pub htex: GpuHtex,
+    /// Store-independent build time (packed mesh → pages), without the upload.
+    pub build: Duration,
+    /// Quad textures (the paper's E) and faces (F).
+    pub textures: (u64, u64),
+    /// Pages (width and height, count).
+    pub pages: ([u32; 2], u32),
+    /// GPU bytes over the packed mesh's face records and colours.
+    pub bytes_over_mesh_colors: f64,
+}
+
+/// Builds the Htex of `packed` within `budget` and uploads it (a job's work).
+pub fn build_htex(
+    packed: &PackedMesh,
+    geometry: &MeshGeometry,
+    budget: &Budget,
+    gpu: &Gpu,
+    job: &JobContext,
+) -> Result<BuiltHtex, String> {
+    job.progress(0.1, "pairing halfedges and filling the pages");
+    let started = Instant::now();
+    let limits = gpu.ctx.limits();
+    let options = meshpaint_core::htex::HtexOptions::within(
+        limits.max_texture_dimension_2d,
+        limits.max_texture_array_layers,
+        budget.memory_bytes,
+    );
+    let texture =
+        meshpaint_core::htex::build(packed, &options).map_err(|error| format!("building the Htex: {error}"))?;
+    let build = started.elapsed();
+    job.progress(0.8, "uploading the pages");
+    let htex = gpu.upload_htex(geometry, &texture).map_err(|error| format!("uploading the Htex: {error}"))?;
+    let mesh_colors = (packed.face_record_bytes() + packed.color_bytes()).max(1);
+    Ok(BuiltHtex {
+        build,
+        textures: texture.texture_count(),
+        pages: ([texture.layout.page_size, texture.layout.page_height], texture.layout.pages),
+        bytes_over_mesh_colors: htex.gpu_bytes() as f64 / mesh_colors as f64,
+        htex,
+    })
 }
 
 /// A packed Ptex on the GPU and what building it cost.
@@ -158,6 +206,8 @@ pub enum AlternateView {
     PositionColors(Box<Result<GpuMesh, String>>),
     /// [`AlternateViews::mct`], built for this mesh generation.
     Mct(u64, Box<Result<BuiltMct, String>>),
+    /// [`AlternateViews::htex`], built for this mesh generation.
+    Htex(u64, Box<Result<BuiltHtex, String>>),
     /// [`AlternateViews::ptex`], built for this mesh generation.
     Ptex(u64, Box<Result<BuiltPtex, String>>),
 }
@@ -249,6 +299,21 @@ impl OpenDocument {
         }
     }
 
+    /// Whether the Htex of the current GPU mesh still has to be built.
+    pub fn htex_missing(&self) -> bool {
+        self.alternates.htex.as_ref().is_none_or(|(generation, _)| *generation != self.mesh_generation)
+    }
+
+    /// The Htex of the current GPU mesh, if it is built; `Err` says why it cannot be.
+    pub fn current_htex(&self) -> Option<Result<&BuiltHtex, &str>> {
+        match &self.alternates.htex {
+            Some((generation, built)) if *generation == self.mesh_generation => {
+                Some(built.as_ref().map_err(String::as_str))
+            }
+            _ => None,
+        }
+    }
+
     /// Whether the packed Ptex of the current GPU mesh still has to be built.
     pub fn ptex_missing(&self) -> bool {
         self.alternates.ptex.as_ref().is_none_or(|(generation, _)| *generation != self.mesh_generation)
@@ -276,10 +341,13 @@ impl OpenDocument {
     /// is built, else the mesh colors (`None` without a GPU).
     pub fn shown_item(&self, shown: Shown, representation: Representation) -> Option<DrawItem<'_>> {
         let alternate = match shown {
-            Shown::MeshColors => match (representation, self.current_mct(), self.current_ptex()) {
-                (Representation::MeshColorTexture, Some(Ok(built)), _) => Some(DrawItem::Mct(&built.mct)),
-                (Representation::PackedPtex, _, Some(Ok(built))) => Some(DrawItem::Ptex(&built.ptex)),
-                _ => None,
+            Shown::MeshColors => match representation {
+                Representation::MeshColorTexture => {
+                    self.current_mct().and_then(Result::ok).map(|b| DrawItem::Mct(&b.mct))
+                }
+                Representation::PackedPtex => self.current_ptex().and_then(Result::ok).map(|b| DrawItem::Ptex(&b.ptex)),
+                Representation::Htex => self.current_htex().and_then(Result::ok).map(|b| DrawItem::Htex(&b.htex)),
+                Representation::MeshColors => None,
             },
             Shown::SourceTexture => match &self.alternates.source_texture {
                 Some(Ok(mesh)) => Some(DrawItem::Baseline(mesh)),

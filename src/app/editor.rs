@@ -328,7 +328,7 @@ impl Editor {
         }
     }
 
-    /// Builds the Mesh Color Texture (or packed Ptex) of the open document's packed mesh on a
+    /// Builds the Mesh Color Texture (or packed Ptex, or Htex) of the open document's packed mesh on a
     /// job, when the view shows that representation and it is missing (never in paint mode,
     /// which draws the paint layout; leaving it repacks, and the texture is built again from
     /// the result).
@@ -340,6 +340,7 @@ impl Editor {
         let missing = match representation {
             Representation::MeshColors => false,
             Representation::MeshColorTexture => open.mct_missing(),
+            Representation::Htex => open.htex_missing(),
             Representation::PackedPtex => open.ptex_missing(),
         };
         if !missing || self.document.level0_only() || self.jobs.is_busy() {
@@ -352,10 +353,19 @@ impl Editor {
         let (gpu, budget) = (Arc::clone(gpu), self.budget());
         let name = representation.name();
         let started = self.jobs.start(JobKind::View, format!("Preparing {name}"), move |job| {
-            let view = if representation == Representation::PackedPtex {
-                AlternateView::Ptex(generation, Box::new(document::build_ptex(&packed, &geometry, &budget, &gpu, job)))
-            } else {
-                AlternateView::Mct(generation, Box::new(document::build_mct(&packed, &geometry, &budget, &gpu, job)))
+            let view = match representation {
+                Representation::PackedPtex => AlternateView::Ptex(
+                    generation,
+                    Box::new(document::build_ptex(&packed, &geometry, &budget, &gpu, job)),
+                ),
+                Representation::Htex => AlternateView::Htex(
+                    generation,
+                    Box::new(document::build_htex(&packed, &geometry, &budget, &gpu, job)),
+                ),
+                _ => AlternateView::Mct(
+                    generation,
+                    Box::new(document::build_mct(&packed, &geometry, &budget, &gpu, job)),
+                ),
             };
             Ok(JobOutput::View(path, Box::new(view)))
         });
@@ -382,8 +392,9 @@ impl Editor {
         let open = self.document.open.as_ref();
         let mesh = open.and_then(|d| d.gpu_mesh.as_ref()).map_or(0, |m| m.gpu_bytes());
         let mct = open.and_then(|d| d.current_mct()).and_then(Result::ok).map_or(0, |b| b.mct.gpu_bytes());
+        let htex = open.and_then(|d| d.current_htex()).and_then(Result::ok).map_or(0, |b| b.htex.gpu_bytes());
         let ptex = open.and_then(|d| d.current_ptex()).and_then(Result::ok).map_or(0, |b| b.ptex.gpu_bytes());
-        mesh + mct + ptex + self.viewport.gpu_bytes
+        mesh + mct + ptex + htex + self.viewport.gpu_bytes
     }
 
     /// The window title.
@@ -502,7 +513,8 @@ impl Editor {
                 view.representation = match view.representation {
                     Representation::MeshColors => Representation::MeshColorTexture,
                     Representation::MeshColorTexture => Representation::PackedPtex,
-                    Representation::PackedPtex => Representation::MeshColors,
+                    Representation::PackedPtex => Representation::Htex,
+                    Representation::Htex => Representation::MeshColors,
                 };
                 self.prepare_mct();
             }

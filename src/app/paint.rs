@@ -100,6 +100,7 @@ impl DocumentState {
                     // Paint mode draws mesh colors; the Mesh Color Texture is rebuilt after it.
                     open.mesh_generation += 1;
                     open.alternates.mct = None;
+                    open.alternates.htex = None;
                     open.alternates.ptex = None;
                     encoded = Some(start.encoded);
                     layout = Some(start.layout);

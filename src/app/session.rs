@@ -149,6 +149,27 @@ impl DocumentState {
                 open.alternates.mct = Some((generation, *built));
                 failed
             }
+            AlternateView::Htex(generation, built) => {
+                if generation != open.mesh_generation {
+                    log::info!("an Htex finished for colours that changed since; ignored");
+                    return;
+                }
+                let failed = built.as_ref().as_ref().err().cloned();
+                if let Ok(built) = built.as_ref() {
+                    let (e, f) = built.textures;
+                    status.set(
+                        Severity::Info,
+                        format!(
+                            "Built the Htex: {e} edge textures for {f} faces, {} ({:.2}× the mesh colors) in {:.0} ms",
+                            human_bytes(built.htex.gpu_bytes()),
+                            built.bytes_over_mesh_colors,
+                            built.build.as_secs_f64() * 1000.0
+                        ),
+                    );
+                }
+                open.alternates.htex = Some((generation, *built));
+                failed
+            }
             AlternateView::Ptex(generation, built) => {
                 if generation != open.mesh_generation {
                     log::info!("a packed Ptex finished for colours that changed since; ignored");
@@ -201,6 +222,7 @@ impl DocumentState {
         // The colours on the GPU changed: a Mesh Color Texture of the old ones is stale.
         open.mesh_generation += 1;
         open.alternates.mct = None;
+        open.alternates.htex = None;
         open.alternates.ptex = None;
         open.samples_with_mips = repacked.samples_with_mips;
         open.packed_bytes = repacked.packed_bytes;

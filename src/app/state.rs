@@ -102,6 +102,9 @@ pub enum Representation {
     /// the shared vertex and edge colours duplicated, filtered by the GPU's bilinear sampler
     /// (crates/core/src/mct; built from the packed mesh when shown, again after each repack).
     MeshColorTexture,
+    /// Htex (Barbier & Dupuy 2022): one square texture per edge in atlas pages, three
+    /// hardware bilinear fetches per pixel (crates/core/src/htex; built like MCT).
+    Htex,
     /// Packed Ptex (Kim, Hillesland, Hensley 2011): per-pair square blocks with their MIP
     /// chains and one-texel borders from the neighbours in one texture, filtered by the
     /// GPU's bilinear sampler (crates/core/src/ptex; built as Mesh Color Textures are).
@@ -110,14 +113,19 @@ pub enum Representation {
 
 impl Representation {
     /// Every choice, in the order the view panel lists them.
-    pub const ALL: [Representation; 3] =
-        [Representation::MeshColors, Representation::MeshColorTexture, Representation::PackedPtex];
+    pub const ALL: [Representation; 4] = [
+        Representation::MeshColors,
+        Representation::MeshColorTexture,
+        Representation::PackedPtex,
+        Representation::Htex,
+    ];
 
     /// The name the view panel shows.
     pub fn name(self) -> &'static str {
         match self {
             Representation::MeshColors => "Mesh colors (software filter)",
             Representation::MeshColorTexture => "Mesh Color Textures (hardware filter)",
+            Representation::Htex => "Htex (per-edge textures, hardware filter)",
             Representation::PackedPtex => "Packed Ptex (hardware filter)",
         }
     }
@@ -218,7 +226,7 @@ pub enum Action {
     ToggleShading,
     /// Cycle the filter: nearest, linear, trilinear.
     CycleFilter,
-    /// Switch the representation: mesh colors / Mesh Color Textures.
+    /// Switch the representation: mesh colors → Mesh Color Textures → Htex.
     ToggleRepresentation,
     /// Show or hide the shortcut help window.
     ToggleHelp,

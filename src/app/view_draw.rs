@@ -87,6 +87,7 @@ impl ViewDrawer {
             DrawItem::MeshColors(_) => "mesh colors",
             DrawItem::Baseline(_) => "the UV-textured source",
             DrawItem::Mct(_) => "Mesh Color Textures",
+            DrawItem::Htex(_) => "Htex",
             DrawItem::Ptex(_) => "packed Ptex",
         };
         if self.last_logged_pipeline != Some(pipeline) {

@@ -1,8 +1,8 @@
 //! `meshpaint bench render`: frame time of the UV-texture baseline, of every mesh-colors
-//! filter mode and of the Mesh Color Textures and packed Ptex built from the same buffers (the
-//! representation axis: every row names its representation) on the same mesh, view and
-//! image size, interleaved in one run, as ratios to the baseline; plus the GPU memory each
-//! path holds and the MCT's and packed Ptex's build times.
+//! filter mode and of the Mesh Color Textures, packed Ptex and Htex built from the same
+//! buffers (the representation axis: every row names its representation) on the same mesh,
+//! view and image size, interleaved in one run, as ratios to the baseline; plus the GPU
+//! memory each path holds and the MCT's, packed Ptex's and Htex's build times.
 //!
 //! A frame is one render pass into an offscreen target, submitted and waited for
 //! (`poll(wait)`), so on lavapipe it measures the rasteriser's whole work. Modes are
@@ -18,6 +18,7 @@ use std::time::Instant;
 
 use meshpaint_core::camera::{DEFAULT_PITCH_DEGREES, DEFAULT_YAW_DEGREES, OrbitCamera, default_camera};
 use meshpaint_core::colors::format::ColorFormat;
+use meshpaint_core::htex::HtexOptions;
 use meshpaint_core::io::document::{Document, bounds};
 use meshpaint_core::mesh::import::import_gltf;
 use meshpaint_core::mesh::scene::Texture;
@@ -31,9 +32,10 @@ use meshpaint_render::{
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeTiming {
     /// `baseline-uv`, `nearest`, `linear`, `mip-1`, `trilinear`, `mct-linear`, `mct-mip-1`,
-    /// `mct-trilinear`, `ptex-linear`, `ptex-mip-1`, `ptex-trilinear`, `mct-anisotropic`.
+    /// `mct-trilinear`, `ptex-linear`, `ptex-mip-1`, `ptex-trilinear`, `htex-linear`,
+    /// `htex-mip-1`, `htex-trilinear`, `mct-anisotropic`.
     pub name: String,
-    /// `uv-texture`, `mesh-colors`, `mct` or `ptex`.
+    /// `uv-texture`, `mesh-colors`, `mct`, `ptex` or `htex`.
     pub representation: &'static str,
     /// Median frame time, seconds.
     pub median_seconds: f64,
@@ -68,6 +70,13 @@ pub struct RenderBench {
     pub modes: Vec<ModeTiming>,
     /// Seconds to build the Mesh Color Texture from the packed buffers.
     pub mct_build_seconds: f64,
+    /// Seconds to build the Htex from the packed buffers.
+    pub htex_build_seconds: f64,
+    /// Htex's quad textures (the paper's E) and the faces (F).
+    pub htex_textures: (u64, u64),
+    /// The largest colour jump across Htex's intrinsic edges per level (equalised corners),
+    /// then at level 0 without equalisation.
+    pub htex_jumps: Vec<serde_json::Value>,
     /// Seconds to build the packed Ptex from the packed buffers.
     pub ptex_build_seconds: f64,
 }
@@ -103,6 +112,10 @@ impl RenderBench {
             "triangles": self.triangles,
             "baseline": self.baseline,
             "mct_build_ms": self.mct_build_seconds * 1e3,
+            "htex_build_ms": self.htex_build_seconds * 1e3,
+            "htex_textures": self.htex_textures.0,
+            "htex_faces": self.htex_textures.1,
+            "htex_jumps": self.htex_jumps,
             "ptex_build_ms": self.ptex_build_seconds * 1e3,
             "modes": modes,
         })
@@ -207,6 +220,7 @@ pub fn bench_render(
     let texture = meshpaint_core::mct::build(&packed, max_dimension, u64::MAX)?;
     let mct_build_seconds = build_start.elapsed().as_secs_f64();
     let mct = gpu.upload_mct(&mesh.geometry(), &texture)?;
+    let (htex, htex_build_seconds, htex_textures, htex_jumps) = build_htex(&gpu, &packed, &mesh)?;
     let build_start = Instant::now();
     let packed_ptex = meshpaint_core::ptex::build(&packed, max_dimension, u64::MAX)?;
     let ptex_build_seconds = build_start.elapsed().as_secs_f64();
@@ -216,8 +230,8 @@ pub fn bench_render(
     let timer = FrameTimer::new(&gpu, width, height);
 
     let geometry_bytes = mesh.gpu_bytes() - mesh.atlas_bytes() - mesh.face_record_bytes();
-    let ptex_bytes = geometry_bytes + ptex.gpu_bytes();
-    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 12] = [
+    let (ptex_bytes, htex_bytes) = (geometry_bytes + ptex.gpu_bytes(), geometry_bytes + htex.gpu_bytes());
+    let paths: [(&str, &str, DrawItem<'_>, FilterMode, u64); 15] = [
         ("baseline-uv", "uv-texture", DrawItem::Baseline(&baseline), FilterMode::Linear, baseline.gpu_bytes()),
         ("nearest", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Nearest, mesh.gpu_bytes()),
         ("linear", "mesh-colors", DrawItem::MeshColors(&mesh), FilterMode::Linear, mesh.gpu_bytes()),
@@ -229,6 +243,9 @@ pub fn bench_render(
         ("ptex-linear", "ptex", DrawItem::Ptex(&ptex), FilterMode::Linear, ptex_bytes),
         ("ptex-mip-1", "ptex", DrawItem::Ptex(&ptex), FilterMode::MipLevel(1), ptex_bytes),
         ("ptex-trilinear", "ptex", DrawItem::Ptex(&ptex), FilterMode::Trilinear, ptex_bytes),
+        ("htex-linear", "htex", DrawItem::Htex(&htex), FilterMode::Linear, htex_bytes),
+        ("htex-mip-1", "htex", DrawItem::Htex(&htex), FilterMode::MipLevel(1), htex_bytes),
+        ("htex-trilinear", "htex", DrawItem::Htex(&htex), FilterMode::Trilinear, htex_bytes),
         // Trilinear where the adapter has no anisotropic filtering (`anisotropic` in the report).
         // Last and timed after the interleaved rounds (`INTERLEAVED`): on lavapipe it is ~100×
         // the others and would leave the frame after it with cold caches.
@@ -240,7 +257,7 @@ pub fn bench_render(
     for &(_, _, item, filter, _) in &paths {
         timer.frame(item, filter, camera);
     }
-    const INTERLEAVED: usize = 11;
+    const INTERLEAVED: usize = 14;
     for modes in [0..INTERLEAVED, INTERLEAVED..paths.len()] {
         for _ in 0..frames.max(1) {
             for k in modes.clone() {
@@ -277,7 +294,43 @@ pub fn bench_render(
         baseline: baseline_name,
         modes,
         mct_build_seconds,
+        htex_build_seconds,
+        htex_textures,
+        htex_jumps,
         ptex_build_seconds,
+    })
+}
+
+/// [`build_htex`]'s result: the uploaded Htex, build seconds, (E, F) and the jump entries.
+type BuiltHtex = (meshpaint_render::GpuHtex, f64, (u64, u64), Vec<serde_json::Value>);
+
+/// The Htex of `packed` uploaded with `mesh`'s geometry, its build time in seconds, its
+/// texture count (E, F) and the largest colour jumps across its intrinsic edges per level
+/// (CPU evaluation), then at level 0 without corner equalisation (the paper's corner-texel
+/// discontinuity).
+fn build_htex(
+    gpu: &Gpu,
+    packed: &meshpaint_core::packing::linear::PackedMesh,
+    mesh: &meshpaint_render::GpuMesh,
+) -> Result<BuiltHtex, BenchRenderError> {
+    let limits = gpu.ctx.limits();
+    let options = HtexOptions::within(limits.max_texture_dimension_2d, limits.max_texture_array_layers, u64::MAX);
+    let build_start = Instant::now();
+    let texture = meshpaint_core::htex::build(packed, &options)?;
+    let seconds = build_start.elapsed().as_secs_f64();
+    let htex = gpu.upload_htex(&mesh.geometry(), &texture)?;
+    let mut jumps: Vec<serde_json::Value> =
+        (0..texture.layout.levels).map(|level| jumps_json(level, true, texture.jumps(level, 17))).collect();
+    let raw = meshpaint_core::htex::build(packed, &HtexOptions { equalize_corners: false, ..options })?;
+    jumps.push(jumps_json(0, false, raw.jumps(0, 17)));
+    Ok((htex, seconds, texture.texture_count(), jumps))
+}
+
+/// One `htex_jumps` entry: the largest jumps (8-bit steps) at `level`.
+fn jumps_json(level: u32, equalized: bool, jumps: meshpaint_core::htex::jumps::Jumps) -> serde_json::Value {
+    serde_json::json!({
+        "level": level, "corners_equalized": equalized,
+        "mesh_edges_steps": jumps.mesh_edges, "spokes_steps": jumps.spokes,
     })
 }
 
@@ -345,6 +398,9 @@ pub enum BenchRenderError {
     /// The Mesh Color Texture cannot be built.
     #[error(transparent)]
     Mct(#[from] meshpaint_core::mct::MctError),
+    /// The Htex cannot be built.
+    #[error(transparent)]
+    Htex(#[from] meshpaint_core::htex::HtexError),
     /// The packed Ptex cannot be built.
     #[error(transparent)]
     Ptex(#[from] meshpaint_core::ptex::PtexError),

@@ -149,6 +149,9 @@ pub(super) enum Representation {
     /// Packed Ptex: per-pair square blocks with every MIP level, sorted by resolution into one
     /// texture with one-texel borders from the neighbours (crates/core/src/ptex; docs/PTEX.md).
     Ptex,
+    /// Htex: one square texture per edge (a halfedge and its twin) in atlas pages, three
+    /// hardware bilinear fetches per pixel (docs/HTEX.md).
+    Htex,
 }
 
 /// What [`OutputArgs::write`] wrote.

@@ -142,11 +142,12 @@ pub(super) enum BenchCommand {
         #[command(flatten)]
         close_up: CloseUpArgs,
     },
-    /// What every choice costs and buys: representation (mesh colors, Mesh Color Texture) ×
-    /// filter × resolution (uniform R 1…32 and --error bounds) × colour format, per view at
-    /// several distances — PSNR, max error, FLIP against a 4×4-supersampled reference, samples,
-    /// GPU bytes, pack and MCT build time, frame-time ratio to the UV baseline (interleaved),
-    /// dab throughput; plus seam jumps of both representations and BVH presets. One JSON object
+    /// What every choice costs and buys: representation (mesh colors, Mesh Color Texture,
+    /// packed Ptex, Htex) × filter × resolution (uniform R 1…32 and --error bounds) × colour
+    /// format, per view at several distances — PSNR, max error, FLIP against a
+    /// 4×4-supersampled reference, samples, GPU bytes, pack and build time, frame-time ratio
+    /// to the UV baseline (interleaved), dab throughput; plus seam jumps of every
+    /// representation and BVH presets. One JSON object
     /// per line; with --out, error-vs-cost plots (PNG).
     Trade(TradeArgs),
     /// Picking and painting: BVH presets, pick latency, dab time and samples/s for brushes
@@ -258,15 +259,24 @@ pub(super) struct TradeArgs {
     /// Colour formats measured (comma-separated; default: rgba8, rgba16f, rgba32f).
     #[arg(long, value_parser = parse_format, value_delimiter = ',')]
     pub(super) formats: Vec<ColorFormat>,
-    /// Leave out the Mesh Color Texture rows (mesh colors only).
+    /// The representations measured (comma-separated: mesh-colors, mct, ptex, htex; default
+    /// all four; mesh colors are always measured).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub(super) representation: Vec<super::args::Representation>,
+    /// Leave out the Mesh Color Texture rows (removes mct from --representation).
     #[arg(long)]
     pub(super) no_mct: bool,
-    /// Leave out the packed Ptex rows.
+    /// Leave out the packed Ptex rows (removes ptex from --representation).
     #[arg(long)]
     pub(super) no_ptex: bool,
 }
 
 impl TradeArgs {
+    /// Whether `--representation` lists `r` (or is empty: every representation).
+    fn wants(&self, r: super::args::Representation) -> bool {
+        self.representation.is_empty() || self.representation.contains(&r)
+    }
+
     /// The study these flags ask for.
     fn options(&self) -> Result<meshpaint::bench::trade::TradeOptions> {
         use meshpaint_core::colors::layout::Resolution;
@@ -279,8 +289,9 @@ impl TradeArgs {
             max_resolution: Resolution::new(self.max_resolution).context("--max-resolution")?,
             uniform: (0..=max_uniform.log2()).filter_map(|l| Resolution::from_log2(l).ok()).collect(),
             formats: if self.formats.is_empty() { ColorFormat::ALL.to_vec() } else { self.formats.clone() },
-            mct: !self.no_mct,
-            ptex: !self.no_ptex,
+            mct: !self.no_mct && self.wants(super::args::Representation::Mct),
+            ptex: !self.no_ptex && self.wants(super::args::Representation::Ptex),
+            htex: self.wants(super::args::Representation::Htex),
             frames: self.frames,
             error_bounds: self.errors.clone(),
             ..Default::default()

@@ -52,7 +52,7 @@ pub(super) struct ExportArgs {
     /// What a non-.glb OUT holds: mesh-colors (a packed file), mct (a Mesh Color Texture
     /// file: mesh, face records, band table and one atlas in --format; docs/MCT_FORMAT.md) or
     /// ptex (a packed Ptex file: mesh, face records, nRes/nRow tables and one texture;
-    /// docs/PTEX_FORMAT.md).
+    /// docs/PTEX_FORMAT.md); htex has no file yet (render it).
     #[arg(
         long,
         value_enum,
@@ -76,6 +76,11 @@ enum ColorsArg {
 pub(super) fn run(args: ExportArgs) -> Result<()> {
     if args.representation == Representation::Mct {
         return export_mct(&args);
+    }
+    if args.representation == Representation::Htex {
+        anyhow::bail!(
+            "--representation htex has no file format yet: render it with `meshpaint render --representation htex`"
+        );
     }
     if args.representation == Representation::Ptex {
         return export_ptex(&args);

@@ -57,9 +57,10 @@ pub(super) struct RenderArgs {
     #[arg(long, conflicts_with = "baseline_uv")]
     position_colors: bool,
     /// mesh-colors (software filter in the shader), mct (Mesh Color Textures: the same
-    /// colours in a 2D atlas filtered by the GPU's sampler; docs/MCT.md) or ptex (packed
-    /// Ptex: per-pair square blocks with borders, hardware bilinear; docs/PTEX.md). Nearest
-    /// filters draw bilinear with mct and ptex; anisotropic draws trilinear with ptex.
+    /// colours in a 2D atlas filtered by the GPU's sampler; docs/MCT.md), ptex (packed Ptex:
+    /// per-pair square blocks with borders, hardware bilinear; docs/PTEX.md) or htex (one
+    /// texture per edge, three hardware fetches; docs/HTEX.md). Nearest filters draw bilinear
+    /// with mct, ptex and htex; anisotropic draws trilinear with ptex and htex.
     #[arg(long, value_enum, default_value_t = Representation::MeshColors, conflicts_with = "baseline_uv")]
     representation: Representation,
 }
@@ -101,6 +102,45 @@ fn filter_mode(filter: RenderFilter, level: Option<u32>) -> Result<FilterMode> {
         (RenderFilter::Anisotropic, None) => FilterMode::Anisotropic,
         (RenderFilter::Anisotropic, Some(_)) => anyhow::bail!("--level does not apply to --filter anisotropic"),
     })
+}
+
+/// `--representation htex`: the Htex of `packed` (the packed mesh of `mesh`) within
+/// `max_bytes`, drawn with `settings`.
+fn htex_image(
+    gpu: &Gpu,
+    packed: &meshpaint_core::packing::linear::PackedMesh,
+    mesh: &meshpaint_render::GpuMesh,
+    max_bytes: u64,
+    settings: &RenderSettings,
+    args: &RenderArgs,
+) -> Result<image::RgbaImage> {
+    let limits = gpu.ctx.limits();
+    let options = meshpaint_core::htex::HtexOptions::within(
+        limits.max_texture_dimension_2d,
+        limits.max_texture_array_layers,
+        max_bytes,
+    );
+    let texture = meshpaint_core::htex::build(packed, &options)
+        .with_context(|| format!("{}: building the Htex", args.file.display()))?;
+    let htex = gpu.upload_htex(&mesh.geometry(), &texture)?;
+    Ok(gpu.render_image(DrawItem::Htex(&htex), settings, args.width, args.height)?)
+}
+
+/// `--representation ptex`: the packed Ptex of `packed` (the packed mesh of `mesh`) within
+/// `max_bytes`, drawn with `settings`.
+fn ptex_image(
+    gpu: &Gpu,
+    packed: &meshpaint_core::packing::linear::PackedMesh,
+    mesh: &meshpaint_render::GpuMesh,
+    max_bytes: u64,
+    settings: &RenderSettings,
+    args: &RenderArgs,
+) -> Result<image::RgbaImage> {
+    let max_dimension = gpu.ctx.limits().max_texture_dimension_2d;
+    let texture = meshpaint_core::ptex::build(packed, max_dimension, max_bytes)
+        .with_context(|| format!("{}: building the packed Ptex", args.file.display()))?;
+    let ptex = gpu.upload_ptex(&mesh.geometry(), &texture)?;
+    Ok(gpu.render_image(DrawItem::Ptex(&ptex), settings, args.width, args.height)?)
 }
 
 /// A packed Ptex file (docs/PTEX_FORMAT.md) drawn as the texture it holds: the image and
@@ -199,13 +239,13 @@ pub(super) fn run(args: RenderArgs) -> Result<()> {
                 let mct = gpu.upload_mct(&mesh.geometry(), &texture)?;
                 gpu.render_image(DrawItem::Mct(&mct), &settings(mesh.bounds), args.width, args.height)?
             }
+            Representation::Htex => {
+                let packed = shown.pack(document.display_format())?;
+                htex_image(&gpu, &packed, &mesh, budget.memory_bytes, &settings(mesh.bounds), &args)?
+            }
             Representation::Ptex => {
                 let packed = shown.pack(document.display_format())?;
-                let max_dimension = gpu.ctx.limits().max_texture_dimension_2d;
-                let texture = meshpaint_core::ptex::build(&packed, max_dimension, budget.memory_bytes)
-                    .with_context(|| format!("{}: building the packed Ptex", args.file.display()))?;
-                let ptex = gpu.upload_ptex(&mesh.geometry(), &texture)?;
-                gpu.render_image(DrawItem::Ptex(&ptex), &settings(mesh.bounds), args.width, args.height)?
+                ptex_image(&gpu, &packed, &mesh, budget.memory_bytes, &settings(mesh.bounds), &args)?
             }
         };
         (image, mesh.face_count, mesh.atlas.samples)

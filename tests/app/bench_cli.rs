@@ -141,6 +141,13 @@ fn bench_render_reports_every_mode_against_the_baseline() {
     // The anisotropic MCT row is there whether or not the adapter filters anisotropically.
     assert!(report["anisotropic"].is_boolean(), "{report}");
     assert!(modes.iter().any(|m| m["mode"] == "mct-anisotropic" && m["representation"] == "mct"), "{report}");
+    // Htex: three filters, its texture count and the corner jumps per level.
+    for mode in ["htex-linear", "htex-mip-1", "htex-trilinear"] {
+        assert!(modes.iter().any(|m| m["mode"] == mode && m["representation"] == "htex"), "{report}");
+    }
+    assert!(report["htex_textures"].as_u64().unwrap() > report["htex_faces"].as_u64().unwrap(), "{report}");
+    let jumps = report["htex_jumps"].as_array().unwrap();
+    assert!(jumps.iter().any(|j| j["corners_equalized"] == false), "{report}");
     for mode in ["ptex-linear", "ptex-mip-1", "ptex-trilinear"] {
         assert!(modes.iter().any(|m| m["mode"] == mode && m["representation"] == "ptex"), "{mode}: {report}");
     }

@@ -47,15 +47,23 @@ fn bench_trade_on_box_textured_prints_complete_rows_and_writes_plots() {
     let representation = |r: &str| configs.iter().copied().filter(|row| row["representation"] == r).collect::<Vec<_>>();
     // (R = 1, 2, 4 and two bounds) × 3 formats × 5 filters × 4 views.
     assert_eq!(representation("mesh-colors").len(), 5 * 3 * 5 * views);
-    // The same packs as MCT and as packed Ptex × 4 filters each (no nearest), less any format
-    // whose MCT or Ptex was skipped.
+    // The same packs as MCT, as packed Ptex and as Htex × 4 filters each (no nearest), less
+    // any format whose MCT, Ptex or Htex was skipped.
     let skipped = kind("skipped");
-    for r in ["mct", "ptex"] {
+    for r in ["mct", "ptex", "htex"] {
         let skipped_here = skipped.iter().filter(|row| row["representation"] == r).count();
         assert_eq!(representation(r).len() + skipped_here * 4 * views, 5 * 3 * 4 * views, "{r}: {skipped:?}");
     }
-    let all = ["mesh-colors", "mct", "ptex"].map(|r| representation(r).len());
+    let all = ["mesh-colors", "mct", "ptex", "htex"].map(|r| representation(r).len());
     assert_eq!(all.iter().sum::<usize>(), configs.len());
+    for row in representation("htex") {
+        for key in ["gpu_bytes", "htex_bytes", "htex_build_seconds", "htex_textures", "htex_e_over_f", "frame_ratio"] {
+            let value = number(row, key);
+            assert!(value.is_finite() && value > 0.0, "{key} = {value} in {row}");
+        }
+        assert!(number(row, "htex_bytes") > number(row, "htex_inside_texel_bytes"), "borders and tables: {row}");
+    }
+    assert!(kind("seam").iter().any(|row| row["representation"] == "htex"), "Htex seam rows");
     for row in representation("ptex") {
         assert!(["linear", "mip-1", "mip-2", "trilinear"].contains(&row["filter"].as_str().unwrap()), "{row}");
         for key in ["gpu_bytes", "ptex_bytes", "ptex_bytes_over_mesh_colors", "ptex_build_seconds", "frame_ratio"] {

@@ -910,7 +910,8 @@ fn comparing_an_untextured_mesh_says_why_and_shows_the_mesh_colors() {
 /// with its cost and its PSNR against the mesh colors' own filter in this view (the Duck at
 /// R = 8: MCT's bilinear differs from mesh colors' piecewise-linear filter inside faces
 /// only — docs/MCT.md); paint mode draws mesh colors, and leaving it builds the texture again
-/// from the repacked colours. T switches on to the packed Ptex, then back to mesh colors.
+/// from the repacked colours. T switches on to the packed Ptex, the Htex, then back to mesh
+/// colors.
 #[test]
 fn the_view_switches_to_mesh_color_textures_and_back_live() {
     use meshpaint::app::state::Representation;
@@ -956,8 +957,7 @@ fn the_view_switches_to_mesh_color_textures_and_back_live() {
         Some(DrawItem::Mct(mct)) => assert_eq!(mct.atlas_size, first_atlas, "same resolutions, same layout"),
         _ => panic!("the texture was not rebuilt after paint mode: {:?}", harness.state().status),
     }
-    // T switches on to the packed Ptex (built on a job, its cost shown), then back to the
-    // mesh colors.
+    // T switches on to the packed Ptex (built on a job, its cost shown).
     harness.key_press(egui::Key::T);
     harness.run_steps(2);
     assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "building the packed Ptex timed out");
@@ -968,6 +968,17 @@ fn the_view_switches_to_mesh_color_textures_and_back_live() {
         harness.state().status
     );
     harness.get_by_label_contains("the mesh colors' buffers");
+    // T switches on to the Htex (built on a job, its cost shown), then back to mesh colors.
+    harness.key_press(egui::Key::T);
+    harness.run_steps(2);
+    assert!(harness.state_mut().wait_for_job(JOB_TIMEOUT), "building the Htex timed out");
+    harness.run_steps(3);
+    assert!(
+        matches!(harness.state().shown_item(), Some(DrawItem::Htex(_))),
+        "the Htex is not shown: {:?}",
+        harness.state().status
+    );
+    harness.get_by_label_contains("page(s) of");
     harness.key_press(egui::Key::T);
     harness.run_steps(2);
     assert!(matches!(harness.state().shown_item(), Some(DrawItem::MeshColors(_))));

@@ -19,6 +19,7 @@
 //! | [`paint`] | [`paint::picking`] (obvhs BVH, watertight rays), [`paint::occlusion`] (a CPU depth map of the view: brush occlusion without a ray per sample), [`paint::brush`] (colour / blur / resolution brushes, tools, replay), [`paint::undo`] (per stroke, memory cap; the one write path, `StoreWriter`), [`paint::split`] (that write path split per element for parallel dabs), [`paint::optimize`] (lower each face's R while the error stays within a bound) |
 //! | [`layers`] | material layers (docs/LAYERS.md): [`layers::blend`] (normal, multiply, add, overlay over a backdrop, straight alpha), [`layers::layer`] (name, visibility, opacity, blend, content and paintable mask, each store with its own undo), [`layers::compose`] (the composite sample by sample, per face or per dirty element), [`layers::stack`] (painting the active layer through the one write path, keeping the composite current), [`layers::ops`] (add, delete, reorder, opacity, blend, visibility, rename, mask; undo and redo in one history with the paint steps) |
 //! | [`mct`] | Mesh Color Textures (Yuksel 2017): packed mesh colors → one 2D atlas the GPU's bilinear sampler filters ([`mct::layout`]: pairs, tents and squares, 4-byte records; [`mct::build`]; [`mct::sample`]: the CPU evaluation the shader is tested against; [`mct::file`]: the MCT file, docs/MCT_FORMAT.md) |
+//! | [`htex`] | Htex (Barbier & Dupuy 2022): packed mesh colors → one square texture per edge (halfedge + twin) in atlas pages with zero borders, three fetches with a border-normalisation channel ([`htex::halfedge`], [`htex::layout`], [`htex::build`], [`htex::sample`]: the CPU evaluation the shader is tested against, [`htex::jumps`]) |
 //! | [`ptex`] | packed Ptex (Kim, Hillesland, Hensley 2011): per-pair square blocks with every MIP level, sorted by resolution into one texture with one-texel borders from the neighbours ([`ptex::layout`]: pairs, `nRes` / `nRow`; [`ptex::build`]; [`ptex::sample`]: the CPU evaluation of bilinear and trilinear) |
 //! | [`convert`] | one signal into another: [`convert::bake`] (texture → mesh colors, point bake), [`convert::least_squares`] (the bake refined to the least-squares fit of the reconstruction), [`convert::adaptive`] (each face at the resolution its content needs), [`convert::bake_uv`] (mesh colors → the model's UV texture), [`convert::subdivide`] (1→4 midpoint split of a scene, budget first) |
 //! | [`io`] | files only: [`io::document`] (open glTF, OBJ, PLY, STL or packed files into a store — the one open path; pack for export), [`io::export_gltf`], [`io::export_fit`], [`io::export_textured`], [`io::autosave`] |
@@ -54,6 +55,7 @@ pub mod atomic_write;
 pub mod camera;
 pub mod colors;
 pub mod convert;
+pub mod htex;
 pub mod io;
 pub mod layers;
 pub mod mct;

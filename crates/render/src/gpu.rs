@@ -78,6 +78,16 @@ impl Gpu {
         GpuMct::upload(&self.ctx, self.renderer.layouts(), geometry, mct)
     }
 
+    /// Uploads the Htex `htex`, built from the packed mesh whose GPU mesh has the geometry
+    /// `geometry`.
+    pub fn upload_htex(
+        &self,
+        geometry: &MeshGeometry,
+        htex: &meshpaint_core::htex::HtexTexture,
+    ) -> Result<super::GpuHtex, RenderError> {
+        super::GpuHtex::upload(&self.ctx, self.renderer.layouts(), geometry, htex)
+    }
+
     /// Uploads the packed Ptex `ptex`, built from the packed mesh whose GPU mesh has the
     /// geometry `geometry` ([`GpuMesh::geometry`]).
     pub fn upload_ptex(&self, geometry: &MeshGeometry, ptex: &PackedPtex) -> Result<GpuPtex, RenderError> {

@@ -10,6 +10,7 @@ pub struct BindLayouts {
     mesh: wgpu::BindGroupLayout,
     baseline: wgpu::BindGroupLayout,
     mct: wgpu::BindGroupLayout,
+    htex: wgpu::BindGroupLayout,
 }
 
 impl BindLayouts {
@@ -111,7 +112,8 @@ impl BindLayouts {
                 ),
             ],
         });
-        BindLayouts { mesh: mesh_layout, baseline: baseline_layout, mct: mct_layout }
+        let htex = htex_layout(device);
+        BindLayouts { mesh: mesh_layout, baseline: baseline_layout, mct: mct_layout, htex }
     }
 
     /// The mesh-colors pipeline's layout (uniforms; positions, vertex ids and face records
@@ -126,10 +128,41 @@ impl BindLayouts {
         &self.mct
     }
 
+    /// The Htex pipeline's layout (`htex_layout`).
+    pub fn htex(&self) -> &wgpu::BindGroupLayout {
+        &self.htex
+    }
+
     /// The baseline pipeline's layout (uniforms, texture, sampler).
     pub fn baseline(&self) -> &wgpu::BindGroupLayout {
         &self.baseline
     }
+}
+
+/// The bind-group layout of shaders/htex.wgsl (keep in sync with its `@group(0)`): the
+/// mesh's geometry (1, 2, 5), records and origins (3, both stages), pages (4), the bilinear
+/// sampler (6), the border-normalisation texture (7).
+fn htex_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let texture = |binding, stages, sample_type, view_dimension| {
+        layout_entry(binding, stages, wgpu::BindingType::Texture { sample_type, view_dimension, multisampled: false })
+    };
+    let (v, vf, f) = (wgpu::ShaderStages::VERTEX, wgpu::ShaderStages::VERTEX_FRAGMENT, wgpu::ShaderStages::FRAGMENT);
+    let d2 = wgpu::TextureViewDimension::D2;
+    let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
+    let filtered = wgpu::TextureSampleType::Float { filterable: true };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("htex layout"),
+        entries: &[
+            uniform_entry(0),
+            texture(1, v, unfiltered, d2),
+            texture(2, v, wgpu::TextureSampleType::Uint, d2),
+            texture(3, vf, wgpu::TextureSampleType::Uint, d2),
+            texture(5, v, unfiltered, d2),
+            texture(4, f, filtered, wgpu::TextureViewDimension::D2Array),
+            layout_entry(6, f, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)),
+            texture(7, f, filtered, d2),
+        ],
+    })
 }
 
 fn layout_entry(binding: u32, visibility: wgpu::ShaderStages, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {

@@ -38,6 +38,7 @@ mod baseline;
 mod context;
 mod gpu;
 mod heat;
+mod htex;
 mod layouts;
 mod mct;
 mod mesh_gpu;
@@ -51,6 +52,7 @@ pub use baseline::{BaselineMesh, BaselineSource, BaselineVertex, mip_chain_linea
 pub use context::{GpuContext, backends_from_env};
 pub use gpu::{Gpu, PaintStart, PaintUpload};
 pub use heat::{HEAT_COLORS, heat_color};
+pub use htex::GpuHtex;
 pub use layouts::BindLayouts;
 pub use mct::GpuMct;
 pub use mesh_gpu::{
@@ -60,8 +62,8 @@ pub use partial::{FaceSubset, Scissor};
 pub use ptex::{GpuPtex, GpuPtexSlice, gpu_tables};
 pub use readback::read_texture;
 pub use renderer::{
-    DrawItem, FRAME_WGSL, FilterMode, MCT_WGSL, MESH_COLORS_WGSL, Overlays, PTEX_WGSL, RenderSettings, RenderTarget,
-    Renderer, Shading, UV_BASELINE_WGSL,
+    DrawItem, FRAME_WGSL, FilterMode, HTEX_WGSL, MCT_WGSL, MESH_COLORS_WGSL, Overlays, PTEX_WGSL, RenderSettings,
+    RenderTarget, Renderer, Shading, UV_BASELINE_WGSL,
 };
 pub use uniforms::FrameUniforms;
 

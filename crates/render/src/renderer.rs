@@ -33,6 +33,15 @@ pub const MCT_WGSL: &str = concat!(
     "\n",
     include_str!("../shaders/mct.wgsl")
 );
+/// The Htex shader exactly as its pipelines compile it: shaders/frame.wgsl,
+/// shaders/mesh_common.wgsl and shaders/htex.wgsl (crates/render/tests/gpu/shaders.rs validates it).
+pub const HTEX_WGSL: &str = concat!(
+    include_str!("../shaders/frame.wgsl"),
+    "\n",
+    include_str!("../shaders/mesh_common.wgsl"),
+    "\n",
+    include_str!("../shaders/htex.wgsl")
+);
 /// The packed Ptex shader exactly as its pipelines compile it: shaders/frame.wgsl,
 /// shaders/mesh_common.wgsl and shaders/ptex.wgsl (crates/render/tests/gpu/shaders.rs validates it).
 pub const PTEX_WGSL: &str = concat!(
@@ -168,6 +177,9 @@ pub enum DrawItem<'a> {
     /// A Mesh Color Texture through the MCT pipeline (hardware bilinear; nearest filter
     /// modes draw bilinear: MCT has no hexagonal nearest).
     Mct(&'a GpuMct),
+    /// An Htex through the Htex pipeline (three bilinear fetches per level; nearest filter
+    /// modes draw bilinear, anisotropic draws trilinear).
+    Htex(&'a super::GpuHtex),
     /// A packed Ptex through the Ptex pipeline (hardware bilinear; nearest filter modes
     /// draw bilinear, anisotropic draws trilinear).
     Ptex(&'a GpuPtex),
@@ -180,6 +192,7 @@ impl DrawItem<'_> {
             DrawItem::MeshColors(mesh) => mesh.origin,
             DrawItem::Baseline(mesh) => mesh.origin,
             DrawItem::Mct(mct) => mct.origin,
+            DrawItem::Htex(htex) => htex.origin,
             DrawItem::Ptex(ptex) => ptex.origin,
         }
     }
@@ -216,6 +229,7 @@ pub struct Renderer {
     /// [`mct_pipeline_index`]), each built the first time it draws.
     mct_module: wgpu::ShaderModule,
     mct_pipelines: [OnceLock<wgpu::RenderPipeline>; MCT_PIPELINES],
+    htex: HtexPipelines,
     /// The packed Ptex shader and its pipelines, one per `LEVEL_MODE` (fixed, automatic) and
     /// set of [`MCT_FLAG_BITS`], each built the first time it draws.
     ptex_module: wgpu::ShaderModule,
@@ -241,6 +255,44 @@ const MCT_LEVEL_ANISOTROPIC: u32 = 2;
 /// The index of the MCT pipeline for `level_mode` (fixed, automatic or anisotropic) and `flags`.
 fn mct_pipeline_index(level_mode: u32, flags: u32) -> usize {
     level_mode.min(MCT_LEVEL_ANISOTROPIC) as usize * (MCT_FLAG_BITS as usize + 1) + (flags & MCT_FLAG_BITS) as usize
+}
+
+/// The `FLAG_*` bits the Htex shader is specialised for (`HTEX_FLAGS`).
+const HTEX_FLAG_BITS: u32 =
+    FrameUniforms::FLAG_LIT | FrameUniforms::FLAG_WIREFRAME | FrameUniforms::FLAG_HEATMAP | FrameUniforms::FLAG_SMOOTH;
+
+/// The Htex shader and its pipelines (`LEVEL_MODE` fixed or automatic × flag sets).
+#[derive(Debug)]
+struct HtexPipelines {
+    module: wgpu::ShaderModule,
+    pipelines: [OnceLock<wgpu::RenderPipeline>; 2 * (HTEX_FLAG_BITS as usize + 1)],
+}
+
+impl HtexPipelines {
+    fn new(ctx: &GpuContext) -> Self {
+        let module = ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("htex"),
+            source: wgpu::ShaderSource::Wgsl(HTEX_WGSL.into()),
+        });
+        HtexPipelines { module, pipelines: std::array::from_fn(|_| OnceLock::new()) }
+    }
+
+    /// The pipeline for `level_mode` (0 fixed, else automatic) and `flags`.
+    fn get(
+        &self,
+        ctx: &GpuContext,
+        layouts: &BindLayouts,
+        target: (wgpu::TextureFormat, (wgpu::CompareFunction, bool)),
+        level_mode: u32,
+        flags: u32,
+    ) -> &wgpu::RenderPipeline {
+        let (mode, flags) = (level_mode.min(1), flags & HTEX_FLAG_BITS);
+        self.pipelines[(mode * (HTEX_FLAG_BITS + 1) + flags) as usize].get_or_init(|| {
+            let constants = [("LEVEL_MODE", f64::from(mode)), ("HTEX_FLAGS", f64::from(flags))];
+            let label = format!("htex (level mode {mode}, flags {flags})");
+            Renderer::pipeline(ctx, &label, &self.module, &constants, layouts.htex(), &[], target)
+        })
+    }
 }
 
 /// The depth test of a full frame: nearer wins, ties go to the face drawn first.
@@ -307,6 +359,7 @@ impl Renderer {
             baseline_pipeline,
             mct_module,
             mct_pipelines: std::array::from_fn(|_| OnceLock::new()),
+            htex: HtexPipelines::new(ctx),
             ptex_module,
             ptex_pipelines: std::array::from_fn(|_| OnceLock::new()),
         };
@@ -484,6 +537,11 @@ impl Renderer {
                 uniforms.face_count = mct.face_count;
                 uniforms.vertex_count = mct.vertex_count;
             }
+            DrawItem::Htex(htex) => {
+                uniforms.vertex_levels = htex.levels.max(1);
+                uniforms.face_count = htex.face_count;
+                uniforms.vertex_count = htex.vertex_count;
+            }
             DrawItem::Ptex(ptex) => {
                 uniforms.vertex_levels = ptex.levels.max(1);
                 uniforms.face_count = ptex.face_count;
@@ -515,6 +573,10 @@ impl Renderer {
                 let anisotropic = settings.filter == FilterMode::Anisotropic && ctx.anisotropic();
                 let level_mode = if anisotropic { MCT_LEVEL_ANISOTROPIC } else { uniforms.level_mode };
                 (&mct.uniforms, self.mct_pipeline(ctx, level_mode, uniforms.flags))
+            }
+            DrawItem::Htex(htex) => {
+                let target = (self.color_format, FULL_DEPTH);
+                (&htex.uniforms, self.htex.get(ctx, &self.layouts, target, uniforms.level_mode, uniforms.flags))
             }
             DrawItem::Ptex(ptex) => (&ptex.uniforms, self.ptex_pipeline(ctx, uniforms.level_mode, uniforms.flags)),
         };
@@ -552,6 +614,13 @@ impl Renderer {
             DrawItem::Mct(mct) => {
                 pass.set_bind_group(0, &mct.bind_group, &[]);
                 let vertex_count = mct.face_count.saturating_mul(3);
+                if vertex_count > 0 {
+                    pass.draw(0..vertex_count, 0..1);
+                }
+            }
+            DrawItem::Htex(htex) => {
+                pass.set_bind_group(0, &htex.bind_group, &[]);
+                let vertex_count = htex.face_count.saturating_mul(3);
                 if vertex_count > 0 {
                     pass.draw(0..vertex_count, 0..1);
                 }

@@ -36,7 +36,7 @@ impl MenuBar {
                 action_button(ui, "Heat map on / off", Action::ToggleHeatmap, true, &mut chosen);
                 action_button(ui, "Lit / unlit", Action::ToggleShading, true, &mut chosen);
                 action_button(ui, "Next filter", Action::CycleFilter, true, &mut chosen);
-                action_button(ui, "Mesh colors / Mesh Color Textures", Action::ToggleRepresentation, true, &mut chosen);
+                action_button(ui, "Mesh colors / MCT / Ptex / Htex", Action::ToggleRepresentation, true, &mut chosen);
             });
             ui.menu_button("Help", |ui| {
                 action_button(ui, "Shortcuts", Action::ToggleHelp, true, &mut chosen);

@@ -192,22 +192,27 @@ impl ViewPanel {
                 .labelled_by(label.id)
                 .on_hover_text(
                     "T — how the GPU draws the painted colours: mesh colors filtered in the shader (exact), \
-                     Mesh Color Textures (one 2D atlas the GPU's own sampler filters) or packed Ptex \
-                     (per-pair blocks with borders, the GPU's sampler too)",
+                     Mesh Color Textures (one 2D atlas the GPU's own sampler filters), packed Ptex \
+                     (per-pair blocks with borders, the GPU's sampler too) or Htex (one texture per edge, three \
+                     hardware fetches)",
                 );
         });
         let Some(open) = ctx.document else {
             return;
         };
-        if view.representation == Representation::PackedPtex && view.shown == Shown::MeshColors {
-            ptex_status(ui, open, ctx.level0_only);
+        if view.representation == Representation::MeshColors || view.shown != Shown::MeshColors {
             return;
         }
-        if view.representation != Representation::MeshColorTexture || view.shown != Shown::MeshColors {
+        if view.representation == Representation::PackedPtex {
+            ptex_status(ui, open, ctx.level0_only);
             return;
         }
         if ctx.level0_only {
             ui.label(egui::RichText::new("Paint mode draws mesh colors; the texture follows when it ends").weak());
+            return;
+        }
+        if view.representation == Representation::Htex {
+            htex_ui(ui, open);
             return;
         }
         let built = match open.current_mct() {
@@ -239,6 +244,32 @@ impl ViewPanel {
         let measure = || measure_mct_psnr(ctx, open, built, &key);
         let line = ("Mesh Color Texture vs mesh colors", "rendering both");
         psnr_line(ui, &mut self.mct_psnr, key, measure, line);
+    }
+}
+
+/// What the Htex costs (or why it is not shown yet).
+fn htex_ui(ui: &mut egui::Ui, open: &OpenDocument) {
+    match open.current_htex() {
+        None => {
+            ui.label(egui::RichText::new("Building the Htex…").weak());
+        }
+        Some(Err(message)) => {
+            ui.colored_label(ui.visuals().warn_fg_color, format!("Showing the mesh colors: {message}"));
+        }
+        Some(Ok(built)) => {
+            let ((e, f), ([w, h], pages)) = (built.textures, built.pages);
+            ui.label(
+                egui::RichText::new(format!(
+                    "{e} edge textures for {f} faces (E/F {:.2}) in {pages} page(s) of {w} × {h}: {} ({:.2}× the mesh \
+                     colors' buffers), built in {:.0} ms",
+                    e as f64 / f.max(1) as f64,
+                    human_bytes(built.htex.gpu_bytes()),
+                    built.bytes_over_mesh_colors,
+                    built.build.as_secs_f64() * 1000.0
+                ))
+                .weak(),
+            );
+        }
     }
 }
 

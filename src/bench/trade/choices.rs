@@ -43,8 +43,18 @@ pub(super) struct Packed {
     pub(super) pack_seconds: f64,
     /// The MCT built from `packed`, or why it could not be built or uploaded.
     pub(super) mct: Result<MctPack, String>,
+    /// The Htex built from `packed`, or why it could not be built or uploaded.
+    pub(super) htex: Result<HtexPack, String>,
     /// The packed Ptex built from `packed`, or why it could not be built or uploaded.
     pub(super) ptex: Result<PtexPack, String>,
+}
+
+/// An Htex of one pack, on the CPU (for the seam evaluation) and the GPU.
+pub(super) struct HtexPack {
+    pub(super) texture: meshpaint_core::htex::HtexTexture,
+    pub(super) gpu: meshpaint_render::GpuHtex,
+    /// Best of three builds from the packed buffers.
+    pub(super) build_seconds: f64,
 }
 
 /// A packed Ptex of one pack, on the CPU (for the seam evaluation) and the GPU.
@@ -132,8 +142,10 @@ pub(super) fn prepare(
             let packed = packed?;
             let mesh = gpu.upload(&packed)?;
             let mct = if options.mct { build_mct(gpu, &packed, &mesh) } else { Err("not asked (--no-mct)".into()) };
+            let htex = if options.htex { build_htex(gpu, &packed, &mesh) } else { Err("not asked".into()) };
             let ptex = if options.ptex { build_ptex(gpu, &packed, &mesh) } else { Err("not asked (--no-ptex)".into()) };
-            choice.packs.push(Packed { format, packed, mesh, pack_seconds: timing.best_seconds, mct, ptex });
+            let pack_seconds = timing.best_seconds;
+            choice.packs.push(Packed { format, packed, mesh, pack_seconds, mct, htex, ptex });
         }
         if !textured {
             choice.reference = Some(gpu.upload(&choice.document.pack(ColorFormat::Rgba32F)?)?);
@@ -155,6 +167,21 @@ fn build_mct(gpu: &Gpu, packed: &PackedMesh, mesh: &GpuMesh) -> Result<MctPack, 
     let texture = texture.map_err(|e| e.to_string())?;
     let gpu_mct = gpu.upload_mct(&mesh.geometry(), &texture).map_err(|e| e.to_string())?;
     Ok(MctPack { texture, gpu: gpu_mct, build_seconds: timing.best_seconds })
+}
+
+/// The Htex of `packed` (best of three builds, pages up to the device's largest texture and
+/// array) uploaded with `mesh`'s geometry, or why not.
+fn build_htex(gpu: &Gpu, packed: &PackedMesh, mesh: &GpuMesh) -> Result<HtexPack, String> {
+    let limits = gpu.ctx.limits();
+    let options = meshpaint_core::htex::HtexOptions::within(
+        limits.max_texture_dimension_2d,
+        limits.max_texture_array_layers,
+        u64::MAX,
+    );
+    let (timing, texture) = Timing::measure(3, || meshpaint_core::htex::build(packed, &options));
+    let texture = texture.map_err(|e| e.to_string())?;
+    let gpu_htex = gpu.upload_htex(&mesh.geometry(), &texture).map_err(|e| e.to_string())?;
+    Ok(HtexPack { texture, gpu: gpu_htex, build_seconds: timing.best_seconds })
 }
 
 /// The packed Ptex of `packed` (best of three builds, sides up to the device's largest

@@ -116,6 +116,8 @@ pub struct TradeOptions {
     pub formats: Vec<ColorFormat>,
     /// Whether Mesh Color Texture rows are measured beside mesh colors.
     pub mct: bool,
+    /// Whether Htex rows are measured beside mesh colors.
+    pub htex: bool,
     /// Whether packed Ptex rows are measured beside mesh colors.
     pub ptex: bool,
     /// Interleaved timing rounds per view (the median frame is reported).
@@ -134,6 +136,7 @@ impl Default for TradeOptions {
             max_resolution: Resolution::from_log2(6).unwrap_or(Resolution::MAX),
             formats: ColorFormat::ALL.to_vec(),
             mct: true,
+            htex: true,
             ptex: true,
             frames: 5,
             dabs: 10,

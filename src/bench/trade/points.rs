@@ -87,6 +87,7 @@ fn short((representation, resolution, format, filter): &Key) -> String {
     };
     let prefix = match representation.as_str() {
         "mct" => "MCT ",
+        "htex" => "Htex ",
         "ptex" => "Ptex ",
         _ => "",
     };
@@ -101,7 +102,7 @@ pub fn write_plots(rows: &[serde_json::Value], dir: &Path, stem: &str) -> Result
     let (bytes_path, frame_path) = (name("bytes"), name("frame"));
     plot_tradeoff(
         &bytes_path,
-        &format!("{stem}: error vs GPU memory (mesh colors, MCT, packed Ptex × filter × resolution × format)"),
+        &format!("{stem}: error vs GPU memory (mesh colors, MCT, packed Ptex, Htex × filter × resolution × format)"),
         "GPU bytes in total: geometry + colours (log scale)",
         true,
         &bytes,

@@ -6,7 +6,7 @@ use std::time::Instant;
 use super::bvh::bvh_rows;
 use super::choices::{Choice, prepare, resolution_choices};
 use super::metrics::merge;
-use super::seams::{SeamEdges, SeamJump, mct_seam_jumps, ptex_seam_jumps, seam_jumps_over};
+use super::seams::{SeamEdges, SeamJump, htex_seam_jumps, mct_seam_jumps, ptex_seam_jumps, seam_jumps_over};
 use super::study::{Study, views};
 use super::{DISTANCES, TradeOptions};
 use crate::bench::BenchRenderError;
@@ -64,10 +64,11 @@ pub fn bench_trade_streaming(
     let bounds =
         first.packs.first().map_or_else(|| BoundingSphere::of_points(&first.document.positions), |p| p.mesh.bounds);
     let face_count = first.document.store.topology().face_count();
-    let representations: Vec<&str> = [(true, "mesh-colors"), (options.mct, "mct"), (options.ptex, "ptex")]
-        .into_iter()
-        .filter_map(|(on, name)| on.then_some(name))
-        .collect();
+    let representations: Vec<&str> =
+        [(true, "mesh-colors"), (options.mct, "mct"), (options.ptex, "ptex"), (options.htex, "htex")]
+            .into_iter()
+            .filter_map(|(on, name)| on.then_some(name))
+            .collect();
     let mut rows = vec![serde_json::json!({
         "bench": "trade", "kind": "meta", "file": file, "adapter": gpu.describe(),
         "size": options.size, "supersample": crate::bench::adaptive::SUPERSAMPLE, "views": options.views,
@@ -102,15 +103,18 @@ fn skipped_rows(choices: &[Choice], file: &str, options: &TradeOptions) -> Vec<s
     let mut rows = Vec::new();
     for choice in choices {
         for packed in &choice.packs {
-            let failed =
-                [(options.mct, "mct", packed.mct.as_ref().err()), (options.ptex, "ptex", packed.ptex.as_ref().err())];
-            for (representation, reason) in
-                failed.into_iter().filter_map(|(asked, r, e)| Some((r, e?)).filter(|_| asked))
-            {
-                rows.push(serde_json::json!({
-                    "bench": "trade", "kind": "skipped", "file": file, "representation": representation,
-                    "resolution": choice.label, "format": packed.format.name(), "reason": reason,
-                }));
+            let failures = [
+                ("mct", options.mct, packed.mct.as_ref().err()),
+                ("ptex", options.ptex, packed.ptex.as_ref().err()),
+                ("htex", options.htex, packed.htex.as_ref().err()),
+            ];
+            for (representation, asked, failure) in failures {
+                if let (true, Some(reason)) = (asked, failure) {
+                    rows.push(serde_json::json!({
+                        "bench": "trade", "kind": "skipped", "file": file, "representation": representation,
+                        "resolution": choice.label, "format": packed.format.name(), "reason": reason,
+                    }));
+                }
             }
         }
     }
@@ -143,6 +147,9 @@ fn seam_rows(choice: &Choice, file: &str) -> Result<Vec<serde_json::Value>, Benc
     for packed in &choice.packs {
         if let Ok(mct) = &packed.mct {
             push(mct_seam_jumps(&packed.packed, &mct.texture), "mct", packed.format);
+        }
+        if let Ok(htex) = &packed.htex {
+            push(htex_seam_jumps(&packed.packed, &htex.texture), "htex", packed.format);
         }
         if let Ok(ptex) = &packed.ptex {
             push(ptex_seam_jumps(&packed.packed, &ptex.texture), "ptex", packed.format);

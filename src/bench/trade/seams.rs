@@ -7,6 +7,7 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use meshpaint_core::colors::format::Rgba;
+use meshpaint_core::htex::HtexTexture;
 use meshpaint_core::mct::MeshColorTexture;
 use meshpaint_core::packing::linear::PackedMesh;
 use meshpaint_core::packing::sampler::{Filter, sample, sample_trilinear};
@@ -198,6 +199,31 @@ pub fn seam_jumps_over(packed: &PackedMesh, which: SeamEdges) -> Vec<SeamJump> {
 /// CPU evaluation of the sampler ([`MeshColorTexture::sample_level`],
 /// [`MeshColorTexture::sample_trilinear`]). Empty when no edge has two faces.
 pub fn mct_seam_jumps(packed: &PackedMesh, texture: &MeshColorTexture) -> Vec<SeamJump> {
+    let edges = edge_pairs(packed, SeamEdges::Every);
+    if edges.pairs.is_empty() {
+        return Vec::new();
+    }
+    let last = texture.layout.levels.saturating_sub(1);
+    let mut out = Vec::new();
+    for filter in ["linear", "trilinear"] {
+        for level in 0..=last {
+            if filter == "trilinear" && level == last {
+                continue;
+            }
+            let read = |face: u32, w: [f32; 3]| match filter {
+                "linear" => texture.sample_level(face, w, level),
+                _ => texture.sample_trilinear(face, w, level as f32 + 0.5),
+            };
+            out.push(measure(packed, &edges, filter, level, &read));
+        }
+    }
+    out
+}
+
+/// The Htex `texture` (built from `packed`) over every mesh edge, as [`mct_seam_jumps`]:
+/// its CPU evaluation of three bilinear fetches ([`HtexTexture::sample_level`],
+/// [`HtexTexture::sample_trilinear`]) at every level, trilinear at `level + 0.5`.
+pub fn htex_seam_jumps(packed: &PackedMesh, texture: &HtexTexture) -> Vec<SeamJump> {
     let edges = edge_pairs(packed, SeamEdges::Every);
     if edges.pairs.is_empty() {
         return Vec::new();

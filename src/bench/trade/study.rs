@@ -4,7 +4,7 @@
 
 use image::RgbaImage;
 
-use super::choices::{Choice, Packed};
+use super::choices::{Choice, HtexPack, Packed};
 use super::metrics::{compare, error_json, median, merge};
 use super::{DISTANCES, FILTERS, MCT_FILTERS, TradeOptions};
 use crate::bench::BenchRenderError;
@@ -51,6 +51,7 @@ enum Rep {
     MeshColors,
     Mct,
     Ptex,
+    Htex,
 }
 
 impl Rep {
@@ -59,13 +60,14 @@ impl Rep {
             Rep::MeshColors => "mesh-colors",
             Rep::Mct => "mct",
             Rep::Ptex => "ptex",
+            Rep::Htex => "htex",
         }
     }
 }
 
 /// One configuration drawn in a view: a choice, one of its packs, the representation and
-/// an index into [`FILTERS`] (mesh colors) or [`MCT_FILTERS`] (MCT and packed Ptex: both
-/// hardware bilinear, a fixed level or two levels).
+/// an index into [`FILTERS`] (mesh colors) or [`MCT_FILTERS`] (MCT, packed Ptex and Htex:
+/// all hardware bilinear, a fixed level or two levels).
 #[derive(Debug, Clone, Copy)]
 struct Item {
     choice: usize,
@@ -93,7 +95,8 @@ impl Study<'_> {
         for (choice, c) in self.choices.iter().enumerate() {
             for (pack, p) in c.packs.iter().enumerate() {
                 items.extend((0..FILTERS.len()).map(|filter| Item { choice, pack, rep: Rep::MeshColors, filter }));
-                for (rep, ok) in [(Rep::Mct, p.mct.is_ok()), (Rep::Ptex, p.ptex.is_ok())] {
+                let built = [(Rep::Mct, p.mct.is_ok()), (Rep::Ptex, p.ptex.is_ok()), (Rep::Htex, p.htex.is_ok())];
+                for (rep, ok) in built {
                     if ok {
                         items.extend((0..MCT_FILTERS.len()).map(|filter| Item { choice, pack, rep, filter }));
                     }
@@ -109,9 +112,10 @@ impl Study<'_> {
 
     fn draw_item(&self, item: Item) -> DrawItem<'_> {
         let packed = self.packed(item);
-        match (item.rep, &packed.mct, &packed.ptex) {
-            (Rep::Mct, Ok(mct), _) => DrawItem::Mct(&mct.gpu),
-            (Rep::Ptex, _, Ok(ptex)) => DrawItem::Ptex(&ptex.gpu),
+        match (item.rep, &packed.mct, &packed.ptex, &packed.htex) {
+            (Rep::Mct, Ok(mct), _, _) => DrawItem::Mct(&mct.gpu),
+            (Rep::Ptex, _, Ok(ptex), _) => DrawItem::Ptex(&ptex.gpu),
+            (Rep::Htex, _, _, Ok(htex)) => DrawItem::Htex(&htex.gpu),
             _ => DrawItem::MeshColors(&packed.mesh),
         }
     }
@@ -228,9 +232,10 @@ impl Study<'_> {
             "pack_seconds": packed.pack_seconds,
             "convert_seconds": choice.convert_seconds,
         });
-        let more = match (item.rep, &packed.mct, &packed.ptex) {
-            (Rep::Ptex, _, Ok(ptex)) => ptex_json(packed, ptex),
-            (Rep::Mct, Ok(mct), _) => serde_json::json!({
+        let more = match (item.rep, &packed.mct, &packed.ptex, &packed.htex) {
+            (Rep::Htex, _, _, Ok(htex)) => htex_json(packed, htex),
+            (Rep::Ptex, _, Ok(ptex), _) => ptex_json(packed, ptex),
+            (Rep::Mct, Ok(mct), _, _) => serde_json::json!({
                 "gpu_bytes": packed.geometry_bytes() + mct.gpu.gpu_bytes(),
                 "color_gpu_bytes": mct.gpu.gpu_bytes(),
                 "mct_bytes": mct.texture.gpu_bytes(),
@@ -252,6 +257,26 @@ impl Study<'_> {
         merge(&mut row, &more);
         row
     }
+}
+
+/// The Htex columns of a `config` row: bytes (pages + tables; the pages' texels the colours
+/// need, without borders and free space), the paper's E/F texture count, build time, the
+/// largest colour jump at level 0 across intrinsic edges (corner texels equalised).
+fn htex_json(packed: &Packed, htex: &HtexPack) -> serde_json::Value {
+    let (e, f) = htex.texture.texture_count();
+    let layout = &htex.texture.layout;
+    let bpp = htex.texture.format.bytes_per_sample() as u64;
+    serde_json::json!({
+        "gpu_bytes": packed.geometry_bytes() + htex.gpu.gpu_bytes(),
+        "color_gpu_bytes": htex.gpu.gpu_bytes(),
+        "htex_bytes": htex.texture.gpu_bytes(),
+        "htex_inside_texel_bytes": layout.inside_texels() * bpp,
+        "htex_bytes_over_mesh_colors": htex.texture.gpu_bytes() as f64 / packed.mesh_colors_bytes().max(1) as f64,
+        "htex_build_seconds": htex.build_seconds,
+        "htex_textures": e, "htex_faces": f, "htex_e_over_f": e as f64 / f.max(1) as f64,
+        "htex_pages": [layout.page_size, layout.page_height, layout.pages],
+        "htex_levels": layout.levels,
+    })
 }
 
 /// The packed Ptex columns of a `config` row: bytes (GPU, and over the packed mesh colors),

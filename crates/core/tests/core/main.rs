@@ -10,6 +10,7 @@ mod examples;
 mod follow_brush;
 mod fuzz;
 mod hard_edge;
+mod htex;
 mod import;
 mod layers;
 mod layers_file;

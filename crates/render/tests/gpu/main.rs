@@ -6,6 +6,7 @@ mod common;
 
 mod baseline_materials;
 mod gpu_atlas_addressing;
+mod gpu_htex;
 mod gpu_mct;
 mod gpu_paint_upload;
 mod gpu_ptex;

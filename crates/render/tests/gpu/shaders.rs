@@ -5,13 +5,14 @@
 
 use std::path::Path;
 
-use meshpaint_render::{FRAME_WGSL, FrameUniforms, MCT_WGSL, MESH_COLORS_WGSL, PTEX_WGSL, UV_BASELINE_WGSL};
+use meshpaint_render::{FRAME_WGSL, FrameUniforms, HTEX_WGSL, MCT_WGSL, MESH_COLORS_WGSL, PTEX_WGSL, UV_BASELINE_WGSL};
 
 /// The assembled sources, by the name of the file each one ends with.
-const SOURCES: [(&str, &str); 4] = [
+const SOURCES: [(&str, &str); 5] = [
     ("mesh_colors.wgsl", MESH_COLORS_WGSL),
     ("uv_baseline.wgsl", UV_BASELINE_WGSL),
     ("mct.wgsl", MCT_WGSL),
+    ("htex.wgsl", HTEX_WGSL),
     ("ptex.wgsl", PTEX_WGSL),
 ];
 
@@ -37,7 +38,15 @@ fn every_shader_parses_and_validates() {
     names.sort();
     assert_eq!(
         names,
-        ["frame.wgsl", "mct.wgsl", "mesh_colors.wgsl", "mesh_common.wgsl", "ptex.wgsl", "uv_baseline.wgsl"]
+        [
+            "frame.wgsl",
+            "htex.wgsl",
+            "mct.wgsl",
+            "mesh_colors.wgsl",
+            "mesh_common.wgsl",
+            "ptex.wgsl",
+            "uv_baseline.wgsl"
+        ]
     );
     for (name, source) in SOURCES {
         assert!(source.starts_with(FRAME_WGSL), "{name} does not start with shaders/frame.wgsl");
@@ -50,7 +59,7 @@ fn every_shader_parses_and_validates() {
 
 #[test]
 fn shaders_have_the_entry_points_and_bindings_the_renderer_uses() {
-    for ((name, source), bindings) in SOURCES.into_iter().zip([0..6u32, 0..3u32, 0..9u32]) {
+    for ((name, source), bindings) in SOURCES.into_iter().zip([0..6u32, 0..3u32, 0..9u32, 0..8u32]) {
         let (module, _) = validate(name, source);
         let entry_points: Vec<&str> = module.entry_points.iter().map(|entry| entry.name.as_str()).collect();
         assert!(entry_points.contains(&"vs_main") && entry_points.contains(&"fs_main"), "{name}: {entry_points:?}");
