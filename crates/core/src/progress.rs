@@ -36,6 +36,9 @@ pub struct Reporter<'a> {
     external: Option<&'a AtomicBool>,
     /// The largest fraction reported, as `f32` bits (non-negative floats order as their bits).
     last: AtomicU32,
+    /// Held while the sink is called: two threads' reports reach it in the order of their
+    /// fractions (a lock-free maximum alone let a smaller one arrive after a larger one).
+    order: std::sync::Mutex<()>,
 }
 
 impl std::fmt::Debug for Reporter<'_> {
@@ -50,7 +53,13 @@ impl std::fmt::Debug for Reporter<'_> {
 impl<'a> Reporter<'a> {
     /// A reporter that hands `(fraction of the whole in [0, 1], stage)` to `sink`, from any thread.
     pub fn new(sink: impl Fn(f32, &str) + Send + Sync + 'a) -> Self {
-        Reporter { sink: Box::new(sink), cancelled: AtomicBool::new(false), external: None, last: AtomicU32::new(0) }
+        Reporter {
+            sink: Box::new(sink),
+            cancelled: AtomicBool::new(false),
+            external: None,
+            last: AtomicU32::new(0),
+            order: std::sync::Mutex::new(()),
+        }
     }
 
     /// [`Reporter::new`], also cancelled once `flag` is set.
@@ -85,6 +94,8 @@ impl<'a> Reporter<'a> {
 
     fn report(&self, fraction: f32, stage: &str) {
         let fraction = if fraction.is_finite() { fraction.clamp(0.0, 1.0) } else { 0.0 };
+        // A poisoned lock only means a sink panicked on another thread; the order still holds.
+        let _order = self.order.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         let previous = self.last.fetch_max(fraction.to_bits(), Ordering::Relaxed);
         (self.sink)(fraction.max(f32::from_bits(previous)), stage);
     }
