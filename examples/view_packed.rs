@@ -150,6 +150,10 @@ fn vertex_lod(positions: &[[f32; 3]], indices: &[u32], face_records: &[u32]) -> 
     (density.iter().map(|&d| if d.is_finite() { d as f32 } else { f32::MAX }).collect(), normals)
 }
 
+/// Levels added to the trilinear level of detail: the pixel size is scaled by `2^LOD_BIAS`.
+/// Keep in sync with `LOD_BIAS` in crates/core/src/packing/lod.rs (the renderer applies it).
+const LOD_BIAS: f64 = -2.0;
+
 /// `struct FrameUniforms` of shaders/frame.wgsl (176 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -267,12 +271,13 @@ pub fn view_packed(input: &Path, output: &Path, size: (u32, u32), yaw: f64, pitc
         light: [light.x as f32, light.y as f32, light.z as f32, 0.25],
         wire_color: [0.0, 0.0, 0.0, 0.85],
         tint: [1.0; 4],
-        // Eye relative to the origin; the world size of a pixel at unit depth (40° fov).
+        // Eye relative to the origin; the world size of a pixel at unit depth (40° fov),
+        // scaled by 2^LOD_BIAS (docs/FORMAT.md, the level of detail).
         lod_eye: [
             eye.x as f32,
             eye.y as f32,
             eye.z as f32,
-            (2.0 * 20.0f64.to_radians().tan() / f64::from(height.max(1))) as f32,
+            (2.0 * 20.0f64.to_radians().tan() / f64::from(height.max(1)) * LOD_BIAS.exp2()) as f32,
         ],
         filter_kind: 1, // linear
         level_mode: 1,  // automatic level (trilinear)

@@ -36,7 +36,8 @@ fn steps(gpu: [u8; 4], truth: [f32; 4]) -> u8 {
     (0..3).map(|c| gpu[c].abs_diff(encode_srgb8(truth[c]))).max().unwrap_or(0)
 }
 
-/// The trilinear level of detail of mesh colors (crates/core/src/packing/lod.rs) in `f64`.
+/// The trilinear level of detail of mesh colors (crates/core/src/packing/lod.rs) in `f64`,
+/// each vertex term with the bias `LOD_BIAS`.
 fn continuous_lod(packed: &PackedMesh, inputs: &VertexLod, camera: &OrbitCamera, face: u32, bary: [f32; 3]) -> f32 {
     let eye = camera.eye();
     let forward = (DVec3::from_array(camera.target) - eye).normalize();
@@ -47,7 +48,8 @@ fn continuous_lod(packed: &PackedMesh, inputs: &VertexLod, camera: &OrbitCamera,
         let n = DVec3::from_array(inputs.normal(v as usize).unwrap().map(f64::from));
         let to_eye = eye - p;
         let cosine = n.dot(to_eye).abs() / to_eye.length();
-        let term = (kappa * f64::from(inputs.density[v as usize]) / cosine.max(1.0 / 16.0)).log2();
+        let term = (kappa * f64::from(inputs.density[v as usize]) / cosine.max(1.0 / 16.0)).log2()
+            + f64::from(meshpaint_core::packing::lod::LOD_BIAS);
         depth += f64::from(bary[k]) * (p - eye).dot(forward);
         mu += f64::from(bary[k]) * term.clamp(-64.0, 64.0);
     }
